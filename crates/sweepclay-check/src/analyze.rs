@@ -1,0 +1,461 @@
+//! The checks: continuity, bounds, collision and support, from the replayed
+//! moves. Beads are kept in a grid of 4 × 4 × 2 mm cells so each question
+//! ("what clay is below this bead?", "is clay inside the nozzle cylinder?")
+//! looks at a few cells, not at every earlier bead.
+
+use crate::parse::{parse, Diagnostic};
+use crate::replay::{replay, Event, Move};
+use crate::report::{Count, Report};
+use crate::CheckConfig;
+use rustc_hash::FxHashMap;
+
+const EPS_E: f64 = 1e-7;
+const CELL_XY: f64 = 4.0;
+const CELL_Z: f64 = 2.0;
+
+/// A deposited move.
+struct Bead {
+    from: [f64; 3],
+    to: [f64; 3],
+    width: f64,
+    /// Path distance at the end of the move.
+    s_end: f64,
+    /// Turnaround step (steeper than 1:2): clay, but no support for others.
+    step: bool,
+}
+
+impl Bead {
+    /// Closest point of the bead's centreline (in plan) to `p`:
+    /// `(parameter, horizontal distance, height there)`.
+    fn closest(&self, p: [f64; 3]) -> (f64, f64, f64) {
+        let (dx, dy) = (self.to[0] - self.from[0], self.to[1] - self.from[1]);
+        let l2 = dx * dx + dy * dy;
+        let t = if l2 > 0.0 {
+            (((p[0] - self.from[0]) * dx + (p[1] - self.from[1]) * dy) / l2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        let (x, y) = (self.from[0] + t * dx, self.from[1] + t * dy);
+        let z = self.from[2] + t * (self.to[2] - self.from[2]);
+        (t, (p[0] - x).hypot(p[1] - y), z)
+    }
+}
+
+fn cell(v: f64, size: f64) -> i32 {
+    (v / size).floor().clamp(-1e8, 1e8) as i32
+}
+
+#[derive(Default)]
+struct BeadGrid {
+    cells: FxHashMap<(i32, i32, i32), Vec<u32>>,
+    column_max: FxHashMap<(i32, i32), f64>,
+}
+
+impl BeadGrid {
+    fn insert(&mut self, b: &Bead, id: u32) {
+        let (x0, x1) = (
+            cell(b.from[0].min(b.to[0]), CELL_XY),
+            cell(b.from[0].max(b.to[0]), CELL_XY),
+        );
+        let (y0, y1) = (
+            cell(b.from[1].min(b.to[1]), CELL_XY),
+            cell(b.from[1].max(b.to[1]), CELL_XY),
+        );
+        let ztop = b.from[2].max(b.to[2]);
+        let (z0, z1) = (cell(b.from[2].min(b.to[2]), CELL_Z), cell(ztop, CELL_Z));
+        // Very long moves (other slicers) are bounded to keep memory sane.
+        if (x1 - x0) as i64 * (y1 - y0) as i64 * (z1 - z0 + 1) as i64 > 100_000 {
+            return;
+        }
+        for x in x0..=x1 {
+            for y in y0..=y1 {
+                let m = self.column_max.entry((x, y)).or_insert(f64::MIN);
+                *m = m.max(ztop);
+                for z in z0..=z1 {
+                    self.cells.entry((x, y, z)).or_default().push(id);
+                }
+            }
+        }
+    }
+
+    /// Ids in cells within `r` (plan) of `p` and heights `zlo..=zhi`.
+    fn for_each(&self, p: [f64; 3], r: f64, zlo: f64, zhi: f64, mut f: impl FnMut(u32)) {
+        let (x0, x1) = (cell(p[0] - r, CELL_XY), cell(p[0] + r, CELL_XY));
+        let (y0, y1) = (cell(p[1] - r, CELL_XY), cell(p[1] + r, CELL_XY));
+        let (z0, z1) = (cell(zlo, CELL_Z), cell(zhi, CELL_Z));
+        for x in x0..=x1 {
+            for y in y0..=y1 {
+                let Some(&top) = self.column_max.get(&(x, y)) else {
+                    continue;
+                };
+                if top < zlo {
+                    continue;
+                }
+                for z in z0..=z1.min(cell(top, CELL_Z)) {
+                    if let Some(v) = self.cells.get(&(x, y, z)) {
+                        v.iter().for_each(|&id| f(id));
+                    }
+                }
+            }
+        }
+    }
+}
+
+/// Overlap of a bead of width `wa` with one of width `wb` whose centre is
+/// `s` to the side, as a fraction of `wa`.
+fn overlap_fraction(wa: f64, wb: f64, s: f64) -> f64 {
+    let lo = (-wa / 2.0).max(s - wb / 2.0);
+    let hi = (wa / 2.0).min(s + wb / 2.0);
+    ((hi - lo).max(0.0) / wa).min(1.0)
+}
+
+fn minmax(slot: &mut Option<[(f64, usize); 2]>, v: f64, line: usize) {
+    match slot {
+        None => *slot = Some([(v, line), (v, line)]),
+        Some([lo, hi]) => {
+            if v < lo.0 {
+                *lo = (v, line);
+            }
+            if v > hi.0 {
+                *hi = (v, line);
+            }
+        }
+    }
+}
+
+/// Checks a G-code text. Never panics, whatever the input.
+pub fn check(text: &str, cfg: &CheckConfig) -> Report {
+    let mut diags: Vec<Diagnostic> = Vec::new();
+    let lines = parse(text, &mut diags);
+    let events = replay(&lines, &mut diags);
+    let mut r = Report {
+        lines: text.lines().count(),
+        ..Report::default()
+    };
+    let is_extruding = |m: &Move| m.de > EPS_E;
+    let first = events
+        .iter()
+        .position(|e| matches!(e, Event::Move(m) if is_extruding(m)));
+    let last = events
+        .iter()
+        .rposition(|e| matches!(e, Event::Move(m) if is_extruding(m)));
+
+    // Continuity.
+    let mut in_run = false;
+    for (i, ev) in events.iter().enumerate() {
+        let inside = first.is_some_and(|f| i > f) && last.is_some_and(|l| i < l);
+        match ev {
+            Event::Pause(line) => {
+                if inside {
+                    r.pauses.add(*line, 0.0);
+                    in_run = false;
+                }
+            }
+            Event::Move(m) => {
+                r.moves += 1;
+                let len = m.length();
+                if m.de < -EPS_E {
+                    if first.is_some_and(|f| i > f) {
+                        r.retractions.add(m.line, -m.de);
+                    }
+                    in_run = false;
+                } else if is_extruding(m) {
+                    r.extruding_moves += 1;
+                    if len == 0.0 {
+                        r.extrusion_without_motion.add(m.line, m.de);
+                    }
+                    if !in_run {
+                        r.extrusion_runs += 1;
+                        if r.run_starts.len() < 20 {
+                            r.run_starts.push(m.line);
+                        }
+                    }
+                    in_run = true;
+                } else if len > 0.0 {
+                    if inside {
+                        r.travel_moves.add(m.line, len);
+                    }
+                    in_run = false;
+                }
+                // Bounds.
+                let bv = cfg.build_volume;
+                let out =
+                    m.to.iter()
+                        .zip(bv)
+                        .fold(0.0f64, |o, (&v, lim)| o.max(-v).max(v - lim));
+                if out > 1e-3 {
+                    r.out_of_bounds.add(m.line, out);
+                }
+            }
+        }
+    }
+
+    // Deposition replay: support and collisions.
+    let mut beads: Vec<Bead> = Vec::new();
+    let mut grid = BeadGrid::default();
+    let mut stamp: Vec<u32> = Vec::new();
+    let mut s = 0.0f64;
+    let mut top_z = f64::MIN;
+    let mut lo = [f64::MAX; 3];
+    let mut hi = [f64::MIN; 3];
+    let mut layer_heights = Vec::new();
+    let recent_nozzle = cfg.nozzle_radius + cfg.width_max;
+    let recent_support = 3.0 * cfg.width_max;
+    let reach = cfg.nozzle_radius + cfg.width_max / 2.0;
+    for (i, ev) in events.iter().enumerate() {
+        let Event::Move(m) = ev else { continue };
+        let len = m.length();
+        let s_start = s;
+        s += len;
+        if m.feed > 0.0 {
+            r.time_min += len / m.feed;
+        }
+        let active = first.is_some_and(|f| i >= f) && last.is_some_and(|l| i <= l);
+        if !active {
+            continue;
+        }
+        // Collisions at points along the move (every r/2 mm, end included).
+        let samples = ((len / (cfg.nozzle_radius / 2.0).max(0.5)).ceil() as usize).clamp(1, 10_000);
+        for k in 1..=samples {
+            let t = k as f64 / samples as f64;
+            let p = [
+                m.from[0] + t * (m.to[0] - m.from[0]),
+                m.from[1] + t * (m.to[1] - m.from[1]),
+                m.from[2] + t * (m.to[2] - m.from[2]),
+            ];
+            let sp = s_start + t * len;
+            if top_z > p[2] + cfg.nozzle_height + cfg.collision_tolerance_mm {
+                r.carriage_collisions
+                    .add(m.line, top_z - p[2] - cfg.nozzle_height);
+            }
+            let mut worst: f64 = 0.0;
+            let zlo = p[2] + cfg.collision_tolerance_mm;
+            grid.for_each(p, reach, zlo, p[2] + cfg.nozzle_height, |id| {
+                let b = &beads[id as usize];
+                if b.s_end > sp - recent_nozzle {
+                    return;
+                }
+                let (_, d, z) = b.closest(p);
+                if z > zlo && d < cfg.nozzle_radius + b.width / 2.0 {
+                    worst = worst.max(z - p[2]);
+                }
+            });
+            if worst > 0.0 {
+                r.nozzle_collisions.add(m.line, worst);
+            }
+        }
+        if !is_extruding(m) || len == 0.0 {
+            continue;
+        }
+        r.path_length_mm += len;
+        let volume = m.de / cfg.e_per_mm3;
+        r.volume_ml += volume / 1000.0;
+        for p in [m.from, m.to] {
+            for a in 0..3 {
+                lo[a] = lo[a].min(p[a]);
+                hi[a] = hi[a].max(p[a]);
+            }
+        }
+        if r.first_layer_z.is_none() {
+            r.first_layer_z = Some(m.from[2].max(m.to[2]));
+        }
+        let rise = (m.to[2] - m.from[2]).abs();
+        let step = m.xy_length() <= 2.0 * rise;
+        let id = beads.len() as u32;
+        let mut width = cfg.width_min;
+        if step {
+            r.support.steps += 1;
+        } else {
+            let mid = [
+                0.5 * (m.from[0] + m.to[0]),
+                0.5 * (m.from[1] + m.to[1]),
+                0.5 * (m.from[2] + m.to[2]),
+            ];
+            stamp.resize(beads.len(), u32::MAX);
+            let mut inside: Option<(f64, f64, f64)> = None; // (z, d, width)
+            let mut outside: Option<(f64, f64, f64)> = None;
+            let mut double = false;
+            grid.for_each(
+                mid,
+                cfg.width_max,
+                mid[2] - cfg.max_gap_mm,
+                mid[2] + cfg.min_layer_mm,
+                |j| {
+                    let ju = j as usize;
+                    if stamp[ju] == id {
+                        return;
+                    }
+                    stamp[ju] = id;
+                    let b = &beads[ju];
+                    if b.step || b.s_end >= s_start - 1e-9 {
+                        return;
+                    }
+                    let (t, d, z) = b.closest(mid);
+                    let interior = t > 0.02 && t < 0.98;
+                    if !interior && s_start - b.s_end <= recent_support {
+                        return;
+                    }
+                    if z <= mid[2] - cfg.min_layer_mm {
+                        if mid[2] - z > cfg.max_gap_mm {
+                            return;
+                        }
+                        let slot = if d <= b.width / 2.0 {
+                            &mut inside
+                        } else if d <= cfg.width_max {
+                            &mut outside
+                        } else {
+                            return;
+                        };
+                        // Highest clay wins; at the same height, the nearest.
+                    if slot.is_none_or(|(bz, bd, _)| z > bz + 0.05 || (z > bz - 0.05 && d < bd)) {
+                            *slot = Some((z, d, b.width));
+                        }
+                    } else if (z - mid[2]).abs() < cfg.min_layer_mm
+                        && d < 0.5 * b.width.min(cfg.width_min)
+                    {
+                        double = true;
+                    }
+                },
+            );
+            r.support.beads += 1;
+            if double {
+                r.support.double_deposition.add(m.line, 0.0);
+            }
+            let support = inside.or(outside);
+            let (dz, overlap, offset) = match support {
+                Some((z, d, wb)) => {
+                    let dz = mid[2] - z;
+                    width = volume / (len * dz);
+                    (dz, overlap_fraction(width, wb, d), d)
+                }
+                None if mid[2] <= cfg.first_layer_max_mm => {
+                    r.support.on_bed += 1;
+                    width = volume / (len * mid[2].max(1e-6));
+                    (mid[2], 1.0, 0.0)
+                }
+                None => {
+                    r.support.unsupported.add(m.line, mid[2]);
+                    (f64::NAN, f64::NAN, 0.0)
+                }
+            };
+            if dz.is_finite() {
+                layer_heights.push(dz);
+                minmax(&mut r.support.layer_height, dz, m.line);
+                minmax(&mut r.support.width, width, m.line);
+                let bin = if overlap < 0.5 {
+                    0
+                } else if overlap < 0.6 {
+                    1
+                } else if overlap < cfg.overlap_target - 1e-9 {
+                    2
+                } else if overlap < 0.9 {
+                    3
+                } else {
+                    4
+                };
+                r.support.overlap_histogram[bin] += 1;
+                if r.support.min_overlap.is_none_or(|(v, _)| overlap < v) {
+                    r.support.min_overlap = Some((overlap, m.line));
+                }
+                if overlap < cfg.overlap_min - 1e-9 {
+                    r.support.under_min.add(m.line, cfg.overlap_min - overlap);
+                }
+                if overlap < cfg.overlap_target - 1e-6 {
+                    r.support.under_target += 1;
+                }
+                let angle = (offset / dz).atan().to_degrees();
+                if r.support.max_overhang_deg.is_none_or(|(v, _)| angle > v) {
+                    r.support.max_overhang_deg = Some((angle, m.line));
+                }
+                if angle > cfg.max_overhang_deg + cfg.overhang_tolerance_deg {
+                    r.support.overhang.add(m.line, angle);
+                }
+            }
+        }
+        let bead = Bead {
+            from: m.from,
+            to: m.to,
+            width: if width.is_finite() {
+                width.clamp(0.0, 1e3)
+            } else {
+                cfg.width_min
+            },
+            s_end: s,
+            step,
+        };
+        grid.insert(&bead, id);
+        top_z = top_z.max(bead.from[2].max(bead.to[2]));
+        beads.push(bead);
+    }
+    if r.extruding_moves > 0 {
+        r.size_mm = [hi[0] - lo[0], hi[1] - lo[1], hi[2].max(0.0)];
+    }
+    if !layer_heights.is_empty() {
+        layer_heights.sort_by(f64::total_cmp);
+        let median = layer_heights[layer_heights.len() / 2];
+        if median > 0.0 {
+            r.layers = (hi[2] / median).round() as usize;
+        }
+    }
+    diags.truncate(50);
+    r.diagnostics = diags;
+    verdict(&mut r, cfg);
+    r
+}
+
+fn verdict(r: &mut Report, cfg: &CheckConfig) {
+    let mut f = Vec::new();
+    let line = |c: &Count| {
+        c.first_line
+            .map(|l| format!(" (first at line {l})"))
+            .unwrap_or_default()
+    };
+    if r.extruding_moves == 0 {
+        f.push("no extrusion at all".to_string());
+    }
+    if r.extrusion_runs > 1 {
+        f.push(format!(
+            "{} separate extrusion runs, must be 1 (the second starts at line {})",
+            r.extrusion_runs, r.run_starts[1]
+        ));
+    }
+    for (name, c) in [
+        ("travel move(s) after the first bead", &r.travel_moves),
+        ("retraction(s)", &r.retractions),
+        ("pause(s)", &r.pauses),
+        ("extrusion(s) without motion", &r.extrusion_without_motion),
+        ("move(s) outside the build volume", &r.out_of_bounds),
+        (
+            "nozzle collision(s) with printed clay",
+            &r.nozzle_collisions,
+        ),
+        (
+            "carriage collision(s) with printed clay",
+            &r.carriage_collisions,
+        ),
+        ("bead(s) with no clay below", &r.support.unsupported),
+        (
+            "bead(s) laid on clay at their own height",
+            &r.support.double_deposition,
+        ),
+        (
+            "bead(s) overlapping the bead below by less than half",
+            &r.support.under_min,
+        ),
+        ("overhang(s) beyond the limit", &r.support.overhang),
+    ] {
+        if c.count > 0 {
+            f.push(format!("{} {name}{}", c.count, line(c)));
+        }
+    }
+    if let Some(z) = r.first_layer_z {
+        if z > cfg.first_layer_max_mm {
+            f.push(format!(
+                "the first bead is {z:.2} mm above the bed (at most {} mm)",
+                cfg.first_layer_max_mm
+            ));
+        }
+    }
+    r.printable = f.is_empty();
+    r.failures = f;
+}

@@ -1,0 +1,208 @@
+//! Replays parsed G-code into a list of moves in absolute millimetres and
+//! absolute E: G0/G1 with any subset of X Y Z E F, G90/G91, M82/M83, G92,
+//! G20/G21, G28; G4, M0, M1 and M600 are pauses; unknown commands are
+//! reported, not fatal.
+
+use crate::parse::{Diagnostic, Line};
+
+/// One linear move.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Move {
+    /// Source line.
+    pub line: usize,
+    /// Start position (mm).
+    pub from: [f64; 3],
+    /// End position (mm).
+    pub to: [f64; 3],
+    /// E change of the move (E units; negative = retraction).
+    pub de: f64,
+    /// Feedrate in force (mm/min).
+    pub feed: f64,
+}
+
+impl Move {
+    /// 3D length (mm).
+    pub fn length(&self) -> f64 {
+        let d = sub(self.to, self.from);
+        (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
+    }
+
+    /// Horizontal length (mm).
+    pub fn xy_length(&self) -> f64 {
+        (self.to[0] - self.from[0]).hypot(self.to[1] - self.from[1])
+    }
+}
+
+fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
+    [a[0] - b[0], a[1] - b[1], a[2] - b[2]]
+}
+
+/// An event in print order.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum Event {
+    /// A move.
+    Move(Move),
+    /// A pause (G4, M0, M1, M600) at a line.
+    Pause(usize),
+}
+
+/// Replays the lines. Returns the events; diagnostics are appended.
+pub fn replay(lines: &[Line], diags: &mut Vec<Diagnostic>) -> Vec<Event> {
+    let mut pos = [0.0f64; 3];
+    let mut e = 0.0f64;
+    let mut abs_xyz = true;
+    let mut abs_e = true;
+    let mut scale = 1.0;
+    let mut feed = 0.0;
+    let mut out = Vec::new();
+    let mut unknown_reported = std::collections::BTreeSet::new();
+    for l in lines {
+        let Some(letter) = l.letter else {
+            diags.push(Diagnostic {
+                line: l.line,
+                message: "parameters without a command".into(),
+            });
+            continue;
+        };
+        match (letter, l.code) {
+            ('G', c) if c == 0.0 || c == 1.0 => {
+                let mut to = pos;
+                for (a, k) in ['X', 'Y', 'Z'].into_iter().enumerate() {
+                    if let Some(v) = l.get(k) {
+                        to[a] = if abs_xyz {
+                            v * scale
+                        } else {
+                            pos[a] + v * scale
+                        };
+                    }
+                }
+                let mut de = 0.0;
+                if let Some(v) = l.get('E') {
+                    let v = v * scale;
+                    de = if abs_e { v - e } else { v };
+                    e += de;
+                }
+                if let Some(f) = l.get('F') {
+                    feed = f * scale;
+                }
+                out.push(Event::Move(Move {
+                    line: l.line,
+                    from: pos,
+                    to,
+                    de,
+                    feed,
+                }));
+                pos = to;
+            }
+            ('G', 2.0) | ('G', 3.0) => diags.push(Diagnostic {
+                line: l.line,
+                message: "arc moves (G2/G3) are not replayed".into(),
+            }),
+            ('G', 4.0) | ('M', 0.0) | ('M', 1.0) | ('M', 600.0) => out.push(Event::Pause(l.line)),
+            ('G', 20.0) => scale = 25.4,
+            ('G', 21.0) => scale = 1.0,
+            ('G', 28.0) => {
+                let any = ['X', 'Y', 'Z'].iter().any(|k| l.get(*k).is_some());
+                let mut to = pos;
+                for (a, k) in ['X', 'Y', 'Z'].into_iter().enumerate() {
+                    if !any || l.get(k).is_some() {
+                        to[a] = 0.0;
+                    }
+                }
+                out.push(Event::Move(Move {
+                    line: l.line,
+                    from: pos,
+                    to,
+                    de: 0.0,
+                    feed,
+                }));
+                pos = to;
+            }
+            ('G', 90.0) => {
+                abs_xyz = true;
+                abs_e = true;
+            }
+            ('G', 91.0) => {
+                abs_xyz = false;
+                abs_e = false;
+            }
+            ('G', 92.0) => {
+                if l.params.is_empty() {
+                    pos = [0.0; 3];
+                    e = 0.0;
+                }
+                for (a, k) in ['X', 'Y', 'Z'].into_iter().enumerate() {
+                    if let Some(v) = l.get(k) {
+                        pos[a] = v * scale;
+                    }
+                }
+                if let Some(v) = l.get('E') {
+                    e = v * scale;
+                }
+            }
+            ('M', 82.0) => abs_e = true,
+            ('M', 83.0) => abs_e = false,
+            // Known commands with no effect on the deposition.
+            ('M', c)
+                if [
+                    17.0, 18.0, 84.0, 104.0, 105.0, 106.0, 107.0, 109.0, 110.0, 114.0, 115.0,
+                    117.0, 140.0, 190.0, 201.0, 203.0, 204.0, 205.0, 220.0, 221.0, 400.0, 73.0,
+                    107.0,
+                ]
+                .contains(&c) => {}
+            ('G', c) if [29.0, 17.0, 80.0].contains(&c) => {}
+            ('T', _) => {}
+            (k, c) => {
+                if unknown_reported.insert(format!("{k}{c}")) {
+                    diags.push(Diagnostic {
+                        line: l.line,
+                        message: format!("unknown command {k}{c} ignored"),
+                    });
+                }
+            }
+        }
+    }
+    out
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::parse::parse;
+
+    fn moves(text: &str) -> Vec<Move> {
+        let mut d = vec![];
+        replay(&parse(text, &mut d), &mut d)
+            .into_iter()
+            .filter_map(|e| match e {
+                Event::Move(m) => Some(m),
+                Event::Pause(_) => None,
+            })
+            .collect()
+    }
+
+    #[test]
+    fn absolute_and_relative_modes() {
+        let m = moves("G90\nM82\nG1 X10 E1\nG1 X20 E3\nM83\nG1 X30 E2\nG91\nG1 X5 E1\n");
+        assert_eq!(m.len(), 4);
+        assert_eq!((m[0].de, m[1].de, m[2].de, m[3].de), (1.0, 2.0, 2.0, 1.0));
+        assert_eq!(m[3].to[0], 35.0);
+    }
+
+    #[test]
+    fn g92_and_inches() {
+        let m = moves("G1 X1 E5\nG92 E0\nG1 X2 E1\nG20\nG1 X1\n");
+        assert_eq!(m[1].de, 1.0);
+        assert!((m[2].to[0] - 25.4).abs() < 1e-12);
+    }
+
+    #[test]
+    fn pauses_and_unknowns() {
+        let mut d = vec![];
+        let ev = replay(&parse("G4 P100\nM600\nM999\nG1 X1\n", &mut d), &mut d);
+        assert!(matches!(ev[0], Event::Pause(1)));
+        assert!(matches!(ev[1], Event::Pause(2)));
+        assert_eq!(d.len(), 1);
+        assert_eq!(d[0].line, 3);
+    }
+}

@@ -1,0 +1,346 @@
+//! Stage 2: sampled surface → corrected surface (paper §4 "Support-free
+//! correction" and "Self-intersection detection and treatment"; DESIGN.md §5).
+//!
+//! - Support-free: each transition curve is walked upward; a step whose
+//!   horizontal offset exceeds s_max(Δz) is shortened to s_max and every
+//!   point above moves with it.
+//! - Self-intersection: surface points of transition curves more than 1.6
+//!   bead widths apart along Ψ that come closer than the widest bead are
+//!   found with a 3D grid (linear time). As in the paper, C_s and C_t are
+//!   then compressed along x (all radial offsets scaled by c = 0.9, 0.81, …)
+//!   until none remains.
+
+use crate::error::{Error, Result};
+use crate::grid::Grid3;
+use crate::surface::Surface;
+use serde::Serialize;
+
+/// Which curve a correction touched.
+#[derive(Clone, Copy, Debug, PartialEq, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum CurveId {
+    /// C_s, the start profile.
+    ProfileStart,
+    /// C_t, the end profile.
+    ProfileEnd,
+    /// The transition curve at column `i`.
+    Transition(u32),
+}
+
+impl std::fmt::Display for CurveId {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            CurveId::ProfileStart => write!(f, "profile_start (C_s)"),
+            CurveId::ProfileEnd => write!(f, "profile_end (C_t)"),
+            CurveId::Transition(i) => write!(f, "transition curve {i}"),
+        }
+    }
+}
+
+/// A curve moved by the support-free correction.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SupportFix {
+    /// The curve.
+    pub curve: CurveId,
+    /// Normalised arc length of the curve's position along Ψ.
+    pub u: f64,
+    /// Height of the first corrected point (mm).
+    pub z_mm: f64,
+    /// Largest horizontal move of a point of this curve (mm).
+    pub max_shift_mm: f64,
+    /// Number of points whose step was shortened.
+    pub steps_shortened: u32,
+}
+
+/// The self-intersection found and how it was removed.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct IntersectionFix {
+    /// Where the surface met itself first (bed coordinates relative to o).
+    pub at: [f64; 3],
+    /// The two transition curves that met.
+    pub curves: [u32; 2],
+    /// Final factor applied to the profiles' x offsets.
+    pub compression: f64,
+    /// Compression steps taken.
+    pub iterations: u32,
+}
+
+/// What the corrections changed.
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct CorrectionReport {
+    /// One entry per curve the support-free correction moved.
+    pub support: Vec<SupportFix>,
+    /// Present when the surface intersected itself.
+    pub intersection: Option<IntersectionFix>,
+}
+
+impl CorrectionReport {
+    /// Whether nothing was changed.
+    pub fn is_empty(&self) -> bool {
+        self.support.is_empty() && self.intersection.is_none()
+    }
+
+    /// One line per kind of correction, for summaries.
+    pub fn summary(&self) -> Vec<String> {
+        let mut out = Vec::new();
+        if !self.support.is_empty() {
+            let worst = self
+                .support
+                .iter()
+                .max_by(|a, b| a.max_shift_mm.total_cmp(&b.max_shift_mm))
+                .expect("non-empty");
+            out.push(format!(
+                "support-free: {} curve(s) corrected; largest move {:.2} mm on {} at z = {:.1} mm",
+                self.support.len(),
+                worst.max_shift_mm,
+                worst.curve,
+                worst.z_mm
+            ));
+        }
+        if let Some(x) = &self.intersection {
+            out.push(format!(
+                "self-intersection: transition curves {} and {} met at ({:.1}, {:.1}, {:.1}) mm; profiles compressed along x by {:.3} ({} steps)",
+                x.curves[0], x.curves[1], x.at[0], x.at[1], x.at[2], x.compression, x.iterations
+            ));
+        }
+        out
+    }
+}
+
+/// The corrected surface and what was changed.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Corrected {
+    /// The surface, now support-free and free of self-intersection.
+    pub surface: Surface,
+    /// What changed.
+    pub report: CorrectionReport,
+}
+
+/// Applies both corrections.
+pub fn correct(surface: &Surface) -> Result<Corrected> {
+    let mut out = surface.clone();
+    let mut support = support_free(&mut out);
+    let mut intersection = None;
+    if let Some((a, b, at)) = find_self_intersection(&out) {
+        // Compressing to nothing must fix it; else Ψ itself is too tight.
+        let mut flat = surface.clone();
+        scale_offsets(&mut flat, surface, 0.0);
+        if let Some((a0, b0, at0)) = find_self_intersection(&flat) {
+            return Err(Error::SelfIntersection(format!(
+                "the trajectory comes within one bead width ({} mm) of itself near ({:.1}, {:.1}) mm (transition curves {a0} and {b0}); move those parts of Ψ apart",
+                surface.params.width_max, at0[0], at0[1]
+            )));
+        }
+        let mut c = 1.0;
+        let mut iterations = 0;
+        loop {
+            c *= 0.9;
+            iterations += 1;
+            scale_offsets(&mut out, surface, c);
+            support = support_free(&mut out);
+            if find_self_intersection(&out).is_none() {
+                break;
+            }
+            if iterations >= 200 {
+                return Err(Error::SelfIntersection(
+                    "compression did not remove the self-intersection".into(),
+                ));
+            }
+        }
+        intersection = Some(IntersectionFix {
+            at,
+            curves: [a, b],
+            compression: c,
+            iterations,
+        });
+    }
+    Ok(Corrected {
+        surface: out,
+        report: CorrectionReport {
+            support,
+            intersection,
+        },
+    })
+}
+
+/// Sets every offset to `c` times the design's.
+fn scale_offsets(out: &mut Surface, design: &Surface, c: f64) {
+    for (o, d) in out.samples.iter_mut().zip(&design.samples) {
+        o.xi = c * d.xi;
+    }
+}
+
+/// Walks every column upward and shortens steps that overhang too far.
+fn support_free(s: &mut Surface) -> Vec<SupportFix> {
+    let n = s.columns.len();
+    let mut fixes = Vec::new();
+    for (c, col) in s.columns.iter().enumerate() {
+        let range = col.samples();
+        let mut carry = 0.0;
+        let mut fix: Option<SupportFix> = None;
+        let mut prev = s.samples[range.start];
+        for i in range.start + 1..range.end {
+            let design = s.samples[i];
+            let mut xi = design.xi + carry;
+            let limit = s.params.max_offset(design.z - prev.z);
+            let step = xi - prev.xi;
+            if step.abs() > limit + 1e-12 {
+                let clamped = prev.xi + limit.copysign(step);
+                carry += clamped - xi;
+                xi = clamped;
+                let f = fix.get_or_insert(SupportFix {
+                    curve: if c == 0 {
+                        CurveId::ProfileStart
+                    } else if c == n - 1 {
+                        CurveId::ProfileEnd
+                    } else {
+                        CurveId::Transition(c as u32)
+                    },
+                    u: col.u,
+                    z_mm: design.z,
+                    max_shift_mm: 0.0,
+                    steps_shortened: 0,
+                });
+                f.steps_shortened += 1;
+            }
+            if let Some(f) = fix.as_mut() {
+                f.max_shift_mm = f.max_shift_mm.max(carry.abs());
+            }
+            s.samples[i].xi = xi;
+            prev = s.samples[i];
+        }
+        fixes.extend(fix);
+    }
+    fixes
+}
+
+/// The first pair of surface points from transition curves far apart along
+/// Ψ that are closer than the widest bead: `(curve a, curve b, position)`.
+fn find_self_intersection(s: &Surface) -> Option<(u32, u32, [f64; 3])> {
+    let w = s.params.width_max;
+    // A U-turn of radius w/2 is the tightest curve whose sides do not touch:
+    // its opposite points are π·w/2 ≈ 1.57 w apart along Ψ.
+    let far = ((1.6 * w) / s.spacing).ceil() as i64;
+    let mut grid = Grid3::new(w);
+    let mut owner = Vec::with_capacity(s.samples.len());
+    let mut pos = Vec::with_capacity(s.samples.len());
+    for (c, col) in s.columns.iter().enumerate() {
+        for i in col.samples() {
+            owner.push(c as u32);
+            pos.push(s.position(c, i));
+        }
+    }
+    for (id, p) in pos.iter().enumerate() {
+        grid.insert(*p, id as u32);
+    }
+    let w2 = w * w;
+    for (id, p) in pos.iter().enumerate() {
+        let mine = owner[id] as i64;
+        let mut hit = None;
+        grid.for_each_near(*p, |other| {
+            if hit.is_some() || (owner[other as usize] as i64 - mine).abs() <= far {
+                return;
+            }
+            let q = pos[other as usize];
+            let d2 = (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2);
+            if d2 < w2 {
+                hit = Some(owner[other as usize]);
+            }
+        });
+        if let Some(b) = hit {
+            return Some((owner[id], b, *p));
+        }
+    }
+    None
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::design::Design;
+    use crate::surface::sample_surface;
+
+    fn design(start: &str, end: &str, traj: &str) -> Design {
+        Design::from_json(&format!(
+            r#"{{"sweepclay":1,"profile_start":{{"control_points":{start}}},
+                "profile_end":{{"control_points":{end}}},"trajectory":{traj}}}"#
+        ))
+        .unwrap()
+    }
+
+    #[test]
+    fn overhang_is_limited_and_reported() {
+        // C_s leans outward at 45° over 20 mm then goes up: slope 1 > tan 57°? no;
+        // use a 70° lean: 27.5 mm out over 10 mm up.
+        let d = design(
+            "[[0,0],[27.5,10],[27.5,30]]",
+            "[[0,0],[0,30]]",
+            r#"{"points":[[-40,20],[40,20]]}"#,
+        );
+        let s = sample_surface(&d).unwrap();
+        let c = correct(&s).unwrap();
+        assert!(!c.report.support.is_empty());
+        assert_eq!(c.report.support[0].curve, CurveId::ProfileStart);
+        let p = &c.surface.params;
+        for col in &c.surface.columns {
+            let r = col.samples();
+            for i in r.start + 1..r.end {
+                let (a, b) = (c.surface.samples[i - 1], c.surface.samples[i]);
+                let s = (b.xi - a.xi).abs();
+                assert!(
+                    s <= p.max_offset(b.z - a.z) + 1e-9,
+                    "step {s} over {}",
+                    b.z - a.z
+                );
+            }
+        }
+        let summary = c.report.summary().join("\n");
+        assert!(summary.contains("support-free"), "{summary}");
+    }
+
+    #[test]
+    fn gentle_surface_is_left_alone() {
+        let d = design(
+            "[[0,0],[2,30]]",
+            "[[0,0],[-2,30]]",
+            r#"{"points":[[-40,20],[40,20]]}"#,
+        );
+        let s = sample_surface(&d).unwrap();
+        let c = correct(&s).unwrap();
+        assert!(c.report.is_empty(), "{:?}", c.report);
+        assert_eq!(c.surface, s);
+    }
+
+    #[test]
+    fn surface_meeting_itself_is_compressed() {
+        // A half circle of radius 20 around o whose profiles lean 15 mm
+        // inward at the top: the two ends come within a bead width.
+        let d = design(
+            "[[0,0],[-5,10],[-10,20],[-15,30]]",
+            "[[0,0],[-5,10],[-10,20],[-15,30]]",
+            r#"{"control_points":[[20,0],[20,20],[-20,20],[-20,0]]}"#,
+        );
+        let s = sample_surface(&d).unwrap();
+        assert!(find_self_intersection(&s).is_some());
+        let c = correct(&s).unwrap();
+        let x = c
+            .report
+            .intersection
+            .as_ref()
+            .expect("intersection reported");
+        assert!(x.compression < 1.0 && x.iterations >= 1);
+        assert!(find_self_intersection(&c.surface).is_none());
+    }
+
+    #[test]
+    fn trajectory_too_tight_is_an_error() {
+        let d = design(
+            "[[0,0],[0,20]]",
+            "[[0,0],[0,20]]",
+            r#"{"points":[[10,40],[60,40],[60,43],[10,43]]}"#,
+        );
+        let s = sample_surface(&d).unwrap();
+        let e = correct(&s).unwrap_err().to_string();
+        assert!(e.contains("within one bead width"), "{e}");
+    }
+}

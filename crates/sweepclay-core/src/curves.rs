@@ -1,0 +1,466 @@
+//! The three kinds of design curve, validated and turned into the sampled
+//! forms the surface needs (paper §4, DESIGN.md §3–4):
+//!
+//! - [`Profile`]: C_s or C_t as a table of horizontal offset against
+//!   normalised height t ∈ [0, 1] (z strictly increasing along the curve);
+//! - [`Trajectory`]: Ψ resampled by arc length into points ≈ `spacing` apart;
+//! - [`Interpolation`]: f(u), monotone, f(0) = 0, f(1) = 1.
+//!
+//! Known limitation: curves are flattened to polylines fine enough that the
+//! chord error is far below a bead width (≤ spacing/8 along Ψ, ≤ 0.05 mm of
+//! height along profiles); resampling interpolates linearly on them.
+
+use crate::bspline::{dist, BSpline};
+use crate::design::{CurveSpec, TrajectorySpec};
+use crate::error::{Error, Result};
+use crate::grid::Grid2;
+
+fn check_points(key: &str, pts: &[[f64; 2]], min: usize) -> Result<()> {
+    if pts.len() < min {
+        return Err(Error::invalid(
+            key,
+            format!("needs at least {min} points (got {})", pts.len()),
+        ));
+    }
+    for (i, p) in pts.iter().enumerate() {
+        if !p[0].is_finite() || !p[1].is_finite() || p[0].abs() > 1e5 || p[1].abs() > 1e5 {
+            return Err(Error::invalid(
+                format!("{key}[{i}]"),
+                format!("coordinates must be finite numbers below 100000 mm (got {p:?})"),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// A profile curve sampled as horizontal offset from its start against
+/// normalised height.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Profile {
+    /// Z(C): the curve's height in mm.
+    pub height: f64,
+    /// x(t·Z) − x(0) at t = k / (len − 1).
+    table: Vec<f64>,
+}
+
+impl Profile {
+    /// Validates and samples a profile. `key` is `profile_start` or
+    /// `profile_end`, used in error messages.
+    pub fn new(key: &str, spec: &CurveSpec) -> Result<Profile> {
+        let ckey = format!("{key}.control_points");
+        check_points(&ckey, &spec.control_points, 2)?;
+        let first = spec.control_points[0];
+        if first[1] != 0.0 {
+            return Err(Error::invalid(
+                format!("{ckey}[0]"),
+                format!("the first point must have z = 0 (got z = {})", first[1]),
+            ));
+        }
+        let curve = BSpline::clamped(spec.control_points.clone()).expect("≥ 2 points");
+        let height = spec.control_points.last().expect("≥ 2 points")[1];
+        if height <= 0.0 {
+            return Err(Error::invalid(
+                &ckey,
+                format!("the curve must rise: its last point has z = {height}"),
+            ));
+        }
+        let per_span = ((height / 0.05) as usize / curve.spans()).clamp(32, 4096);
+        let poly = curve.flatten(per_span);
+        for w in poly.windows(2) {
+            if w[1][1] <= w[0][1] {
+                return Err(Error::invalid(
+                    &ckey,
+                    format!(
+                        "z must increase strictly along the curve, but it turns down near z = {:.2} mm (x = {:.2})",
+                        w[0][1], w[0][0]
+                    ),
+                ));
+            }
+        }
+        // Resample x at uniform heights by walking the monotone polyline.
+        let rows = ((height / 0.05).ceil() as usize).clamp(64, 1 << 16);
+        let mut table = Vec::with_capacity(rows + 1);
+        let mut seg = 0;
+        for k in 0..=rows {
+            let z = height * k as f64 / rows as f64;
+            while seg + 2 < poly.len() && poly[seg + 1][1] < z {
+                seg += 1;
+            }
+            let (a, b) = (poly[seg], poly[seg + 1]);
+            let s = ((z - a[1]) / (b[1] - a[1])).clamp(0.0, 1.0);
+            table.push(a[0] + s * (b[0] - a[0]) - first[0]);
+        }
+        Ok(Profile { height, table })
+    }
+
+    /// x(t·Z) − x(0), the horizontal offset at normalised height `t`.
+    pub fn offset(&self, t: f64) -> f64 {
+        lerp_table(&self.table, t)
+    }
+}
+
+fn lerp_table(table: &[f64], t: f64) -> f64 {
+    let last = table.len() - 1;
+    let f = t.clamp(0.0, 1.0) * last as f64;
+    let i = (f as usize).min(last - 1);
+    let s = f - i as f64;
+    table[i] + s * (table[i + 1] - table[i])
+}
+
+/// The interpolation function f(u) of paper §4 (Fig. 3).
+#[derive(Clone, Debug, PartialEq)]
+pub enum Interpolation {
+    /// f(u) = u, the default.
+    Linear,
+    /// f sampled at u = k / (len − 1).
+    Table(Vec<f64>),
+}
+
+impl Interpolation {
+    /// Validates the control curve: first point (0, 0), last (1, 1), u
+    /// strictly and f weakly increasing between control points (which makes
+    /// the B-spline a monotone function of u).
+    pub fn new(spec: Option<&CurveSpec>) -> Result<Interpolation> {
+        let Some(spec) = spec else {
+            return Ok(Interpolation::Linear);
+        };
+        let key = "interpolation.control_points";
+        let pts = &spec.control_points;
+        check_points(key, pts, 2)?;
+        let (first, last) = (pts[0], pts[pts.len() - 1]);
+        if first != [0.0, 0.0] {
+            return Err(Error::invalid(
+                format!("{key}[0]"),
+                format!("must be [0, 0] (got {first:?})"),
+            ));
+        }
+        if last != [1.0, 1.0] {
+            return Err(Error::invalid(
+                format!("{key}[{}]", pts.len() - 1),
+                format!("must be [1, 1] (got {last:?})"),
+            ));
+        }
+        for i in 1..pts.len() {
+            if pts[i][0] <= pts[i - 1][0] {
+                return Err(Error::invalid(
+                    format!("{key}[{i}]"),
+                    format!(
+                        "u must increase strictly ({} after {})",
+                        pts[i][0],
+                        pts[i - 1][0]
+                    ),
+                ));
+            }
+            if pts[i][1] < pts[i - 1][1] {
+                return Err(Error::invalid(
+                    format!("{key}[{i}]"),
+                    format!(
+                        "f must not decrease: the interpolation is monotone ({} after {})",
+                        pts[i][1],
+                        pts[i - 1][1]
+                    ),
+                ));
+            }
+        }
+        let curve = BSpline::clamped(pts.clone()).expect("≥ 2 points");
+        let poly = curve.flatten(256);
+        let rows = 2048;
+        let mut table = Vec::with_capacity(rows + 1);
+        let mut seg = 0;
+        for k in 0..=rows {
+            let u = k as f64 / rows as f64;
+            while seg + 2 < poly.len() && poly[seg + 1][0] < u {
+                seg += 1;
+            }
+            let (a, b) = (poly[seg], poly[seg + 1]);
+            let s = if b[0] > a[0] {
+                ((u - a[0]) / (b[0] - a[0])).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            table.push((a[1] + s * (b[1] - a[1])).clamp(0.0, 1.0));
+        }
+        // Flattening error can break monotonicity by a rounding step; repair.
+        for k in 1..table.len() {
+            if table[k] < table[k - 1] {
+                table[k] = table[k - 1];
+            }
+        }
+        Ok(Interpolation::Table(table))
+    }
+
+    /// λ = f(u) for u ∈ [0, 1].
+    pub fn eval(&self, u: f64) -> f64 {
+        match self {
+            Interpolation::Linear => u.clamp(0.0, 1.0),
+            Interpolation::Table(t) => lerp_table(t, u),
+        }
+    }
+}
+
+/// Ψ resampled by arc length.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Trajectory {
+    /// The sample points p_0 … p_{n−1}, relative to `o`.
+    pub points: Vec<[f64; 2]>,
+    /// Arc length of Ψ in mm.
+    pub length: f64,
+}
+
+impl Trajectory {
+    /// Validates Ψ (not closed, no self-intersection, non-zero length) and
+    /// resamples it into `round(length / spacing) + 1` points.
+    pub fn new(spec: &TrajectorySpec, spacing: f64) -> Result<Trajectory> {
+        if spec.closed {
+            return Err(Error::invalid(
+                "trajectory.closed",
+                "closed trajectories are reserved for a later version; use an open curve",
+            ));
+        }
+        let poly = match (&spec.control_points, &spec.points) {
+            (Some(_), Some(_)) => {
+                return Err(Error::invalid(
+                    "trajectory",
+                    "give either `control_points` or `points`, not both",
+                ))
+            }
+            (None, None) => {
+                return Err(Error::invalid(
+                    "trajectory",
+                    "needs `control_points` (a B-spline) or `points` (a polyline)",
+                ))
+            }
+            (Some(cp), None) => {
+                check_points("trajectory.control_points", cp, 2)?;
+                let curve = BSpline::clamped(cp.clone()).expect("≥ 2 points");
+                let est = curve.polygon_length();
+                let per_span =
+                    ((est / (spacing / 8.0)) as usize / curve.spans()).clamp(16, 1 << 14);
+                curve.flatten(per_span)
+            }
+            (None, Some(p)) => {
+                check_points("trajectory.points", p, 2)?;
+                let mut v: Vec<[f64; 2]> = Vec::with_capacity(p.len());
+                for q in p {
+                    if v.last().is_none_or(|l| dist(*l, *q) > 1e-9) {
+                        v.push(*q);
+                    }
+                }
+                v
+            }
+        };
+        let mut cum = Vec::with_capacity(poly.len());
+        let mut acc = 0.0;
+        cum.push(0.0);
+        for w in poly.windows(2) {
+            acc += dist(w[0], w[1]);
+            cum.push(acc);
+        }
+        let length = acc;
+        if length < 2.0 * spacing.max(0.5) {
+            return Err(Error::invalid(
+                "trajectory",
+                format!("is too short ({length:.2} mm); it must be at least two samples long"),
+            ));
+        }
+        let n = ((length / spacing).round() as usize).max(1) + 1;
+        let mut points = Vec::with_capacity(n);
+        let mut seg = 0;
+        for m in 0..n {
+            let s = length * m as f64 / (n - 1) as f64;
+            while seg + 2 < poly.len() && cum[seg + 1] < s {
+                seg += 1;
+            }
+            let (a, b) = (poly[seg], poly[seg + 1]);
+            let l = cum[seg + 1] - cum[seg];
+            let f = if l > 0.0 {
+                ((s - cum[seg]) / l).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            points.push([a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1])]);
+        }
+        let traj = Trajectory { points, length };
+        traj.check_self_intersection()?;
+        Ok(traj)
+    }
+
+    /// Refuses a trajectory whose polyline crosses itself (grid of
+    /// segments; linear time for curves that do not pile up in one place).
+    fn check_self_intersection(&self) -> Result<()> {
+        let pts = &self.points;
+        let seg_len = self.length / (pts.len() - 1) as f64;
+        let mut grid = Grid2::new(seg_len.max(1e-3));
+        for i in 0..pts.len() - 1 {
+            grid.insert_segment(pts[i], pts[i + 1], i as u32);
+        }
+        for i in 0..pts.len() - 1 {
+            let (a, b) = (pts[i], pts[i + 1]);
+            let mut hit = None;
+            grid.for_each_near_segment(a, b, 0.0, |j| {
+                let j = j as usize;
+                if j > i + 1 && hit.is_none() && segments_cross(a, b, pts[j], pts[j + 1]) {
+                    hit = Some(j);
+                }
+            });
+            if let Some(j) = hit {
+                let u1 = i as f64 / (pts.len() - 1) as f64;
+                let u2 = j as f64 / (pts.len() - 1) as f64;
+                return Err(Error::invalid(
+                    "trajectory",
+                    format!(
+                        "crosses itself near ({:.1}, {:.1}) mm, at u = {u1:.3} and u = {u2:.3}",
+                        a[0], a[1]
+                    ),
+                ));
+            }
+        }
+        Ok(())
+    }
+}
+
+/// Whether two closed segments intersect (touching counts).
+fn segments_cross(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> bool {
+    fn orient(p: [f64; 2], q: [f64; 2], r: [f64; 2]) -> f64 {
+        (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])
+    }
+    let (d1, d2) = (orient(c, d, a), orient(c, d, b));
+    let (d3, d4) = (orient(a, b, c), orient(a, b, d));
+    if ((d1 > 0.0 && d2 < 0.0) || (d1 < 0.0 && d2 > 0.0))
+        && ((d3 > 0.0 && d4 < 0.0) || (d3 < 0.0 && d4 > 0.0))
+    {
+        return true;
+    }
+    let on = |p: [f64; 2], q: [f64; 2], r: [f64; 2], o: f64| {
+        o == 0.0
+            && r[0] >= p[0].min(q[0])
+            && r[0] <= p[0].max(q[0])
+            && r[1] >= p[1].min(q[1])
+            && r[1] <= p[1].max(q[1])
+    };
+    on(c, d, a, d1) || on(c, d, b, d2) || on(a, b, c, d3) || on(a, b, d, d4)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn curve(p: &[[f64; 2]]) -> CurveSpec {
+        CurveSpec {
+            control_points: p.to_vec(),
+        }
+    }
+
+    #[test]
+    fn two_point_profile_is_a_straight_line() {
+        let p = Profile::new("profile_start", &curve(&[[10.0, 0.0], [16.0, 30.0]])).unwrap();
+        assert_eq!(p.height, 30.0);
+        for k in 0..=10 {
+            let t = k as f64 / 10.0;
+            assert!(
+                (p.offset(t) - 6.0 * t).abs() < 1e-9,
+                "offset({t}) = {}",
+                p.offset(t)
+            );
+        }
+    }
+
+    #[test]
+    fn profile_errors_name_the_key() {
+        let e = Profile::new("profile_end", &curve(&[[0.0, 1.0], [0.0, 10.0]])).unwrap_err();
+        assert!(
+            e.to_string().starts_with("profile_end.control_points[0]"),
+            "{e}"
+        );
+        let e = Profile::new(
+            "profile_end",
+            &curve(&[[0.0, 0.0], [1.0, 30.0], [2.0, 10.0]]),
+        )
+        .unwrap_err();
+        assert!(e.to_string().contains("increase strictly"), "{e}");
+        let e = Profile::new("profile_start", &curve(&[[0.0, 0.0], [f64::NAN, 10.0]])).unwrap_err();
+        assert!(
+            e.to_string().starts_with("profile_start.control_points[1]"),
+            "{e}"
+        );
+        let e = Profile::new("profile_start", &curve(&[[0.0, 0.0]])).unwrap_err();
+        assert!(e.to_string().contains("at least 2"), "{e}");
+    }
+
+    #[test]
+    fn linear_interpolation_is_identity_and_curves_are_monotone() {
+        assert_eq!(Interpolation::new(None).unwrap().eval(0.3), 0.3);
+        let f = Interpolation::new(Some(&curve(&[[0.0, 0.0], [0.4, 0.1], [1.0, 1.0]]))).unwrap();
+        let mut last = 0.0;
+        for k in 0..=100 {
+            let v = f.eval(k as f64 / 100.0);
+            assert!(v >= last, "f decreased at u = {}", k as f64 / 100.0);
+            last = v;
+        }
+        assert!((f.eval(0.0)).abs() < 1e-12 && (f.eval(1.0) - 1.0).abs() < 1e-12);
+        // Straight control polygon: f(u) = u.
+        let g = Interpolation::new(Some(&curve(&[[0.0, 0.0], [0.5, 0.5], [1.0, 1.0]]))).unwrap();
+        assert!((g.eval(0.25) - 0.25).abs() < 1e-6, "{}", g.eval(0.25));
+    }
+
+    #[test]
+    fn interpolation_errors_name_the_point() {
+        let e = Interpolation::new(Some(&curve(&[
+            [0.0, 0.0],
+            [0.5, 0.7],
+            [0.6, 0.4],
+            [1.0, 1.0],
+        ])))
+        .unwrap_err();
+        assert!(
+            e.to_string().starts_with("interpolation.control_points[2]"),
+            "{e}"
+        );
+        let e = Interpolation::new(Some(&curve(&[[0.0, 0.0], [1.0, 0.9]]))).unwrap_err();
+        assert!(
+            e.to_string().starts_with("interpolation.control_points[1]"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn trajectory_is_resampled_by_arc_length() {
+        let spec = TrajectorySpec {
+            control_points: None,
+            points: Some(vec![[0.0, 10.0], [30.0, 10.0], [30.0, 50.0]]),
+            closed: false,
+        };
+        let t = Trajectory::new(&spec, 1.0).unwrap();
+        assert!((t.length - 70.0).abs() < 1e-9);
+        assert_eq!(t.points.len(), 71);
+        for w in t.points.windows(2) {
+            let d = dist(w[0], w[1]);
+            assert!(d <= 1.0 + 1e-9 && d > 0.7, "spacing {d}");
+        }
+    }
+
+    #[test]
+    fn self_intersecting_and_closed_trajectories_are_refused() {
+        let spec = TrajectorySpec {
+            control_points: None,
+            points: Some(vec![
+                [0.0, 10.0],
+                [40.0, 10.0],
+                [40.0, 40.0],
+                [20.0, 40.0],
+                [20.0, 0.0],
+            ]),
+            closed: false,
+        };
+        let e = Trajectory::new(&spec, 1.1).unwrap_err();
+        assert!(e.to_string().contains("crosses itself"), "{e}");
+        let spec = TrajectorySpec {
+            closed: true,
+            ..spec
+        };
+        assert!(Trajectory::new(&spec, 1.1)
+            .unwrap_err()
+            .to_string()
+            .starts_with("trajectory.closed"));
+    }
+}

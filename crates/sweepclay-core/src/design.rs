@@ -1,0 +1,318 @@
+//! The design file (DESIGN.md §3, format version 1): two profile curves, a
+//! trajectory, an optional interpolation curve, parameters and a printer.
+//!
+//! Parsing rejects unknown keys (typos are caught) and reports the line and
+//! column; [`Params::validate`] checks ranges and names the key.
+
+use crate::error::{Error, Result};
+use crate::printer::PrinterRef;
+use serde::{Deserialize, Serialize};
+
+/// The format version this library reads and writes.
+pub const FORMAT_VERSION: u32 = 1;
+
+/// One design file.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct Design {
+    /// Format version; must be [`FORMAT_VERSION`].
+    pub sweepclay: u32,
+    /// Free-form name, written into the G-code header.
+    #[serde(default)]
+    pub name: String,
+    /// C_s: profile at the start of the trajectory, points `[x, z]`.
+    pub profile_start: CurveSpec,
+    /// C_t: profile at the end of the trajectory, points `[x, z]`.
+    pub profile_end: CurveSpec,
+    /// Ψ: the trajectory in the xy plane, relative to the centre `o`.
+    pub trajectory: TrajectorySpec,
+    /// Control curve of f(u), points `[u, f]`; omitted means linear.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub interpolation: Option<CurveSpec>,
+    /// Slicing parameters; every key optional.
+    #[serde(default)]
+    pub params: Params,
+    /// Printer preset name or inline profile; default `generic`.
+    #[serde(default)]
+    pub printer: PrinterRef,
+}
+
+/// A curve given by the control points of a clamped B-spline.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct CurveSpec {
+    /// Control points; 2 give a segment, 3 a quadratic, 4 or more a cubic.
+    pub control_points: Vec<[f64; 2]>,
+}
+
+/// The trajectory: a B-spline or an imported polyline.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TrajectorySpec {
+    /// Control points of a clamped B-spline, `[x, y]` in mm.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub control_points: Option<Vec<[f64; 2]>>,
+    /// Or: the vertices of a polyline (e.g. from an SVG import).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub points: Option<Vec<[f64; 2]>>,
+    /// Reserved for closed trajectories (vases); must be `false` for now.
+    #[serde(default)]
+    pub closed: bool,
+}
+
+/// Slicing parameters (DESIGN.md §3). Lengths in mm, angles in degrees,
+/// feedrate in mm/min. Defaults are the paper's (§5–6).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Params {
+    /// Δz_min: minimum layer height. Default 1.25 mm.
+    pub layer_height: f64,
+    /// Δz_max: thickest layer allowed. Default 2.5 mm.
+    pub max_layer_height: f64,
+    /// Sample spacing along the trajectory. Default 1.1 mm.
+    pub spacing: f64,
+    /// H: height of the extruder body above the nozzle tip. Default 30 mm.
+    pub nozzle_height: f64,
+    /// Narrowest bead. Default 3 mm.
+    pub width_min: f64,
+    /// Widest bead. Default 6 mm.
+    pub width_max: f64,
+    /// Target overlap with the bead below, as a fraction of the bead's
+    /// width. Default 2/3.
+    pub overlap: f64,
+    /// Overhang threshold measured from vertical. Default 57°.
+    pub max_overhang_deg: f64,
+    /// Printing speed. Default 2000 mm/min.
+    pub feedrate: f64,
+}
+
+impl Default for Params {
+    fn default() -> Self {
+        Params {
+            layer_height: 1.25,
+            max_layer_height: 2.5,
+            spacing: 1.1,
+            nozzle_height: 30.0,
+            width_min: 3.0,
+            width_max: 6.0,
+            overlap: 2.0 / 3.0,
+            max_overhang_deg: 57.0,
+            feedrate: 2000.0,
+        }
+    }
+}
+
+/// Safety margin (mm) kept between the highest printed clay and the bottom
+/// of the carriage, on top of one layer (see `docs/ALGORITHMS.md`).
+pub const COLLISION_MARGIN_MM: f64 = 1.0;
+
+impl Params {
+    /// Checks every parameter against its allowed range.
+    pub fn validate(&self) -> Result<()> {
+        range("params.layer_height", self.layer_height, 0.5, 10.0)?;
+        range(
+            "params.max_layer_height",
+            self.max_layer_height,
+            self.layer_height,
+            20.0,
+        )?;
+        range("params.spacing", self.spacing, 0.01, 50.0)?;
+        let h_min = self.max_layer_height + self.layer_height + COLLISION_MARGIN_MM;
+        if !(self.nozzle_height.is_finite() && self.nozzle_height > h_min) {
+            return Err(Error::invalid(
+                "params.nozzle_height",
+                format!(
+                    "must exceed max_layer_height + layer_height + {COLLISION_MARGIN_MM} mm = {h_min} mm (got {})",
+                    self.nozzle_height
+                ),
+            ));
+        }
+        range("params.width_min", self.width_min, 0.1, 50.0)?;
+        range("params.width_max", self.width_max, self.width_min, 50.0)?;
+        range("params.overlap", self.overlap, 0.5, 0.95)?;
+        range("params.max_overhang_deg", self.max_overhang_deg, 1.0, 80.0)?;
+        range("params.feedrate", self.feedrate, 1.0, 100_000.0)?;
+        Ok(())
+    }
+
+    /// The largest horizontal step between two samples `dz` apart (DESIGN.md
+    /// §5): the overhang limit and the offset the widest bead still covers
+    /// with the target overlap.
+    pub fn max_offset(&self, dz: f64) -> f64 {
+        let by_angle = dz * self.max_overhang_deg.to_radians().tan();
+        let by_width = self.width_max * (1.0 - self.overlap);
+        by_angle.min(by_width)
+    }
+
+    /// The keys `--set` accepts, in file order.
+    pub const KEYS: &'static [&'static str] = &[
+        "layer_height",
+        "max_layer_height",
+        "spacing",
+        "nozzle_height",
+        "width_min",
+        "width_max",
+        "overlap",
+        "max_overhang_deg",
+        "feedrate",
+    ];
+
+    /// Sets one parameter by name (`--set key=value`).
+    pub fn set(&mut self, key: &str, value: f64) -> Result<()> {
+        let slot = match key {
+            "layer_height" => &mut self.layer_height,
+            "max_layer_height" => &mut self.max_layer_height,
+            "spacing" => &mut self.spacing,
+            "nozzle_height" => &mut self.nozzle_height,
+            "width_min" => &mut self.width_min,
+            "width_max" => &mut self.width_max,
+            "overlap" => &mut self.overlap,
+            "max_overhang_deg" => &mut self.max_overhang_deg,
+            "feedrate" => &mut self.feedrate,
+            _ => {
+                return Err(Error::invalid(
+                    format!("params.{key}"),
+                    format!("unknown parameter (known: {})", Self::KEYS.join(", ")),
+                ))
+            }
+        };
+        *slot = value;
+        Ok(())
+    }
+}
+
+fn range(key: &str, v: f64, lo: f64, hi: f64) -> Result<()> {
+    if v.is_finite() && v >= lo && v <= hi {
+        Ok(())
+    } else {
+        Err(Error::invalid(
+            key,
+            format!("must be between {lo} and {hi} (got {v})"),
+        ))
+    }
+}
+
+impl Design {
+    /// Parses a design file. Unknown keys, wrong types and a wrong format
+    /// version are errors naming the line.
+    pub fn from_json(text: &str) -> Result<Design> {
+        let d: Design = serde_json::from_str(text).map_err(|e| Error::Parse {
+            message: e
+                .to_string()
+                .split(" at line ")
+                .next()
+                .unwrap_or("")
+                .to_string(),
+            line: e.line(),
+            column: e.column(),
+        })?;
+        if d.sweepclay != FORMAT_VERSION {
+            return Err(Error::invalid(
+                "sweepclay",
+                format!(
+                    "format version {} is not supported (this build reads {FORMAT_VERSION})",
+                    d.sweepclay
+                ),
+            ));
+        }
+        Ok(d)
+    }
+
+    /// The design as pretty JSON (the format [`Design::from_json`] reads).
+    pub fn to_json(&self) -> String {
+        serde_json::to_string_pretty(self).expect("a design always serialises")
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    const MINIMAL: &str = r#"{
+        "sweepclay": 1,
+        "profile_start": { "control_points": [[0, 0], [0, 20]] },
+        "profile_end": { "control_points": [[0, 0], [0, 20]] },
+        "trajectory": { "control_points": [[-50, 10], [50, 10]] }
+    }"#;
+
+    #[test]
+    fn minimal_design_takes_defaults() {
+        let d = Design::from_json(MINIMAL).unwrap();
+        assert_eq!(d.params, Params::default());
+        assert_eq!(d.printer, PrinterRef::default());
+        assert!(d.interpolation.is_none());
+        d.params.validate().unwrap();
+    }
+
+    #[test]
+    fn round_trips_through_json() {
+        let d = Design::from_json(MINIMAL).unwrap();
+        assert_eq!(Design::from_json(&d.to_json()).unwrap(), d);
+    }
+
+    #[test]
+    fn unknown_key_names_key_and_line() {
+        let text = MINIMAL.replace("\"sweepclay\": 1,", "\"sweepclay\": 1, \"profil_end\": 3,");
+        match Design::from_json(&text).unwrap_err() {
+            Error::Parse { message, line, .. } => {
+                assert!(message.contains("profil_end"), "{message}");
+                assert_eq!(line, 2);
+            }
+            e => panic!("unexpected {e}"),
+        }
+        let text = MINIMAL.replace(
+            "\"trajectory\": {",
+            "\"params\": {\"layer_hieght\": 1}, \"trajectory\": {",
+        );
+        let e = Design::from_json(&text).unwrap_err().to_string();
+        assert!(e.contains("layer_hieght"), "{e}");
+    }
+
+    #[test]
+    fn wrong_version_is_refused() {
+        let e = Design::from_json(&MINIMAL.replace("\"sweepclay\": 1", "\"sweepclay\": 2"))
+            .unwrap_err();
+        assert!(
+            e.to_string().starts_with("sweepclay: format version 2"),
+            "{e}"
+        );
+    }
+
+    #[test]
+    fn parameter_ranges_name_the_key() {
+        let mut p = Params::default();
+        p.set("layer_height", -1.0).unwrap();
+        let e = p.validate().unwrap_err().to_string();
+        assert!(
+            e.starts_with("params.layer_height") && e.contains("-1"),
+            "{e}"
+        );
+        let mut p = Params::default();
+        p.set("width_max", 2.0).unwrap();
+        assert!(p
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .starts_with("params.width_max"));
+        let mut p = Params::default();
+        p.set("nozzle_height", 3.0).unwrap();
+        assert!(p
+            .validate()
+            .unwrap_err()
+            .to_string()
+            .starts_with("params.nozzle_height"));
+        assert!(Params::default().set("feed", 1.0).is_err());
+    }
+
+    #[test]
+    fn max_offset_is_the_papers_bound() {
+        let p = Params::default();
+        // 1.25 · tan 57° = 1.925 < 6 · (1 − 2/3) = 2.
+        assert!((p.max_offset(1.25) - 1.25 * 57f64.to_radians().tan()).abs() < 1e-12);
+        assert!(
+            (p.max_offset(2.5) - 2.0).abs() < 1e-12,
+            "{}",
+            p.max_offset(2.5)
+        );
+    }
+}

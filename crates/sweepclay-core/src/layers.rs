@@ -1,0 +1,291 @@
+//! Layering: which heights each transition curve is visited at, and by
+//! which pass (paper §5.2, Algorithm 2; DESIGN.md §6). The full derivation
+//! and the proofs of the invariants are in `docs/ALGORITHMS.md`.
+//!
+//! Columns (transition curves) are ordered from the short end (index 0) to
+//! the tall end. With h the column's height, N' the number of "lower"
+//! passes, δ_T the tall column's layer height and H_s the allowed height
+//! spread within one pass, pass k would put column h at
+//!
+//! ```text
+//! g_k(h) = max(k · min(h / N', δ_T),  k · δ_T − H_s)
+//! ```
+//!
+//! Columns whose `h / N' ≤ δ_T` finish exactly on their top edge at pass N'
+//! (the paper's lower stage, layers tilted between the two ends); taller
+//! columns are printed in flat layers k·δ_T and the pass turns at the first
+//! column whose top edge it reaches (the paper's returning points). The
+//! second term lifts lagging columns so that no pass spans more than H_s.
+
+use crate::design::{Params, COLLISION_MARGIN_MM};
+use crate::error::{Error, Result};
+
+/// The layering of one design.
+#[derive(Clone, Debug, PartialEq)]
+pub struct LayerPlan {
+    /// K: number of passes (the tall column's layer count).
+    pub passes: u32,
+    /// N': passes of the lower (tilted) stage; equals `passes` for a single
+    /// stage path.
+    pub lower_passes: u32,
+    /// δ_T: layer height of the tall column (mm).
+    pub tall_layer_mm: f64,
+    /// H_s: largest height difference allowed within one pass (mm).
+    pub spread_mm: f64,
+    /// Whether pass 1 runs from the short end toward the tall end.
+    pub first_toward_tall: bool,
+    /// Thinnest top-edge bead laid by a returning turn (mm).
+    pub min_top_bead_mm: f64,
+}
+
+/// How one column is visited.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct ColumnLayers {
+    /// Passes 1..=q visit the column.
+    pub passes: u32,
+    /// The last visit lands exactly on the top edge.
+    pub exact_top: bool,
+    /// Height of the top-edge bead a returning turn lays on it, if any.
+    pub top_bead: Option<f64>,
+}
+
+impl LayerPlan {
+    /// Whether the path has an upper stage with returning points.
+    pub fn two_stage(&self) -> bool {
+        self.passes > self.lower_passes
+    }
+
+    /// Whether pass `k` (1-based) runs toward the tall end.
+    pub fn toward_tall(&self, k: u32) -> bool {
+        (k % 2 == 1) == self.first_toward_tall
+    }
+
+    /// g_k(h): the nominal height of pass `k` on a column of height `h`.
+    pub fn nominal(&self, k: u32, h: f64) -> f64 {
+        let d = (h / self.lower_passes as f64).min(self.tall_layer_mm);
+        let k = k as f64;
+        (k * d).max(k * self.tall_layer_mm - self.spread_mm)
+    }
+
+    fn eps(h: f64) -> f64 {
+        1e-7 * h.max(1.0)
+    }
+
+    /// The height pass `k` visits a column of height `h` at (the top edge
+    /// when the pass finishes the column exactly there).
+    pub fn height(&self, k: u32, h: f64) -> f64 {
+        let g = self.nominal(k, h);
+        if (g - h).abs() <= Self::eps(h) {
+            h
+        } else {
+            g
+        }
+    }
+
+    /// Which passes visit a column of height `h`. A toward-tall pass (or the
+    /// last pass) may finish a column exactly on its top edge; a
+    /// toward-short pass only visits columns it leaves room above, and the
+    /// returning turn that follows it lays their top-edge bead.
+    pub fn column(&self, h: f64) -> ColumnLayers {
+        let eps = Self::eps(h);
+        let mut q = 0;
+        let mut exact = false;
+        for k in 1..=self.passes {
+            let g = self.nominal(k, h);
+            if self.toward_tall(k) || k == self.passes {
+                if g > h + eps {
+                    break;
+                }
+                q = k;
+                if g >= h - eps {
+                    exact = true;
+                    break;
+                }
+            } else {
+                if g >= h - eps {
+                    break;
+                }
+                q = k;
+            }
+        }
+        let top_bead = (!exact && q > 0 && q < self.passes && !self.toward_tall(q))
+            .then(|| h.max(self.nominal(q, h) + self.min_top_bead_mm));
+        ColumnLayers {
+            passes: q,
+            exact_top: exact,
+            top_bead,
+        }
+    }
+
+    /// Chooses the layering for columns of heights `h` (ordered short end
+    /// first, non-decreasing), `ds` mm apart along Ψ, for an extruder body
+    /// of radius `nozzle_radius`.
+    ///
+    /// Tries the paper's single stage first (N' = ⌊h_short/Δz_min⌋); then
+    /// two stages with the same N'; then fewer tilted passes until tilted
+    /// passes are flat enough that the nozzle body clears the layer below
+    /// (see `docs/ALGORITHMS.md`, "slope condition").
+    pub fn choose(h: &[f64], ds: f64, params: &Params, nozzle_radius: f64) -> Result<LayerPlan> {
+        let (dmin, dmax) = (params.layer_height, params.max_layer_height);
+        let h_short = h[0];
+        let h_tall = *h.last().expect("at least one column");
+        let spread = params.nozzle_height - COLLISION_MARGIN_MM - dmax;
+        let n = ((h_short / dmin + 1e-9).floor() as u32).max(1);
+        // Arc window ≥ chord reach of the nozzle body, with 20 % for curvature.
+        let reach = 1.2 * (nozzle_radius + params.width_max / 2.0);
+        let window = (reach / ds).ceil() as usize;
+        let mut last_err = None;
+        for lower in (1..=n).rev() {
+            let cap = dmax.min((h_short + spread) / lower as f64);
+            let mut k = ((h_tall / cap) - 1e-9).ceil().max(1.0) as u32;
+            if k < lower {
+                k = lower;
+            }
+            let mut delta = h_tall / k as f64;
+            if delta < dmin - 1e-9 {
+                k = ((h_tall / dmin + 1e-9).floor() as u32).max(1);
+                delta = h_tall / k as f64;
+                if delta > dmax + 1e-9 || k < lower {
+                    last_err = Some(format!(
+                        "the {h_tall:.2} mm tall end cannot be split into layers between {dmin} and {dmax} mm; raise params.max_layer_height"
+                    ));
+                    continue;
+                }
+            }
+            let plan = LayerPlan {
+                passes: k,
+                lower_passes: lower,
+                tall_layer_mm: delta,
+                spread_mm: spread,
+                first_toward_tall: k == lower || lower % 2 == 1,
+                min_top_bead_mm: 0.5 * dmin,
+            };
+            match plan.slope_violation(h, window) {
+                None => return Ok(plan),
+                Some(at) => {
+                    last_err = Some(format!(
+                        "no layering keeps the extruder body (radius {nozzle_radius} mm) clear of the layer below; the top edge rises too steeply near column {at}"
+                    ))
+                }
+            }
+        }
+        Err(Error::Layering(last_err.unwrap_or_default()))
+    }
+
+    /// The first column where a pass would bring the nozzle lower than the
+    /// previous pass's clay within `window` columns (the slope condition).
+    fn slope_violation(&self, h: &[f64], window: usize) -> Option<usize> {
+        for (j, &hj) in h.iter().enumerate() {
+            let far = (j + window).min(h.len() - 1);
+            let hf = h[far];
+            if hf <= hj {
+                continue;
+            }
+            let q = self.column(hj).passes;
+            for k in 2..=q {
+                let mine = self.height(k, hj).min(hj);
+                let theirs = self.nominal(k - 1, hf).min(hf);
+                if theirs > mine + 1e-9 {
+                    return Some(j);
+                }
+            }
+        }
+        None
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn heights(a: f64, b: f64, n: usize) -> Vec<f64> {
+        (0..n)
+            .map(|i| a + (b - a) * i as f64 / (n - 1) as f64)
+            .collect()
+    }
+
+    #[test]
+    fn equal_heights_give_the_papers_single_stage() {
+        let p = Params::default();
+        let plan = LayerPlan::choose(&heights(50.0, 50.0, 100), 1.1, &p, 5.0).unwrap();
+        assert_eq!(plan.passes, 40, "⌊50 / 1.25⌋ = 40 passes");
+        assert!(!plan.two_stage());
+        let c = plan.column(50.0);
+        assert_eq!(c.passes, 40);
+        assert!(c.exact_top && c.top_bead.is_none());
+        assert_eq!(plan.height(40, 50.0), 50.0);
+        assert!((plan.height(1, 50.0) - 1.25).abs() < 1e-12);
+    }
+
+    #[test]
+    fn small_difference_tilts_layers_between_the_ends() {
+        let p = Params::default();
+        let plan = LayerPlan::choose(&heights(40.0, 50.0, 400), 1.1, &p, 5.0).unwrap();
+        assert_eq!((plan.passes, plan.lower_passes), (32, 32));
+        // Pass k at k/N of each column's height.
+        assert!((plan.height(16, 40.0) - 20.0).abs() < 1e-12);
+        assert!((plan.height(16, 50.0) - 25.0).abs() < 1e-12);
+    }
+
+    #[test]
+    fn large_difference_needs_two_stages() {
+        let p = Params::default();
+        let h = heights(20.0, 60.0, 2000);
+        let plan = LayerPlan::choose(&h, 1.1, &p, 5.0).unwrap();
+        assert!(plan.two_stage(), "{plan:?}");
+        assert!(plan.tall_layer_mm >= p.layer_height && plan.tall_layer_mm <= p.max_layer_height);
+        // Pass N' runs toward the tall end, so the lower stage can finish.
+        assert!(plan.toward_tall(plan.lower_passes));
+        // Steps per column stay within bounds; the short end finishes on top.
+        for &hj in h.iter().step_by(50) {
+            let c = plan.column(hj);
+            let mut last = 0.0;
+            for k in 1..=c.passes {
+                let z = plan.height(k, hj);
+                let step = z - last;
+                assert!(
+                    step >= p.layer_height - 1e-9 && step <= p.max_layer_height + 1e-9,
+                    "h = {hj}: pass {k} step {step}"
+                );
+                last = z;
+            }
+            assert!(
+                hj - last < p.max_layer_height + 1e-9,
+                "h = {hj}: {last} leaves a gap"
+            );
+        }
+        assert!(plan.column(20.0).exact_top);
+    }
+
+    #[test]
+    fn spread_within_a_pass_is_bounded() {
+        let p = Params::default();
+        let h = heights(10.0, 90.0, 3000);
+        let plan = LayerPlan::choose(&h, 1.1, &p, 5.0).unwrap();
+        for k in 1..=plan.passes {
+            let zs: Vec<f64> = h
+                .iter()
+                .filter(|&&hj| plan.column(hj).passes >= k)
+                .map(|&hj| plan.height(k, hj))
+                .collect();
+            let (lo, hi) = zs
+                .iter()
+                .fold((f64::MAX, f64::MIN), |(a, b), &z| (a.min(z), b.max(z)));
+            assert!(
+                hi - lo <= plan.spread_mm + 1e-9,
+                "pass {k}: spread {}",
+                hi - lo
+            );
+        }
+    }
+
+    #[test]
+    fn steep_top_edges_fall_back_to_flat_layers() {
+        let p = Params::default();
+        // 20 mm of rise over 22 mm of trajectory.
+        let h = heights(30.0, 50.0, 21);
+        let plan = LayerPlan::choose(&h, 1.1, &p, 5.0).unwrap();
+        assert!(plan.lower_passes < 24, "{plan:?}");
+        assert!(plan.slope_violation(&h, 12).is_none());
+    }
+}

@@ -1,0 +1,156 @@
+//! # sweepclay-core
+//!
+//! Turns a sweeping-surface design (two profile curves, a trajectory and an
+//! interpolation curve; Zhong et al., "Ceramic 3D printed sweeping
+//! surfaces", C&G 2020) into G-code for a clay printer: one strictly
+//! continuous extrusion path, collision-free, self-supporting, with the
+//! extrusion adapted so each bead rests on the one below.
+//!
+//! The library is pure: each stage is a function from one plain type to the
+//! next, with no I/O and no shared state.
+//!
+//! | stage | function | input → output | paper |
+//! |---|---|---|---|
+//! | 1 | [`surface::sample_surface`] | [`Design`] → [`Surface`] | §4 sample points |
+//! | 2 | [`correct::correct`] | [`Surface`] → [`Corrected`] | §4 support-free, self-intersection |
+//! | 3 | [`toolpath::plan_path`] | [`Corrected`] → [`Toolpath`] | §5.2, Alg. 2 |
+//! | 4 | [`extrude::plan_extrusion`] | [`Toolpath`] → [`Extrusion`] | §5.3, Alg. 3 |
+//! | 5 | [`gcode::emit`] | [`Sliced`] → G-code text | §5.1, Alg. 1 |
+//!
+//! [`slice`] runs them all and computes the statistics of the paper's
+//! Table 1. The layering that decides single or two stages is in
+//! [`layers`]; `docs/ALGORITHMS.md` gives the formulation and its proofs.
+//!
+//! ```
+//! let design = sweepclay_core::Design::from_json(r#"{
+//!   "sweepclay": 1,
+//!   "profile_start": { "control_points": [[0, 0], [3, 20], [0, 40]] },
+//!   "profile_end":   { "control_points": [[0, 0], [0, 45]] },
+//!   "trajectory":    { "control_points": [[-40, 20], [0, 50], [40, 20]] }
+//! }"#).unwrap();
+//! let sliced = sweepclay_core::slice(&design).unwrap();
+//! let gcode = sweepclay_core::gcode::to_string(&sliced);
+//! assert!(gcode.contains("G1 F2000"));
+//! assert_eq!(sliced.stats.stages, 1);
+//! ```
+
+pub mod bspline;
+pub mod correct;
+pub mod curves;
+pub mod design;
+pub mod error;
+pub mod examples;
+pub mod extrude;
+pub mod gcode;
+pub mod grid;
+pub mod layers;
+pub mod printer;
+pub mod surface;
+pub mod toolpath;
+
+pub use correct::{Corrected, CorrectionReport};
+pub use design::{Design, Params};
+pub use error::{Error, Result};
+pub use extrude::Extrusion;
+pub use printer::{Printer, PrinterRef};
+pub use surface::Surface;
+pub use toolpath::Toolpath;
+
+use serde::Serialize;
+
+/// The statistics of the paper's Table 1, and a few more.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Stats {
+    /// Bounding box of the path, bead edges included (mm).
+    pub size_mm: [f64; 3],
+    /// Path points (= surface samples).
+    pub sample_points: usize,
+    /// Passes of the zig-zag.
+    pub passes: u32,
+    /// 1 or 2.
+    pub stages: u8,
+    /// Returning turns along the top edge.
+    pub returning_points: u32,
+    /// Transition curves (columns along Ψ).
+    pub curves: usize,
+    /// Length of the extrusion path (mm).
+    pub path_length_mm: f64,
+    /// Clay volume (ml).
+    pub volume_ml: f64,
+    /// Printing time at the feedrate, plus the first rapid move (min).
+    pub time_min: f64,
+    /// Bed coordinates of the bounding box: `[[xmin, ymin, zmin], [xmax, ymax, zmax]]`.
+    pub bounds_mm: [[f64; 3]; 2],
+}
+
+/// Everything the pipeline computed for one design.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Sliced {
+    /// The corrected surface and the correction report.
+    pub corrected: Corrected,
+    /// The toolpath.
+    pub toolpath: Toolpath,
+    /// Bead widths and volumes.
+    pub extrusion: Extrusion,
+    /// Table-1 statistics.
+    pub stats: Stats,
+}
+
+/// Runs the whole pipeline: validate, sample, correct, plan the path and the
+/// extrusion, and check that the result fits the printer.
+pub fn slice(design: &Design) -> Result<Sliced> {
+    let surface = surface::sample_surface(design)?;
+    let corrected = correct::correct(&surface)?;
+    let toolpath = toolpath::plan_path(&corrected);
+    let extrusion = extrude::plan_extrusion(&toolpath, &corrected.surface.params);
+    let stats = stats(&corrected, &toolpath, &extrusion);
+    let pr = &corrected.surface.printer;
+    for axis in 0..3 {
+        let (lo, hi) = (stats.bounds_mm[0][axis], stats.bounds_mm[1][axis]);
+        if lo < -1e-9 || hi > pr.build_volume[axis] + 1e-9 {
+            return Err(Error::DoesNotFit {
+                printer: pr.name.clone(),
+                axis: ['x', 'y', 'z'][axis],
+                min: lo,
+                max: hi,
+                limit: pr.build_volume[axis],
+            });
+        }
+    }
+    Ok(Sliced {
+        corrected,
+        toolpath,
+        extrusion,
+        stats,
+    })
+}
+
+fn stats(c: &Corrected, t: &Toolpath, e: &Extrusion) -> Stats {
+    let pr = &c.surface.printer;
+    let mut lo = [f64::MAX; 3];
+    let mut hi = [f64::MIN; 3];
+    for (p, w) in t.points.iter().zip(&e.width) {
+        for a in 0..2 {
+            lo[a] = lo[a].min(p.pos[a] + pr.origin[a] - w / 2.0);
+            hi[a] = hi[a].max(p.pos[a] + pr.origin[a] + w / 2.0);
+        }
+        hi[2] = hi[2].max(p.pos[2]);
+    }
+    lo[2] = 0.0;
+    let p0 = t.points[0].pos;
+    let travel = (p0[0] + pr.origin[0])
+        .hypot(p0[1] + pr.origin[1])
+        .hypot(p0[2]);
+    Stats {
+        size_mm: [hi[0] - lo[0], hi[1] - lo[1], hi[2] - lo[2]],
+        sample_points: t.points.len(),
+        passes: t.passes,
+        stages: t.stages,
+        returning_points: t.returning_points,
+        curves: c.surface.columns.len(),
+        path_length_mm: e.path_length,
+        volume_ml: e.total_volume / 1000.0,
+        time_min: e.path_length / c.surface.params.feedrate + travel / pr.travel_feedrate,
+        bounds_mm: [lo, hi],
+    }
+}

@@ -1,0 +1,217 @@
+//! Printer profiles: where the design lands on the bed, how big the bed is,
+//! how extrusion volume becomes E, and how big the extruder body is.
+//!
+//! DESIGN.md §3: `printer` is a preset name or an inline object whose missing
+//! keys take the `generic` values.
+
+use crate::error::{Error, Result};
+use serde::{Deserialize, Serialize};
+
+/// A resolved printer profile. Lengths in mm, feedrates in mm/min.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields, default)]
+pub struct Printer {
+    /// Profile name, written into the G-code header.
+    pub name: String,
+    /// Build volume `[x, y, z]` in mm; the bed spans `0..x`, `0..y`.
+    pub build_volume: [f64; 3],
+    /// Where the design's centre `o` lands on the bed, `[x, y]` in mm.
+    pub origin: [f64; 2],
+    /// Extrusion calibration: E units per mm³ of clay. Default 0.13.
+    pub e_per_mm3: f64,
+    /// Relative E (`M83`) instead of absolute (`M82`, the default).
+    pub relative_e: bool,
+    /// Radius of the extruder body (mm) that must not touch printed clay
+    /// below `nozzle_height`. Default 5.
+    pub nozzle_radius: f64,
+    /// Feedrate of the single rapid move to the first point, mm/min.
+    pub travel_feedrate: f64,
+    /// G-code sent before the first move.
+    pub start_gcode: String,
+    /// G-code sent after the last move.
+    pub end_gcode: String,
+}
+
+impl Default for Printer {
+    fn default() -> Self {
+        Printer {
+            name: "generic".into(),
+            build_volume: [200.0, 200.0, 200.0],
+            origin: [100.0, 100.0],
+            e_per_mm3: 0.13,
+            relative_e: false,
+            nozzle_radius: 5.0,
+            travel_feedrate: 2400.0,
+            start_gcode: "G28 ; home all axes\nG92 E0\n".into(),
+            end_gcode: "M84 ; motors off\n".into(),
+        }
+    }
+}
+
+/// Names of the built-in presets, in the order `--help` lists them.
+pub const PRESETS: &[&str] = &["cerambot-plus", "cerambot-mini", "generic"];
+
+impl Printer {
+    /// A built-in preset by name.
+    pub fn preset(name: &str) -> Option<Printer> {
+        let base = Printer::default();
+        match name {
+            "generic" => Some(base),
+            // Paper Fig. 10: CERAMBOT Plus, 180 × 190 × 200 mm.
+            "cerambot-plus" => Some(Printer {
+                name: name.into(),
+                build_volume: [180.0, 190.0, 200.0],
+                origin: [90.0, 95.0],
+                ..base
+            }),
+            // Paper Fig. 10: CERAMBOT Mini, 120 × 135 × 100 mm.
+            "cerambot-mini" => Some(Printer {
+                name: name.into(),
+                build_volume: [120.0, 135.0, 100.0],
+                origin: [60.0, 67.5],
+                ..base
+            }),
+            _ => None,
+        }
+    }
+
+    /// Checks every value; `key` is the dotted path used in messages.
+    pub fn validate(&self, key: &str) -> Result<()> {
+        for (i, v) in self.build_volume.iter().enumerate() {
+            if !v.is_finite() || *v <= 0.0 {
+                return Err(Error::invalid(
+                    format!("{key}.build_volume[{i}]"),
+                    format!("must be a positive number of mm (got {v})"),
+                ));
+            }
+        }
+        for (i, v) in self.origin.iter().enumerate() {
+            if !v.is_finite() {
+                return Err(Error::invalid(
+                    format!("{key}.origin[{i}]"),
+                    format!("must be a finite number (got {v})"),
+                ));
+            }
+        }
+        positive(&format!("{key}.e_per_mm3"), self.e_per_mm3)?;
+        positive(&format!("{key}.travel_feedrate"), self.travel_feedrate)?;
+        if !self.nozzle_radius.is_finite() || self.nozzle_radius < 0.0 {
+            return Err(Error::invalid(
+                format!("{key}.nozzle_radius"),
+                format!("must be ≥ 0 mm (got {})", self.nozzle_radius),
+            ));
+        }
+        Ok(())
+    }
+}
+
+/// The `printer` key: a preset name or an inline profile.
+#[derive(Clone, Debug, PartialEq)]
+pub enum PrinterRef {
+    /// One of [`PRESETS`].
+    Preset(String),
+    /// An inline object; missing keys took the `generic` values.
+    Inline(Printer),
+}
+
+impl Default for PrinterRef {
+    fn default() -> Self {
+        PrinterRef::Preset("generic".into())
+    }
+}
+
+impl PrinterRef {
+    /// The profile this reference names.
+    pub fn resolve(&self) -> Result<Printer> {
+        match self {
+            PrinterRef::Preset(name) => Printer::preset(name).ok_or_else(|| {
+                Error::invalid(
+                    "printer",
+                    format!("unknown preset `{name}` (known: {})", PRESETS.join(", ")),
+                )
+            }),
+            PrinterRef::Inline(p) => {
+                p.validate("printer")?;
+                Ok(p.clone())
+            }
+        }
+    }
+}
+
+impl Serialize for PrinterRef {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> std::result::Result<S::Ok, S::Error> {
+        match self {
+            PrinterRef::Preset(n) => s.serialize_str(n),
+            PrinterRef::Inline(p) => p.serialize(s),
+        }
+    }
+}
+
+impl<'de> Deserialize<'de> for PrinterRef {
+    fn deserialize<D: serde::Deserializer<'de>>(d: D) -> std::result::Result<Self, D::Error> {
+        use serde::de::Error as _;
+        match serde_json::Value::deserialize(d)? {
+            serde_json::Value::String(s) => Ok(PrinterRef::Preset(s)),
+            v @ serde_json::Value::Object(_) => serde_json::from_value(v)
+                .map(PrinterRef::Inline)
+                .map_err(|e| D::Error::custom(format!("printer: {e}"))),
+            other => Err(D::Error::custom(format!(
+                "printer: expected a preset name or an object, got {other}"
+            ))),
+        }
+    }
+}
+
+fn positive(key: &str, v: f64) -> Result<()> {
+    if v.is_finite() && v > 0.0 {
+        Ok(())
+    } else {
+        Err(Error::invalid(key, format!("must be > 0 (got {v})")))
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn presets_have_the_papers_build_volumes() {
+        assert_eq!(
+            Printer::preset("cerambot-plus").unwrap().build_volume,
+            [180.0, 190.0, 200.0]
+        );
+        assert_eq!(
+            Printer::preset("cerambot-mini").unwrap().build_volume,
+            [120.0, 135.0, 100.0]
+        );
+        for name in PRESETS {
+            Printer::preset(name).unwrap().validate("printer").unwrap();
+        }
+    }
+
+    #[test]
+    fn inline_printer_fills_missing_keys_from_generic() {
+        let r: PrinterRef = serde_json::from_str(r#"{"name":"mine","e_per_mm3":0.2}"#).unwrap();
+        let p = r.resolve().unwrap();
+        assert_eq!(p.e_per_mm3, 0.2);
+        assert_eq!(p.build_volume, Printer::default().build_volume);
+    }
+
+    #[test]
+    fn unknown_preset_and_unknown_key_are_named() {
+        let e = PrinterRef::Preset("prusa".into()).resolve().unwrap_err();
+        assert!(e.to_string().contains("unknown preset `prusa`"), "{e}");
+        let e = serde_json::from_str::<PrinterRef>(r#"{"nozle_radius":3}"#).unwrap_err();
+        assert!(e.to_string().contains("nozle_radius"), "{e}");
+    }
+
+    #[test]
+    fn bad_values_are_refused() {
+        let p = Printer {
+            e_per_mm3: -1.0,
+            ..Printer::default()
+        };
+        let e = p.validate("printer").unwrap_err();
+        assert!(e.to_string().starts_with("printer.e_per_mm3"), "{e}");
+    }
+}

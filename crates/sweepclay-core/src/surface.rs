@@ -1,0 +1,293 @@
+//! Stage 1: design → sampled sweeping surface (paper §4 "Sample points
+//! generation", DESIGN.md §4).
+//!
+//! Ψ is resampled by arc length into columns p_i; each column carries the
+//! transition curve T_i between the two profiles, λ_i = f(u_i), evaluated
+//! at exactly the heights the toolpath will visit (the [`LayerPlan`]), so a
+//! sample *is* a path point, as in the paper.
+
+use crate::curves::{Interpolation, Profile, Trajectory};
+use crate::design::{Design, Params};
+use crate::error::{Error, Result};
+use crate::layers::LayerPlan;
+use crate::printer::Printer;
+
+/// One transition curve, at trajectory sample p_i.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Column {
+    /// p_i, relative to the centre `o` (mm).
+    pub p: [f64; 2],
+    /// d_i = (p_i − o)/|p_i − o|: direction of the radial offset.
+    pub dir: [f64; 2],
+    /// u_i: normalised arc length along Ψ.
+    pub u: f64,
+    /// λ_i = f(u_i).
+    pub lambda: f64,
+    /// h_i = (1 − λ_i)·Z_s + λ_i·Z_t: the column's designed height (mm).
+    pub height: f64,
+    /// Index of the column's first sample in [`Surface::samples`].
+    pub first: u32,
+    /// Passes 1..=`passes` visit the column (one sample each, bottom up).
+    pub passes: u32,
+    /// A top-edge bead sample follows the pass samples.
+    pub top: bool,
+}
+
+impl Column {
+    /// Number of samples of this column.
+    pub fn len(&self) -> usize {
+        self.passes as usize + usize::from(self.top)
+    }
+
+    /// Whether the column has no samples (never for a valid surface).
+    pub fn is_empty(&self) -> bool {
+        self.len() == 0
+    }
+
+    /// The range of this column's samples.
+    pub fn samples(&self) -> std::ops::Range<usize> {
+        self.first as usize..self.first as usize + self.len()
+    }
+
+    /// The position of a point at radial offset `xi` and height `z`.
+    pub fn point(&self, xi: f64, z: f64) -> [f64; 3] {
+        [
+            self.p[0] + xi * self.dir[0],
+            self.p[1] + xi * self.dir[1],
+            z,
+        ]
+    }
+}
+
+/// One surface sample: a height on a transition curve and its radial offset.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Sample {
+    /// Height above the bed (mm).
+    pub z: f64,
+    /// ξ: horizontal offset along the column's direction (mm).
+    pub xi: f64,
+}
+
+/// The sampled sweeping surface.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Surface {
+    /// Design name.
+    pub name: String,
+    /// Columns in trajectory order.
+    pub columns: Vec<Column>,
+    /// All samples, column by column, bottom up.
+    pub samples: Vec<Sample>,
+    /// The layering the samples follow.
+    pub plan: LayerPlan,
+    /// Whether the tall end is the end of Ψ (else its start).
+    pub tall_at_end: bool,
+    /// C_s sampled.
+    pub start: Profile,
+    /// C_t sampled.
+    pub end: Profile,
+    /// Arc length of Ψ (mm).
+    pub trajectory_length: f64,
+    /// Distance between columns along Ψ (mm).
+    pub spacing: f64,
+    /// The parameters.
+    pub params: Params,
+    /// The printer.
+    pub printer: Printer,
+}
+
+impl Surface {
+    /// ξ_i(t) of the design (before corrections), scaled by `compression`.
+    pub fn design_offset(&self, col: &Column, z: f64, compression: f64) -> f64 {
+        let t = (z / col.height).min(1.0);
+        compression * ((1.0 - col.lambda) * self.start.offset(t) + col.lambda * self.end.offset(t))
+    }
+
+    /// Column index for position `m` counted from the short end.
+    pub fn ordered(&self, m: usize) -> usize {
+        if self.tall_at_end {
+            m
+        } else {
+            self.columns.len() - 1 - m
+        }
+    }
+
+    /// The position of sample `s` of column `c`.
+    pub fn position(&self, c: usize, s: usize) -> [f64; 3] {
+        let smp = self.samples[s];
+        self.columns[c].point(smp.xi, smp.z)
+    }
+}
+
+/// Samples the design's surface. Validates every part of the design first.
+pub fn sample_surface(design: &Design) -> Result<Surface> {
+    let params = design.params.clone();
+    params.validate()?;
+    let printer = design.printer.resolve()?;
+    let start = Profile::new("profile_start", &design.profile_start)?;
+    let end = Profile::new("profile_end", &design.profile_end)?;
+    for (key, prof) in [("profile_start", &start), ("profile_end", &end)] {
+        if prof.height < params.layer_height {
+            return Err(Error::invalid(
+                key,
+                format!(
+                    "is {:.2} mm tall, less than one layer (params.layer_height = {})",
+                    prof.height, params.layer_height
+                ),
+            ));
+        }
+    }
+    let interp = Interpolation::new(design.interpolation.as_ref())?;
+    let traj = Trajectory::new(&design.trajectory, params.spacing)?;
+    let n = traj.points.len();
+    let mut columns = Vec::with_capacity(n);
+    for (i, &p) in traj.points.iter().enumerate() {
+        let r = p[0].hypot(p[1]);
+        let u = i as f64 / (n - 1) as f64;
+        if r < 1.0 {
+            return Err(Error::invalid(
+                "trajectory",
+                format!(
+                    "passes within 1 mm of the centre o at ({:.2}, {:.2}), u = {u:.3}; the radial direction is undefined there",
+                    p[0], p[1]
+                ),
+            ));
+        }
+        let lambda = interp.eval(u);
+        columns.push(Column {
+            p,
+            dir: [p[0] / r, p[1] / r],
+            u,
+            lambda,
+            height: (1.0 - lambda) * start.height + lambda * end.height,
+            first: 0,
+            passes: 0,
+            top: false,
+        });
+    }
+    let tall_at_end = end.height >= start.height;
+    let ordered: Vec<f64> = if tall_at_end {
+        columns.iter().map(|c| c.height).collect()
+    } else {
+        columns.iter().rev().map(|c| c.height).collect()
+    };
+    let spacing = traj.length / (n - 1) as f64;
+    let plan = LayerPlan::choose(&ordered, spacing, &params, printer.nozzle_radius)?;
+    let mut surface = Surface {
+        name: design.name.clone(),
+        columns,
+        samples: Vec::new(),
+        plan,
+        tall_at_end,
+        start,
+        end,
+        trajectory_length: traj.length,
+        spacing,
+        params,
+        printer,
+    };
+    let mut samples = Vec::new();
+    let mut columns = std::mem::take(&mut surface.columns);
+    for col in &mut columns {
+        let layers = surface.plan.column(col.height);
+        col.first = samples.len() as u32;
+        col.passes = layers.passes;
+        col.top = layers.top_bead.is_some();
+        for k in 1..=layers.passes {
+            let z = surface.plan.height(k, col.height);
+            samples.push(Sample {
+                z,
+                xi: surface.design_offset(col, z, 1.0),
+            });
+        }
+        if let Some(z) = layers.top_bead {
+            samples.push(Sample {
+                z,
+                xi: surface.design_offset(col, z, 1.0),
+            });
+        }
+    }
+    surface.columns = columns;
+    surface.samples = samples;
+    Ok(surface)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A circular arc of radius 40 with vertical profiles: a cylinder piece.
+    fn cylinder(hs: f64, ht: f64) -> Design {
+        let pts: Vec<[f64; 2]> = (0..=60)
+            .map(|i| {
+                let a = std::f64::consts::PI * i as f64 / 60.0;
+                [40.0 * a.cos(), 40.0 * a.sin()]
+            })
+            .collect();
+        Design::from_json(&format!(
+            r#"{{"sweepclay":1,
+                "profile_start":{{"control_points":[[0,0],[0,{hs}]]}},
+                "profile_end":{{"control_points":[[0,0],[0,{ht}]]}},
+                "trajectory":{{"points":{}}}}}"#,
+            serde_json::to_string(&pts).unwrap()
+        ))
+        .unwrap()
+    }
+
+    #[test]
+    fn vertical_profiles_on_a_circle_give_a_cylinder() {
+        let s = sample_surface(&cylinder(50.0, 50.0)).unwrap();
+        assert_eq!(s.plan.passes, 40);
+        for (c, col) in s.columns.iter().enumerate() {
+            assert_eq!(col.len(), 40);
+            for i in col.samples() {
+                let p = s.position(c, i);
+                let r = p[0].hypot(p[1]);
+                // Ψ is a 60-gon: chord sagitta 40·(1 − cos(π/120)) = 0.014 mm.
+                assert!(
+                    (r - 40.0).abs() < 0.015,
+                    "sample at radius {r}, expected 40"
+                );
+            }
+            let top = s.samples[col.samples().end - 1].z;
+            assert!((top - 50.0).abs() < 1e-9, "top {top}");
+        }
+        // Arc length π·40 ≈ 125.6 mm at 1.1 mm → 115 columns.
+        assert_eq!(s.columns.len(), 115);
+    }
+
+    #[test]
+    fn leaning_profiles_offset_radially() {
+        let mut d = cylinder(40.0, 40.0);
+        d.profile_start.control_points = vec![[0.0, 0.0], [10.0, 40.0]];
+        d.profile_end.control_points = vec![[5.0, 0.0], [5.0, 40.0]];
+        let s = sample_surface(&d).unwrap();
+        let first = &s.columns[0];
+        let top = s.samples[first.samples().end - 1];
+        assert!(
+            (top.xi - 10.0).abs() < 1e-6,
+            "start column leans 10 mm, got {}",
+            top.xi
+        );
+        // Halfway along Ψ with linear f: the mean profile, 5 mm at the top.
+        let mid = &s.columns[s.columns.len() / 2];
+        let top = s.samples[mid.samples().end - 1];
+        assert!((top.xi - 10.0 * (1.0 - mid.lambda)).abs() < 1e-6);
+        assert!((mid.lambda - 0.5).abs() < 0.01);
+    }
+
+    #[test]
+    fn trajectory_through_the_centre_is_refused() {
+        let mut d = cylinder(20.0, 20.0);
+        d.trajectory.points = Some(vec![[-30.0, 0.0], [30.0, 0.0]]);
+        let e = sample_surface(&d).unwrap_err().to_string();
+        assert!(e.contains("within 1 mm of the centre"), "{e}");
+    }
+
+    #[test]
+    fn too_short_profile_is_refused() {
+        let e = sample_surface(&cylinder(1.0, 20.0))
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("profile_start: is 1.00 mm tall"), "{e}");
+    }
+}
