@@ -101,6 +101,38 @@ impl BeadGrid {
     }
 }
 
+/// A bead below a new bead: height under it, horizontal distance, width,
+/// and whether its footprint (a capsule: the centreline ± w/2, round ends
+/// included) covers the new bead's middle.
+#[derive(Clone, Copy)]
+struct Candidate {
+    z: f64,
+    d: f64,
+    width: f64,
+    covers: bool,
+}
+
+/// The bead a new bead rests on: among the beads whose footprint covers its
+/// middle (else any nearby), those within half a layer of the highest, and
+/// of these the nearest centreline. At a bead's edge the clay is lower than
+/// at its centre, so a slightly higher neighbour reaching under with its
+/// edge is not what the bead rests on.
+fn pick_support(cands: &[Candidate], z_mid: f64) -> Option<Candidate> {
+    let covering = cands.iter().any(|c| c.covers);
+    let group = |c: &&Candidate| c.covers == covering;
+    let top = cands
+        .iter()
+        .filter(group)
+        .map(|c| c.z)
+        .fold(f64::MIN, f64::max);
+    cands
+        .iter()
+        .filter(group)
+        .filter(|c| c.z >= top - 0.5 * (z_mid - top))
+        .min_by(|a, b| a.d.total_cmp(&b.d))
+        .copied()
+}
+
 /// Overlap of a bead of width `wa` with one of width `wb` whose centre is
 /// `s` to the side, as a fraction of `wa`.
 fn overlap_fraction(wa: f64, wb: f64, s: f64) -> f64 {
@@ -199,8 +231,8 @@ pub fn check(text: &str, cfg: &CheckConfig) -> Report {
     let mut lo = [f64::MAX; 3];
     let mut hi = [f64::MIN; 3];
     let mut layer_heights = Vec::new();
+    let mut cands: Vec<Candidate> = Vec::new();
     let recent_nozzle = cfg.nozzle_radius + cfg.width_max;
-    let recent_support = 3.0 * cfg.width_max;
     let reach = cfg.nozzle_radius + cfg.width_max / 2.0;
     for (i, ev) in events.iter().enumerate() {
         let Event::Move(m) = ev else { continue };
@@ -272,8 +304,7 @@ pub fn check(text: &str, cfg: &CheckConfig) -> Report {
                 0.5 * (m.from[2] + m.to[2]),
             ];
             stamp.resize(beads.len(), u32::MAX);
-            let mut inside: Option<(f64, f64, f64)> = None; // (z, d, width)
-            let mut outside: Option<(f64, f64, f64)> = None;
+            cands.clear();
             let mut double = false;
             grid.for_each(
                 mid,
@@ -291,24 +322,25 @@ pub fn check(text: &str, cfg: &CheckConfig) -> Report {
                         return;
                     }
                     let (t, d, z) = b.closest(mid);
-                    let interior = t > 0.02 && t < 0.98;
-                    if !interior && s_start - b.s_end <= recent_support {
+                    // A bead laid earlier in the same run lies behind the
+                    // nozzle, not below it: its nearest point is its end and
+                    // the path from there to here is about as long as the
+                    // distance. A bead below reached through a turn or a
+                    // step-up is not like that.
+                    if t >= 1.0 - 1e-9 && s_start - b.s_end <= 1.1 * d + 1e-6 {
                         return;
                     }
                     if z <= mid[2] - cfg.min_layer_mm {
                         if mid[2] - z > cfg.max_gap_mm {
                             return;
                         }
-                        let slot = if d <= b.width / 2.0 {
-                            &mut inside
-                        } else if d <= cfg.width_max {
-                            &mut outside
-                        } else {
-                            return;
-                        };
-                        // Highest clay wins; at the same height, the nearest.
-                    if slot.is_none_or(|(bz, bd, _)| z > bz + 0.05 || (z > bz - 0.05 && d < bd)) {
-                            *slot = Some((z, d, b.width));
+                        if d <= cfg.width_max.max(b.width / 2.0) {
+                            cands.push(Candidate {
+                                z,
+                                d,
+                                width: b.width,
+                                covers: d <= b.width / 2.0,
+                            });
                         }
                     } else if (z - mid[2]).abs() < cfg.min_layer_mm
                         && d < 0.5 * b.width.min(cfg.width_min)
@@ -321,12 +353,12 @@ pub fn check(text: &str, cfg: &CheckConfig) -> Report {
             if double {
                 r.support.double_deposition.add(m.line, 0.0);
             }
-            let support = inside.or(outside);
+            let support = pick_support(&cands, mid[2]);
             let (dz, overlap, offset) = match support {
-                Some((z, d, wb)) => {
-                    let dz = mid[2] - z;
+                Some(c) => {
+                    let dz = mid[2] - c.z;
                     width = volume / (len * dz);
-                    (dz, overlap_fraction(width, wb, d), d)
+                    (dz, overlap_fraction(width, c.width, c.d), c.d)
                 }
                 None if mid[2] <= cfg.first_layer_max_mm => {
                     r.support.on_bed += 1;

@@ -81,6 +81,9 @@ struct CheckArgs {
     /// Overhang threshold from vertical (degrees).
     #[arg(long, default_value_t = 57.0)]
     max_overhang_deg: f64,
+    /// The first bead must start at most this high (mm).
+    #[arg(long, default_value_t = 3.0)]
+    first_layer_max: f64,
     /// Print the report as JSON.
     #[arg(long)]
     json: bool,
@@ -140,6 +143,9 @@ fn check_config(p: &Printer, params: &sweepclay_core::Params) -> CheckConfig {
         width_max: params.width_max,
         overlap_target: params.overlap,
         max_overhang_deg: params.max_overhang_deg,
+        first_layer_max_mm: CheckConfig::default()
+            .first_layer_max_mm
+            .max(params.max_layer_height + 0.05),
         ..CheckConfig::default()
     }
 }
@@ -257,6 +263,7 @@ fn check_cmd(a: CheckArgs) -> Result<i32> {
         overlap_target: a.overlap,
         overlap_min: a.min_overlap,
         max_overhang_deg: a.max_overhang_deg,
+        first_layer_max_mm: a.first_layer_max,
         ..CheckConfig::default()
     };
     let report = check(&text, &cfg);
