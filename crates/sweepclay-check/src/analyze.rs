@@ -26,8 +26,8 @@ struct Bead {
 
 impl Bead {
     /// Closest point of the bead's centreline (in plan) to `p`:
-    /// `(parameter, horizontal distance, height there)`.
-    fn closest(&self, p: [f64; 3]) -> (f64, f64, f64) {
+    /// `(parameter, horizontal distance, height there, the point)`.
+    fn closest(&self, p: [f64; 3]) -> (f64, f64, f64, [f64; 2]) {
         let (dx, dy) = (self.to[0] - self.from[0], self.to[1] - self.from[1]);
         let l2 = dx * dx + dy * dy;
         let t = if l2 > 0.0 {
@@ -37,7 +37,7 @@ impl Bead {
         };
         let (x, y) = (self.from[0] + t * dx, self.from[1] + t * dy);
         let z = self.from[2] + t * (self.to[2] - self.from[2]);
-        (t, (p[0] - x).hypot(p[1] - y), z)
+        (t, (p[0] - x).hypot(p[1] - y), z, [x, y])
     }
 }
 
@@ -101,36 +101,44 @@ impl BeadGrid {
     }
 }
 
-/// A bead below a new bead: height under it, horizontal distance, width,
-/// and whether its footprint (a capsule: the centreline ± w/2, round ends
-/// included) covers the new bead's middle.
-#[derive(Clone, Copy)]
+/// A bead below a new bead: height at its point nearest to the new bead's
+/// middle, that point, the horizontal distance to it, its width, and
+/// whether its footprint (a capsule: centreline ± w/2) covers the middle.
+#[derive(Clone, Copy, Debug)]
 struct Candidate {
     z: f64,
+    at: [f64; 2],
     d: f64,
     width: f64,
     covers: bool,
 }
 
-/// The bead a new bead rests on: among the beads whose footprint covers its
-/// middle (else any nearby), those within half a layer of the highest, and
-/// of these the nearest centreline. At a bead's edge the clay is lower than
-/// at its centre, so a slightly higher neighbour reaching under with its
-/// edge is not what the bead rests on.
-fn pick_support(cands: &[Candidate], z_mid: f64) -> Option<Candidate> {
+/// The bead a new bead rests on. Under a bead, earlier passes form a stack
+/// of ridges; it rests on the top of the stack nearest its centreline.
+/// Start from the candidate nearest the middle (among those whose
+/// footprint covers it, else among all); while another candidate is higher
+/// by at least `min_layer` and steeper than 1:2 from it, move up to it. A
+/// step up a stack is steep (leaning walls keep rise ≥ 0.65 × run within
+/// the overhang limit); a step along one tilted ridge is gentle, so the
+/// walk climbs stacks without sliding along ridges.
+fn pick_support(cands: &[Candidate], min_layer: f64) -> Option<Candidate> {
     let covering = cands.iter().any(|c| c.covers);
-    let group = |c: &&Candidate| c.covers == covering;
-    let top = cands
-        .iter()
-        .filter(group)
-        .map(|c| c.z)
-        .fold(f64::MIN, f64::max);
-    cands
-        .iter()
-        .filter(group)
-        .filter(|c| c.z >= top - 0.5 * (z_mid - top))
-        .min_by(|a, b| a.d.total_cmp(&b.d))
-        .copied()
+    let group: Vec<&Candidate> = cands.iter().filter(|c| c.covers == covering).collect();
+    let mut best = **group.iter().min_by(|a, b| a.d.total_cmp(&b.d))?;
+    loop {
+        let next = group
+            .iter()
+            .filter(|c| {
+                let rise = c.z - best.z;
+                rise >= min_layer
+                    && rise >= 0.5 * (c.at[0] - best.at[0]).hypot(c.at[1] - best.at[1])
+            })
+            .min_by(|a, b| a.d.total_cmp(&b.d));
+        match next {
+            Some(c) => best = **c,
+            None => return Some(best),
+        }
+    }
 }
 
 /// Overlap of a bead of width `wa` with one of width `wb` whose centre is
@@ -267,7 +275,7 @@ pub fn check(text: &str, cfg: &CheckConfig) -> Report {
                 if b.s_end > sp - recent_nozzle {
                     return;
                 }
-                let (_, d, z) = b.closest(p);
+                let (_, d, z, _) = b.closest(p);
                 if z > zlo && d < cfg.nozzle_radius + b.width / 2.0 {
                     worst = worst.max(z - p[2]);
                 }
@@ -321,13 +329,15 @@ pub fn check(text: &str, cfg: &CheckConfig) -> Report {
                     if b.step || b.s_end >= s_start - 1e-9 {
                         return;
                     }
-                    let (t, d, z) = b.closest(mid);
-                    // A bead laid earlier in the same run lies behind the
-                    // nozzle, not below it: its nearest point is its end and
-                    // the path from there to here is about as long as the
-                    // distance. A bead below reached through a turn or a
-                    // step-up is not like that.
-                    if t >= 1.0 - 1e-9 && s_start - b.s_end <= 1.1 * d + 1e-6 {
+                    let (t, d, z, at) = b.closest(mid);
+                    // A bead laid earlier in this run lies behind the
+                    // nozzle, not below it: its end is its point nearest to
+                    // the new bead, the new bead moves away from that end,
+                    // and little path lies between them. (A bead below that
+                    // the path returns over, after a turn or a step-up, is
+                    // approached, not left.)
+                    let from_end = (m.from[0] - at[0]).hypot(m.from[1] - at[1]);
+                    if t >= 1.0 - 1e-9 && d > from_end && s_start - b.s_end <= 1.5 * d + 1e-6 {
                         return;
                     }
                     if z <= mid[2] - cfg.min_layer_mm {
@@ -337,6 +347,7 @@ pub fn check(text: &str, cfg: &CheckConfig) -> Report {
                         if d <= cfg.width_max.max(b.width / 2.0) {
                             cands.push(Candidate {
                                 z,
+                                at,
                                 d,
                                 width: b.width,
                                 covers: d <= b.width / 2.0,
@@ -353,7 +364,7 @@ pub fn check(text: &str, cfg: &CheckConfig) -> Report {
             if double {
                 r.support.double_deposition.add(m.line, 0.0);
             }
-            let support = pick_support(&cands, mid[2]);
+            let support = pick_support(&cands, cfg.min_layer_mm);
             let (dz, overlap, offset) = match support {
                 Some(c) => {
                     let dz = mid[2] - c.z;
