@@ -64,7 +64,7 @@ impl BeadGrid {
         let ztop = b.from[2].max(b.to[2]);
         let (z0, z1) = (cell(b.from[2].min(b.to[2]), CELL_Z), cell(ztop, CELL_Z));
         // Very long moves (other slicers) are bounded to keep memory sane.
-        if (x1 - x0) as i64 * (y1 - y0) as i64 * (z1 - z0 + 1) as i64 > 100_000 {
+        if (x1 - x0 + 1) as i64 * (y1 - y0 + 1) as i64 * (z1 - z0 + 1) as i64 > 100_000 {
             return;
         }
         for x in x0..=x1 {
@@ -115,14 +115,19 @@ struct Candidate {
 
 /// The bead a new bead rests on. Under a bead, earlier passes form a stack
 /// of ridges; it rests on the top of the stack nearest its centreline.
-/// Start from the candidate nearest the middle (among those whose
-/// footprint covers it, else among all); while another candidate is higher
+/// Start from the candidate nearest the middle among those whose footprint
+/// covers it (if none does: the bed when `near_bed`, else the nearest
+/// candidate, an overhang); while another candidate is higher
 /// by at least `min_layer` and steeper than 1:2 from it, move up to it. A
 /// step up a stack is steep (leaning walls keep rise ≥ 0.65 × run within
 /// the overhang limit); a step along one tilted ridge is gentle, so the
 /// walk climbs stacks without sliding along ridges.
-fn pick_support(cands: &[Candidate], min_layer: f64) -> Option<Candidate> {
+fn pick_support(cands: &[Candidate], min_layer: f64, near_bed: bool) -> Option<Candidate> {
     let covering = cands.iter().any(|c| c.covers);
+    if !covering && near_bed {
+        // Nothing under its middle but the bed, which is within reach.
+        return None;
+    }
     let group: Vec<&Candidate> = cands.iter().filter(|c| c.covers == covering).collect();
     let mut best = **group.iter().min_by(|a, b| a.d.total_cmp(&b.d))?;
     loop {
@@ -255,7 +260,7 @@ pub fn check(text: &str, cfg: &CheckConfig) -> Report {
             continue;
         }
         // Collisions at points along the move (every r/2 mm, end included).
-        let samples = ((len / (cfg.nozzle_radius / 2.0).max(0.5)).ceil() as usize).clamp(1, 10_000);
+        let samples = ((len / (cfg.nozzle_radius / 2.0).max(0.5)).ceil() as usize).clamp(1, 200);
         for k in 1..=samples {
             let t = k as f64 / samples as f64;
             let p = [
@@ -364,7 +369,7 @@ pub fn check(text: &str, cfg: &CheckConfig) -> Report {
             if double {
                 r.support.double_deposition.add(m.line, 0.0);
             }
-            let support = pick_support(&cands, cfg.min_layer_mm);
+            let support = pick_support(&cands, cfg.min_layer_mm, mid[2] <= cfg.first_layer_max_mm);
             let (dz, overlap, offset) = match support {
                 Some(c) => {
                     let dz = mid[2] - c.z;
@@ -440,6 +445,7 @@ pub fn check(text: &str, cfg: &CheckConfig) -> Report {
             r.layers = (hi[2] / median).round() as usize;
         }
     }
+    diags.sort_by_key(|d| d.line);
     diags.truncate(50);
     r.diagnostics = diags;
     verdict(&mut r, cfg);
