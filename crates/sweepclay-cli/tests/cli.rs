@@ -1,0 +1,262 @@
+//! Integration tests: the real `sweepclay` binary in a fresh temporary
+//! directory, on every bundled example and on bad input.
+
+use assert_cmd::Command;
+use predicates::prelude::*;
+use std::path::Path;
+
+fn sweepclay(dir: &Path) -> Command {
+    let mut c = Command::cargo_bin("sweepclay").unwrap();
+    c.current_dir(dir);
+    c
+}
+
+fn examples(dir: &Path) {
+    sweepclay(dir)
+        .args(["examples", "ex"])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("t6.json"));
+}
+
+#[test]
+fn every_example_slices_to_gcode_that_checks() {
+    let tmp = tempfile::tempdir().unwrap();
+    examples(tmp.path());
+    for t in ["t1", "t2", "t3", "t4", "t5", "t6"] {
+        let out = format!("{t}.gcode");
+        sweepclay(tmp.path())
+            .args(["slice", &format!("ex/{t}.json"), "-o", &out])
+            .assert()
+            .success()
+            .stdout(predicate::str::contains("check              printable"))
+            .stdout(predicate::str::contains("sample points"));
+        let gcode = std::fs::read_to_string(tmp.path().join(&out)).unwrap();
+        assert!(
+            gcode.contains("; sample_points:") && gcode.contains("M82"),
+            "{t}: header"
+        );
+        let g1_after_first = gcode.lines().skip_while(|l| !l.starts_with("G0")).skip(1);
+        assert!(
+            g1_after_first
+                .filter(|l| !l.starts_with(';'))
+                .take_while(|l| l.starts_with("G1"))
+                .count()
+                > 1000
+        );
+        sweepclay(tmp.path())
+            .args(["check", &out, "--printer", "cerambot-plus"])
+            .assert()
+            .success()
+            .stdout(predicate::str::starts_with("PRINTABLE"));
+    }
+}
+
+#[test]
+fn two_stage_examples_say_so() {
+    let tmp = tempfile::tempdir().unwrap();
+    sweepclay(tmp.path())
+        .args(["slice", "t3", "-o", "t3.gcode"])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("(2 stages,"));
+}
+
+#[test]
+fn set_and_printer_override_and_json_summary() {
+    let tmp = tempfile::tempdir().unwrap();
+    let out = sweepclay(tmp.path())
+        .args([
+            "slice",
+            "t4",
+            "-o",
+            "a.gcode",
+            "--set",
+            "layer_height=1.5",
+            "--set",
+            "params.feedrate=1500",
+            "--printer",
+            "cerambot-mini",
+            "--json",
+        ])
+        .assert()
+        .success()
+        .get_output()
+        .stdout
+        .clone();
+    let v: serde_json::Value = serde_json::from_slice(&out).unwrap();
+    assert_eq!(v["written"], true);
+    assert_eq!(v["check"]["printable"], true);
+    let g = std::fs::read_to_string(tmp.path().join("a.gcode")).unwrap();
+    assert!(
+        g.contains("layer_height=1.5")
+            && g.contains("feedrate=1500")
+            && g.contains("; printer: cerambot-mini")
+    );
+    assert!(g.contains("G1 F1500"));
+}
+
+#[test]
+fn relative_extrusion_printer_file() {
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::write(
+        tmp.path().join("p.json"),
+        r#"{"name":"rel","relative_e":true,"e_per_mm3":0.5}"#,
+    )
+    .unwrap();
+    sweepclay(tmp.path())
+        .args(["slice", "t5", "-o", "r.gcode", "--printer", "p.json"])
+        .assert()
+        .success();
+    let g = std::fs::read_to_string(tmp.path().join("r.gcode")).unwrap();
+    assert!(g.contains("M83"));
+    sweepclay(tmp.path())
+        .args(["check", "r.gcode", "--printer", "p.json"])
+        .assert()
+        .success();
+}
+
+#[test]
+fn bad_design_names_the_key_and_writes_nothing() {
+    let tmp = tempfile::tempdir().unwrap();
+    let cases = [
+        (
+            r#"{"sweepclay":1,"profile_start":{"control_points":[[0,0],[0,20]]},"profile_end":{"control_points":[[0,0],[0,20]]},"trajectory":{"points":[[-40,20],[40,20]]},"params":{"layer_hieght":1}}"#,
+            "layer_hieght",
+        ),
+        (
+            r#"{"sweepclay":1,"profile_start":{"control_points":[[0,0],[0,20]]},"profile_end":{"control_points":[[0,0],[0,20]]},"trajectory":{"points":[[-40,20],[40,20]]},"params":{"spacing":-1}}"#,
+            "params.spacing",
+        ),
+        (
+            r#"{"sweepclay":1,"profile_start":{"control_points":[[0,5],[0,20]]},"profile_end":{"control_points":[[0,0],[0,20]]},"trajectory":{"points":[[-40,20],[40,20]]}}"#,
+            "profile_start.control_points[0]",
+        ),
+        (
+            r#"{"sweepclay":1,"profile_start":{"control_points":[[0,0],[0,20]]},"profile_end":{"control_points":[[0,0],[0,20]]},"trajectory":{"points":[[-40,20],[40,20],[40,60],[0,60],[0,0]]}}"#,
+            "crosses itself",
+        ),
+        (
+            r#"{"sweepclay":1,"profile_start":{"control_points":[[0,0],[0,20]]},"profile_end":{"control_points":[[0,0],[0,20]]},"trajectory":{"points":[[-90,20],[90,20]]},"printer":"cerambot-mini"}"#,
+            "does not fit printer `cerambot-mini`",
+        ),
+        ("{\n  \"sweepclay\": 1,\n  oops\n}", "line 3"),
+    ];
+    for (i, (text, want)) in cases.iter().enumerate() {
+        let f = format!("bad{i}.json");
+        std::fs::write(tmp.path().join(&f), text).unwrap();
+        sweepclay(tmp.path())
+            .args(["slice", &f, "-o", "bad.gcode"])
+            .assert()
+            .code(2)
+            .stderr(predicate::str::contains(*want));
+        assert!(!tmp.path().join("bad.gcode").exists());
+    }
+    sweepclay(tmp.path())
+        .args(["slice", "missing.json"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("missing.json"));
+    sweepclay(tmp.path())
+        .args(["slice", "t1", "--set", "nope=1"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("params.nope"));
+    sweepclay(tmp.path())
+        .args(["slice", "t1", "--set", "layer_height"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("KEY=VALUE"));
+}
+
+#[test]
+fn failing_check_writes_nothing_unless_forced() {
+    let tmp = tempfile::tempdir().unwrap();
+    // An extruder body of radius 40 mm reaches across t5's wave to clay
+    // printed on the other side: the pipeline slices, the check says no.
+    std::fs::write(
+        tmp.path().join("fat.json"),
+        r#"{"name":"fat","nozzle_radius":40}"#,
+    )
+    .unwrap();
+    sweepclay(tmp.path())
+        .args(["slice", "t5", "-o", "x.gcode", "--printer", "fat.json"])
+        .assert()
+        .code(1)
+        .stdout(predicate::str::contains("NOT printable"))
+        .stderr(predicate::str::contains("nothing written"));
+    assert!(!tmp.path().join("x.gcode").exists());
+    sweepclay(tmp.path())
+        .args([
+            "slice",
+            "t5",
+            "-o",
+            "x.gcode",
+            "--printer",
+            "fat.json",
+            "--force",
+        ])
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("FAILS"));
+    assert!(tmp.path().join("x.gcode").exists());
+}
+
+#[test]
+fn check_reports_and_exit_codes() {
+    let tmp = tempfile::tempdir().unwrap();
+    std::fs::write(
+        tmp.path().join("bad.gcode"),
+        "G21\nG90\nM82\nG0 X50 Y50 Z1.2\nG1 X60 E1\nG1 E0.5\nG1 X70 E2\n",
+    )
+    .unwrap();
+    sweepclay(tmp.path())
+        .args(["check", "bad.gcode"])
+        .assert()
+        .code(1)
+        .stdout(predicate::str::starts_with("NOT PRINTABLE"))
+        .stdout(predicate::str::contains("retraction"));
+    let out = sweepclay(tmp.path())
+        .args(["check", "bad.gcode", "--json"])
+        .assert()
+        .code(1)
+        .get_output()
+        .stdout
+        .clone();
+    let v: serde_json::Value = serde_json::from_slice(&out).unwrap();
+    assert_eq!(v["retractions"]["count"], 1);
+    assert_eq!(v["retractions"]["first_line"], 6);
+    sweepclay(tmp.path())
+        .args(["check", "nothing.gcode"])
+        .assert()
+        .code(2);
+    sweepclay(tmp.path())
+        .args(["check", "bad.gcode", "--printer", "nope"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("neither a preset"));
+}
+
+#[test]
+fn help_documents_every_command() {
+    let tmp = tempfile::tempdir().unwrap();
+    sweepclay(tmp.path())
+        .arg("--help")
+        .assert()
+        .success()
+        .stdout(
+            predicate::str::contains("slice")
+                .and(predicate::str::contains("check"))
+                .and(predicate::str::contains("examples")),
+        );
+    sweepclay(tmp.path())
+        .args(["slice", "--help"])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("--force").and(predicate::str::contains("layer_height")));
+    sweepclay(tmp.path())
+        .args(["check", "--help"])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("--nozzle-height"));
+}
