@@ -319,52 +319,55 @@ pub fn check(text: &str, cfg: &CheckConfig) -> Report {
             stamp.resize(beads.len(), u32::MAX);
             cands.clear();
             let mut double = false;
-            grid.for_each(
-                mid,
-                cfg.width_max,
-                mid[2] - cfg.max_gap_mm,
-                mid[2] + cfg.min_layer_mm,
-                |j| {
-                    let ju = j as usize;
-                    if stamp[ju] == id {
+            let covered = std::cell::Cell::new(false);
+            let (zlo, zhi) = (mid[2] - cfg.max_gap_mm, mid[2] + cfg.min_layer_mm);
+            let mut visit = |j: u32| {
+                let ju = j as usize;
+                if stamp[ju] == id {
+                    return;
+                }
+                stamp[ju] = id;
+                let b = &beads[ju];
+                if b.step || b.s_end >= s_start - 1e-9 {
+                    return;
+                }
+                let (t, d, z, at) = b.closest(mid);
+                // A bead laid earlier in this run lies behind the
+                // nozzle, not below it: its end is its point nearest to
+                // the new bead, the new bead moves away from that end,
+                // and little path lies between them. (A bead below that
+                // the path returns over, after a turn or a step-up, is
+                // approached, not left.)
+                let from_end = (m.from[0] - at[0]).hypot(m.from[1] - at[1]);
+                if t >= 1.0 - 1e-9 && d > from_end && s_start - b.s_end <= 1.5 * d + 1e-6 {
+                    return;
+                }
+                if z <= mid[2] - cfg.min_layer_mm {
+                    if mid[2] - z > cfg.max_gap_mm {
                         return;
                     }
-                    stamp[ju] = id;
-                    let b = &beads[ju];
-                    if b.step || b.s_end >= s_start - 1e-9 {
-                        return;
+                    if d <= cfg.width_max.max(b.width / 2.0) {
+                        cands.push(Candidate {
+                            z,
+                            at,
+                            d,
+                            width: b.width,
+                            covers: d <= b.width / 2.0,
+                        });
+                        covered.set(covered.get() || d <= b.width / 2.0);
                     }
-                    let (t, d, z, at) = b.closest(mid);
-                    // A bead laid earlier in this run lies behind the
-                    // nozzle, not below it: its end is its point nearest to
-                    // the new bead, the new bead moves away from that end,
-                    // and little path lies between them. (A bead below that
-                    // the path returns over, after a turn or a step-up, is
-                    // approached, not left.)
-                    let from_end = (m.from[0] - at[0]).hypot(m.from[1] - at[1]);
-                    if t >= 1.0 - 1e-9 && d > from_end && s_start - b.s_end <= 1.5 * d + 1e-6 {
-                        return;
-                    }
-                    if z <= mid[2] - cfg.min_layer_mm {
-                        if mid[2] - z > cfg.max_gap_mm {
-                            return;
-                        }
-                        if d <= cfg.width_max.max(b.width / 2.0) {
-                            cands.push(Candidate {
-                                z,
-                                at,
-                                d,
-                                width: b.width,
-                                covers: d <= b.width / 2.0,
-                            });
-                        }
-                    } else if (z - mid[2]).abs() < cfg.min_layer_mm
-                        && d < 0.5 * b.width.min(cfg.width_min)
-                    {
-                        double = true;
-                    }
-                },
-            );
+                } else if (z - mid[2]).abs() < cfg.min_layer_mm
+                    && d < 0.5 * b.width.min(cfg.width_min)
+                {
+                    double = true;
+                }
+            };
+            // Beads covering the middle are within w/2; look wider only
+            // when none is (to measure an overhang).
+            grid.for_each(mid, cfg.width_max / 2.0 + 0.5, zlo, zhi, &mut visit);
+            if !covered.get() {
+                grid.for_each(mid, cfg.width_max, zlo, zhi, &mut visit);
+            }
             r.support.beads += 1;
             if double {
                 r.support.double_deposition.add(m.line, 0.0);
