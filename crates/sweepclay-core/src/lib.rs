@@ -17,7 +17,7 @@
 //! | 4 | [`extrude::plan_extrusion`] | [`Toolpath`] → [`Extrusion`] | §5.3, Alg. 3 |
 //! | 5 | [`gcode::emit`] | [`Sliced`] → G-code text | §5.1, Alg. 1 |
 //!
-//! [`slice`] runs them all and computes the statistics of the paper's
+//! [`slice()`] runs them all and computes the statistics of the paper's
 //! Table 1. The layering that decides single or two stages is in
 //! [`layers`]; `docs/ALGORITHMS.md` gives the formulation and its proofs.
 //!
