@@ -4,9 +4,10 @@
 //! input must give an error, never a panic.
 
 use proptest::prelude::*;
-use sweepclay_check::{check, CheckConfig};
+mod common;
+
 use sweepclay_core::toolpath::PointKind;
-use sweepclay_core::{gcode, slice, Design};
+use sweepclay_core::{slice, Design};
 
 #[derive(Debug, Clone)]
 struct Spec {
@@ -125,7 +126,6 @@ proptest! {
             Err(e) => return Err(TestCaseError::fail(format!("{e}"))),
         };
         let p = &sliced.corrected.surface.params;
-        let pr = &sliced.corrected.surface.printer;
         let t = &sliced.toolpath;
         let ex = &sliced.extrusion;
 
@@ -171,20 +171,7 @@ proptest! {
         }
 
         // The independent checker agrees the G-code prints in clay.
-        let text = gcode::to_string(&sliced);
-        let cfg = CheckConfig {
-            build_volume: pr.build_volume,
-            e_per_mm3: pr.e_per_mm3,
-            nozzle_radius: pr.nozzle_radius,
-            nozzle_height: p.nozzle_height,
-            width_min: p.width_min,
-            width_max: p.width_max,
-            overlap_target: p.overlap,
-            max_overhang_deg: p.max_overhang_deg,
-            first_layer_max_mm: p.max_layer_height + 0.05,
-            ..CheckConfig::default()
-        };
-        let r = check(&text, &cfg);
+        let r = common::check_sliced(&sliced);
         prop_assert!(r.printable, "{}\ndesign:\n{}", r.render(), d.to_json());
         prop_assert_eq!(r.extrusion_runs, 1);
         prop_assert_eq!(r.support.under_min.count, 0);

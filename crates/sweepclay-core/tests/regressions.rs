@@ -4,27 +4,14 @@
 //! wider bead; r3: first layer thicker than 3 mm; r4: steep climbing turn;
 //! r5: lean-out step at the trajectory's start; r6: steep tilted pass.
 
-use sweepclay_check::{check, CheckConfig};
-use sweepclay_core::{gcode, slice, Design};
+mod common;
+
+use sweepclay_core::{slice, Design};
 
 fn run(name: &str, text: &str) {
     let d = Design::from_json(text).unwrap_or_else(|e| panic!("{name}: {e}"));
     let s = slice(&d).unwrap_or_else(|e| panic!("{name}: {e}"));
-    let p = &s.corrected.surface.params;
-    let pr = &s.corrected.surface.printer;
-    let cfg = CheckConfig {
-        build_volume: pr.build_volume,
-        e_per_mm3: pr.e_per_mm3,
-        nozzle_radius: pr.nozzle_radius,
-        nozzle_height: p.nozzle_height,
-        width_min: p.width_min,
-        width_max: p.width_max,
-        overlap_target: p.overlap,
-        max_overhang_deg: p.max_overhang_deg,
-        first_layer_max_mm: p.max_layer_height + 0.05,
-        ..CheckConfig::default()
-    };
-    let r = check(&gcode::to_string(&s), &cfg);
+    let r = common::check_sliced(&s);
     assert!(r.printable, "{name}:\n{}", r.render());
 }
 

@@ -1,0 +1,24 @@
+//! Helpers shared by the integration tests of the pipeline.
+
+use sweepclay_check::{check, CheckConfig, Report};
+use sweepclay_core::{gcode, Sliced};
+
+/// The checker configured from the design's printer and parameters, as
+/// `sweepclay slice` configures it.
+pub fn check_sliced(s: &Sliced) -> Report {
+    let p = &s.corrected.surface.params;
+    let pr = &s.corrected.surface.printer;
+    let cfg = CheckConfig {
+        build_volume: pr.build_volume,
+        e_per_mm3: pr.e_per_mm3,
+        nozzle_radius: pr.nozzle_radius,
+        nozzle_height: p.nozzle_height,
+        width_min: p.width_min,
+        width_max: p.width_max,
+        overlap_target: p.overlap,
+        max_overhang_deg: p.max_overhang_deg,
+        first_layer_max_mm: p.max_layer_height + 0.05,
+        ..CheckConfig::default()
+    };
+    check(&gcode::to_string(s), &cfg)
+}
