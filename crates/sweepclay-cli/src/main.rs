@@ -48,6 +48,9 @@ struct SliceArgs {
     /// Override a parameter, e.g. `--set layer_height=1.5` (repeatable). Keys: layer_height, max_layer_height, spacing, nozzle_height, width_min, width_max, overlap, max_overhang_deg, feedrate.
     #[arg(long = "set", value_name = "KEY=VALUE")]
     sets: Vec<String>,
+    /// Also write a picture of the toolpath (SVG).
+    #[arg(long, value_name = "FILE.svg")]
+    preview: Option<PathBuf>,
     /// Write the file even if the printability check fails.
     #[arg(long)]
     force: bool,
@@ -189,6 +192,9 @@ fn slice(a: SliceArgs) -> Result<i32> {
             .unwrap_or_else(|| "out".into());
         PathBuf::from(stem).with_extension("gcode")
     });
+    if let Some(p) = &a.preview {
+        write_atomic(p, sweepclay_core::preview::svg(&sliced).as_bytes())?;
+    }
     let st = &sliced.stats;
     if a.json {
         let v = serde_json::json!({
@@ -285,6 +291,13 @@ fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let mut tmp = tempfile::NamedTempFile::new_in(dir)
         .with_context(|| format!("creating a temporary file in {}", dir.display()))?;
     tmp.write_all(bytes)?;
+    // Temporary files are private (0600); the result is an ordinary file.
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        tmp.as_file()
+            .set_permissions(std::fs::Permissions::from_mode(0o644))?;
+    }
     tmp.as_file().sync_all()?;
     tmp.persist(path)
         .with_context(|| format!("writing {}", path.display()))?;

@@ -53,6 +53,30 @@ fn every_example_slices_to_gcode_that_checks() {
 }
 
 #[test]
+fn preview_picture_is_written() {
+    let tmp = tempfile::tempdir().unwrap();
+    sweepclay(tmp.path())
+        .args(["slice", "t2", "-o", "t2.gcode", "--preview", "t2.svg"])
+        .assert()
+        .success();
+    let svg = std::fs::read_to_string(tmp.path().join("t2.svg")).unwrap();
+    assert!(svg.starts_with("<svg") && svg.contains("t2 petal wall") && svg.contains("<polyline"));
+    #[cfg(unix)]
+    {
+        use std::os::unix::fs::PermissionsExt;
+        let mode = std::fs::metadata(tmp.path().join("t2.gcode"))
+            .unwrap()
+            .permissions()
+            .mode();
+        assert_eq!(
+            mode & 0o644,
+            0o644,
+            "G-code is readable by others: {mode:o}"
+        );
+    }
+}
+
+#[test]
 fn two_stage_examples_say_so() {
     let tmp = tempfile::tempdir().unwrap();
     sweepclay(tmp.path())

@@ -44,6 +44,7 @@ pub mod extrude;
 pub mod gcode;
 pub mod grid;
 pub mod layers;
+pub mod preview;
 pub mod printer;
 pub mod surface;
 pub mod toolpath;
