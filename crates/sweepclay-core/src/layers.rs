@@ -4,18 +4,20 @@
 //!
 //! Columns (transition curves) are ordered from the short end (index 0) to
 //! the tall end. With h the column's height, N' the number of "lower"
-//! passes, δ_T the tall column's layer height and H_s the allowed height
-//! spread within one pass, pass k would put column h at
+//! passes, T_k the tall column's k-th height (layers of δ_low up to pass N',
+//! then of δ_up ≈ `layer_height`) and H_s the allowed height spread within
+//! one pass, pass k would put column h at
 //!
 //! ```text
-//! g_k(h) = max(k · min(h / N', δ_T),  k · δ_T − H_s)
+//! g_k(h) = max(min(k · h / N', T_k),  T_k − H_s)
 //! ```
 //!
-//! Columns whose `h / N' ≤ δ_T` finish exactly on their top edge at pass N'
-//! (the paper's lower stage, layers tilted between the two ends); taller
-//! columns are printed in flat layers k·δ_T and the pass turns at the first
-//! column whose top edge it reaches (the paper's returning points). The
-//! second term lifts lagging columns so that no pass spans more than H_s.
+//! Columns with `h ≤ T_N'` finish exactly on their top edge at pass N' (the
+//! paper's lower stage, layers tilted between the two ends); taller columns
+//! follow the tall column in flat layers T_k and the pass turns at the first
+//! column whose top edge it reaches (the paper's upper stage and returning
+//! points). The second term lifts lagging columns so that no pass spans more
+//! than H_s.
 
 use crate::design::{Params, COLLISION_MARGIN_MM};
 use crate::error::{Error, Result};
@@ -28,8 +30,11 @@ pub struct LayerPlan {
     /// N': passes of the lower (tilted) stage; equals `passes` for a single
     /// stage path.
     pub lower_passes: u32,
-    /// δ_T: layer height of the tall column (mm).
-    pub tall_layer_mm: f64,
+    /// δ_low: layer height of the tall column in the lower stage (mm).
+    pub lower_layer_mm: f64,
+    /// δ_up: layer height of the upper stage (mm); equals `lower_layer_mm`
+    /// for a single stage path.
+    pub upper_layer_mm: f64,
     /// H_s: largest height difference allowed within one pass (mm).
     pub spread_mm: f64,
     /// Whether pass 1 runs from the short end toward the tall end.
@@ -60,11 +65,22 @@ impl LayerPlan {
         (k % 2 == 1) == self.first_toward_tall
     }
 
+    /// T_k: the tall column's height after pass `k`.
+    pub fn tall(&self, k: u32) -> f64 {
+        let n = self.lower_passes;
+        if k <= n {
+            k as f64 * self.lower_layer_mm
+        } else {
+            n as f64 * self.lower_layer_mm + (k - n) as f64 * self.upper_layer_mm
+        }
+    }
+
     /// g_k(h): the nominal height of pass `k` on a column of height `h`.
     pub fn nominal(&self, k: u32, h: f64) -> f64 {
-        let d = (h / self.lower_passes as f64).min(self.tall_layer_mm);
-        let k = k as f64;
-        (k * d).max(k * self.tall_layer_mm - self.spread_mm)
+        let t = self.tall(k);
+        (k as f64 * h / self.lower_passes as f64)
+            .min(t)
+            .max(t - self.spread_mm)
     }
 
     fn eps(h: f64) -> f64 {
@@ -136,26 +152,18 @@ impl LayerPlan {
         let window = (reach / ds).ceil() as usize;
         let mut last_err = None;
         for lower in (1..=n).rev() {
-            let cap = dmax.min((h_short + spread) / lower as f64);
-            let mut k = ((h_tall / cap) - 1e-9).ceil().max(1.0) as u32;
-            if k < lower {
-                k = lower;
-            }
-            let mut delta = h_tall / k as f64;
-            if delta < dmin - 1e-9 {
-                k = ((h_tall / dmin + 1e-9).floor() as u32).max(1);
-                delta = h_tall / k as f64;
-                if delta > dmax + 1e-9 || k < lower {
-                    last_err = Some(format!(
-                        "the {h_tall:.2} mm tall end cannot be split into layers between {dmin} and {dmax} mm; raise params.max_layer_height"
-                    ));
-                    continue;
-                }
-            }
+            let Some((k, low, up)) = Self::tall_layers(h_short, h_tall, lower, spread, dmin, dmax)
+            else {
+                last_err = Some(format!(
+                    "the {h_tall:.2} mm tall end cannot be split into layers between {dmin} and {dmax} mm; raise params.max_layer_height"
+                ));
+                continue;
+            };
             let plan = LayerPlan {
                 passes: k,
                 lower_passes: lower,
-                tall_layer_mm: delta,
+                lower_layer_mm: low,
+                upper_layer_mm: up,
                 spread_mm: spread,
                 first_toward_tall: k == lower || lower % 2 == 1,
                 min_top_bead_mm: 0.5 * dmin,
@@ -170,6 +178,42 @@ impl LayerPlan {
             }
         }
         Err(Error::Layering(last_err.unwrap_or_default()))
+    }
+
+    /// The tall column's layering for `lower` tilted passes: `(K, δ_low,
+    /// δ_up)`. The lower stage reaches at most h_short + H_s (so its tilted
+    /// passes span at most H_s) in layers of at most Δz_max; the rest is
+    /// split into upper layers as close to Δz_min as divides it.
+    fn tall_layers(
+        h_short: f64,
+        h_tall: f64,
+        lower: u32,
+        spread: f64,
+        dmin: f64,
+        dmax: f64,
+    ) -> Option<(u32, f64, f64)> {
+        let n = lower as f64;
+        let cap = dmax.min((h_short + spread) / n);
+        if h_tall <= n * cap + 1e-9 {
+            // Single stage: every column in N' tilted layers.
+            let d = h_tall / n;
+            return (d >= dmin - 1e-9 && d <= dmax + 1e-9).then_some((lower, d, d));
+        }
+        let mut low = cap;
+        let mut rest = h_tall - n * low;
+        if rest < dmin {
+            // Leave one full upper layer.
+            low = (h_tall - dmin) / n;
+            rest = dmin;
+        }
+        let mut m = ((rest / dmin) + 1e-9).floor().max(1.0);
+        let mut up = rest / m;
+        if up > dmax + 1e-9 {
+            m = (rest / dmax - 1e-9).ceil();
+            up = rest / m;
+        }
+        let ok = low >= dmin - 1e-9 && low <= dmax + 1e-9 && up >= dmin - 1e-9 && up <= dmax + 1e-9;
+        ok.then_some((lower + m as u32, low, up))
     }
 
     /// The first column where a pass would bring the nozzle lower than the
@@ -233,7 +277,12 @@ mod tests {
         let h = heights(20.0, 60.0, 2000);
         let plan = LayerPlan::choose(&h, 1.1, &p, 5.0).unwrap();
         assert!(plan.two_stage(), "{plan:?}");
-        assert!(plan.tall_layer_mm >= p.layer_height && plan.tall_layer_mm <= p.max_layer_height);
+        for d in [plan.lower_layer_mm, plan.upper_layer_mm] {
+            assert!(d >= p.layer_height && d <= p.max_layer_height, "{plan:?}");
+        }
+        // The upper stage is printed near the minimum layer height, as in the paper.
+        assert!(plan.upper_layer_mm < 1.5 * p.layer_height, "{plan:?}");
+        assert!((plan.tall(plan.passes) - 60.0).abs() < 1e-9);
         // Pass N' runs toward the tall end, so the lower stage can finish.
         assert!(plan.toward_tall(plan.lower_passes));
         // Steps per column stay within bounds; the short end finishes on top.
