@@ -6,11 +6,11 @@
 //! A rapid `G0` moves to the first point; after it only `G1` moves with
 //! increasing E until the printer's end code.
 
+use crate::extrude::Extrusion;
 use crate::Sliced;
 use std::io::{self, Write};
 
 /// Writes the G-code of a sliced design.
-#[allow(clippy::needless_range_loop)] // indexes points, widths, heights, volumes together
 pub fn emit<W: Write>(s: &Sliced, out: &mut W) -> io::Result<()> {
     let pr = &s.corrected.surface.printer;
     let pa = &s.corrected.surface.params;
@@ -61,13 +61,58 @@ pub fn emit<W: Write>(s: &Sliced, out: &mut W) -> io::Result<()> {
     if !pr.start_gcode.is_empty() && !pr.start_gcode.ends_with('\n') {
         writeln!(out)?;
     }
-    let pts = &s.toolpath.points;
-    let ex = &s.extrusion;
-    let p0 = pts[0].pos;
+    let points: Vec<[f64; 3]> = s.toolpath.points.iter().map(|p| p.pos).collect();
+    emit_moves(
+        out,
+        &points,
+        &s.extrusion,
+        &MoveFormat {
+            origin: o,
+            e_per_mm3: pr.e_per_mm3,
+            relative_e: pr.relative_e,
+            feed_mm_min: pa.feedrate,
+            travel_feed_mm_min: pr.travel_feedrate,
+        },
+    )?;
+    out.write_all(pr.end_gcode.as_bytes())?;
+    if !pr.end_gcode.is_empty() && !pr.end_gcode.ends_with('\n') {
+        writeln!(out)?;
+    }
+    Ok(())
+}
+
+/// How [`emit_moves`] writes moves.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct MoveFormat {
+    /// Added to x and y: where the design's centre lands on the bed (mm).
+    pub origin: [f64; 2],
+    /// E per mm³ of clay.
+    pub e_per_mm3: f64,
+    /// Relative E values instead of absolute.
+    pub relative_e: bool,
+    /// Printing feedrate (mm/min), set on the first `G1`.
+    pub feed_mm_min: f64,
+    /// Feedrate of the rapid move to the first point (mm/min).
+    pub travel_feed_mm_min: f64,
+}
+
+/// Writes the moves: a `G0` to the first point, then one `G1` per point
+/// with E for the bead volume, preceded by `;WIDTH:` / `;HEIGHT:` when the
+/// bead size (to 3 decimals) changes. Coordinates have 3 decimals, E 5;
+/// absolute E never repeats a value.
+#[allow(clippy::needless_range_loop)] // indexes points, widths, heights, volumes together
+pub fn emit_moves<W: Write>(
+    out: &mut W,
+    points: &[[f64; 3]],
+    ex: &Extrusion,
+    f: &MoveFormat,
+) -> io::Result<()> {
+    let o = f.origin;
+    let p0 = points[0];
     writeln!(
         out,
         "G0 F{} X{:.3} Y{:.3} Z{:.3}",
-        pr.travel_feedrate,
+        f.travel_feed_mm_min,
         p0[0] + o[0],
         p0[1] + o[1],
         p0[2]
@@ -75,7 +120,7 @@ pub fn emit<W: Write>(s: &Sliced, out: &mut W) -> io::Result<()> {
     let mut e_total = 0.0f64;
     let mut e_printed = 0.0f64;
     let (mut last_w, mut last_h) = (String::new(), String::new());
-    for i in 1..pts.len() {
+    for i in 1..points.len() {
         let w = format!("{:.3}", 0.5 * (ex.width[i] + ex.width[i - 1]));
         let h = format!("{:.3}", 0.5 * (ex.layer_height[i] + ex.layer_height[i - 1]));
         if w != last_w {
@@ -86,14 +131,14 @@ pub fn emit<W: Write>(s: &Sliced, out: &mut W) -> io::Result<()> {
             writeln!(out, ";HEIGHT:{h}")?;
             last_h = h;
         }
-        let de = ex.volume[i] * pr.e_per_mm3;
-        let p = pts[i].pos;
-        let f = if i == 1 {
-            format!("F{} ", pa.feedrate)
+        let de = ex.volume[i] * f.e_per_mm3;
+        let p = points[i];
+        let feed = if i == 1 {
+            format!("F{} ", f.feed_mm_min)
         } else {
             String::new()
         };
-        let e = if pr.relative_e {
+        let e = if f.relative_e {
             de.max(1e-5)
         } else {
             e_total += de;
@@ -102,15 +147,11 @@ pub fn emit<W: Write>(s: &Sliced, out: &mut W) -> io::Result<()> {
         };
         writeln!(
             out,
-            "G1 {f}X{:.3} Y{:.3} Z{:.3} E{e:.5}",
+            "G1 {feed}X{:.3} Y{:.3} Z{:.3} E{e:.5}",
             p[0] + o[0],
             p[1] + o[1],
             p[2]
         )?;
-    }
-    out.write_all(pr.end_gcode.as_bytes())?;
-    if !pr.end_gcode.is_empty() && !pr.end_gcode.ends_with('\n') {
-        writeln!(out)?;
     }
     Ok(())
 }
@@ -124,4 +165,83 @@ pub fn to_string(s: &Sliced) -> String {
 
 fn one_line(s: &str) -> String {
     s.replace(['\n', '\r'], " ")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ex(width: Vec<f64>, layer_height: Vec<f64>, volume: Vec<f64>) -> Extrusion {
+        let total_volume = volume.iter().sum();
+        Extrusion {
+            width,
+            layer_height,
+            volume,
+            total_volume,
+            path_length: 0.0,
+        }
+    }
+
+    const FMT: MoveFormat = MoveFormat {
+        origin: [100.0, 50.0],
+        e_per_mm3: 0.1,
+        relative_e: false,
+        feed_mm_min: 2000.0,
+        travel_feed_mm_min: 2400.0,
+    };
+
+    #[test]
+    fn moves_have_exact_formats() {
+        let pts = [
+            [0.0, 0.0, 1.25],
+            [1.0, 0.0, 1.25],
+            [2.0, 0.00049, 1.25],
+            [3.0, 0.0, 2.5],
+        ];
+        let e = ex(
+            vec![3.0, 3.0, 3.0, 4.0],
+            vec![1.25; 4],
+            vec![0.0, 3.75, 3.75, 5.0],
+        );
+        let mut out = Vec::new();
+        emit_moves(&mut out, &pts, &e, &FMT).unwrap();
+        assert_eq!(
+            String::from_utf8(out).unwrap(),
+            "G0 F2400 X100.000 Y50.000 Z1.250\n\
+             ;WIDTH:3.000\n\
+             ;HEIGHT:1.250\n\
+             G1 F2000 X101.000 Y50.000 Z1.250 E0.37500\n\
+             G1 X102.000 Y50.000 Z1.250 E0.75000\n\
+             ;WIDTH:3.500\n\
+             G1 X103.000 Y50.000 Z2.500 E1.25000\n"
+        );
+    }
+
+    #[test]
+    fn relative_e_and_tiny_volumes_still_extrude() {
+        let pts = [[0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [1.0, 1e-6, 1.0]];
+        let e = ex(vec![3.0; 3], vec![1.0; 3], vec![0.0, 3.0, 1e-9]);
+        let mut out = Vec::new();
+        emit_moves(
+            &mut out,
+            &pts,
+            &e,
+            &MoveFormat {
+                relative_e: true,
+                ..FMT
+            },
+        )
+        .unwrap();
+        let text = String::from_utf8(out).unwrap();
+        assert!(
+            text.ends_with("E0.30000\nG1 X101.000 Y50.000 Z1.000 E0.00001\n"),
+            "{text}"
+        );
+        // Absolute E never repeats a value, so every move extrudes.
+        let mut out = Vec::new();
+        emit_moves(&mut out, &pts, &e, &FMT).unwrap();
+        assert!(String::from_utf8(out)
+            .unwrap()
+            .ends_with("E0.30000\nG1 X101.000 Y50.000 Z1.000 E0.30001\n"));
+    }
 }
