@@ -179,7 +179,7 @@ fn slice(a: SliceArgs) -> Result<i32> {
         design.params.set(k, v)?;
     }
     let sliced = sweepclay_core::slice(&design).with_context(|| source.clone())?;
-    let text = gcode::to_string(&sliced);
+    let (text, point_lines) = gcode::to_string_with_lines(&sliced);
     let printer = &sliced.corrected.surface.printer;
     let report = check(
         &text,
@@ -253,6 +253,49 @@ fn slice(a: SliceArgs) -> Result<i32> {
     }
     write_atomic(&out, text.as_bytes())?;
     Ok(if report.printable { 0 } else { 1 })
+}
+
+/// The first line of each kind of failure in a report.
+fn failure_lines(r: &sweepclay_check::Report) -> Vec<usize> {
+    let sp = &r.support;
+    let mut v: Vec<usize> = [
+        &r.travel_moves,
+        &r.retractions,
+        &r.pauses,
+        &r.extrusion_without_motion,
+        &r.out_of_bounds,
+        &r.nozzle_collisions,
+        &r.carriage_collisions,
+        &sp.unsupported,
+        &sp.double_deposition,
+        &sp.under_min,
+        &sp.overhang,
+    ]
+    .iter()
+    .filter_map(|c| c.first_line)
+    .collect();
+    v.sort_unstable();
+    v.dedup();
+    v
+}
+
+/// Where in the design a G-code line of our own output is.
+fn locate(s: &sweepclay_core::Sliced, lines: &[usize], line: usize) -> Option<String> {
+    let i = lines.partition_point(|&l| l < line);
+    if lines.get(i) != Some(&line) {
+        return None;
+    }
+    let p = &s.toolpath.points[i];
+    let col = &s.corrected.surface.columns[p.column as usize];
+    let top = if p.kind == sweepclay_core::toolpath::PointKind::Top {
+        ", top-edge bead"
+    } else {
+        ""
+    };
+    Some(format!(
+        "line {line}: pass {}, transition curve {} (u = {:.3}), z = {:.2} mm{top}",
+        p.pass, p.column, col.u, p.pos[2]
+    ))
 }
 
 fn check_cmd(a: CheckArgs) -> Result<i32> {

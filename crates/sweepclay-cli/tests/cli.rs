@@ -208,6 +208,10 @@ fn failing_check_writes_nothing_unless_forced() {
         .assert()
         .code(1)
         .stdout(predicate::str::contains("NOT printable"))
+        .stdout(
+            predicate::str::is_match(r"where +line \d+: pass \d+, transition curve \d+ \(u = ")
+                .unwrap(),
+        )
         .stderr(predicate::str::contains("nothing written"));
     assert!(!tmp.path().join("x.gcode").exists());
     sweepclay(tmp.path())

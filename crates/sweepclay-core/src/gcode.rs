@@ -10,8 +10,32 @@ use crate::extrude::Extrusion;
 use crate::Sliced;
 use std::io::{self, Write};
 
-/// Writes the G-code of a sliced design.
-pub fn emit<W: Write>(s: &Sliced, out: &mut W) -> io::Result<()> {
+/// Counts the lines written through it.
+struct Lines<'a, W> {
+    inner: &'a mut W,
+    count: usize,
+}
+
+impl<W: Write> Write for Lines<'_, W> {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        let n = self.inner.write(buf)?;
+        self.count += buf[..n].iter().filter(|&&b| b == b'\n').count();
+        Ok(n)
+    }
+    fn flush(&mut self) -> io::Result<()> {
+        self.inner.flush()
+    }
+}
+
+/// Writes the G-code of a sliced design. Returns, for each toolpath point,
+/// the 1-based line of the move that ends at it (the `G0` for the first),
+/// so a line of the file maps back to a point of the design.
+pub fn emit<W: Write>(s: &Sliced, out: &mut W) -> io::Result<Vec<usize>> {
+    let mut out = Lines {
+        inner: out,
+        count: 0,
+    };
+    let out = &mut out;
     let pr = &s.corrected.surface.printer;
     let pa = &s.corrected.surface.params;
     let st = &s.stats;
@@ -62,7 +86,8 @@ pub fn emit<W: Write>(s: &Sliced, out: &mut W) -> io::Result<()> {
         writeln!(out)?;
     }
     let points: Vec<[f64; 3]> = s.toolpath.points.iter().map(|p| p.pos).collect();
-    emit_moves(
+    let before = out.count;
+    let lines = emit_moves(
         out,
         &points,
         &s.extrusion,
@@ -78,7 +103,7 @@ pub fn emit<W: Write>(s: &Sliced, out: &mut W) -> io::Result<()> {
     if !pr.end_gcode.is_empty() && !pr.end_gcode.ends_with('\n') {
         writeln!(out)?;
     }
-    Ok(())
+    Ok(lines.into_iter().map(|l| l + before).collect())
 }
 
 /// How [`emit_moves`] writes moves.
@@ -106,7 +131,7 @@ pub fn emit_moves<W: Write>(
     points: &[[f64; 3]],
     ex: &Extrusion,
     f: &MoveFormat,
-) -> io::Result<()> {
+) -> io::Result<Vec<usize>> {
     let o = f.origin;
     let p0 = points[0];
     writeln!(
@@ -117,6 +142,9 @@ pub fn emit_moves<W: Write>(
         p0[1] + o[1],
         p0[2]
     )?;
+    let mut line = 1;
+    let mut lines = Vec::with_capacity(points.len());
+    lines.push(line);
     let mut e_total = 0.0f64;
     let mut e_printed = 0.0f64;
     let (mut last_w, mut last_h) = (String::new(), String::new());
@@ -126,10 +154,12 @@ pub fn emit_moves<W: Write>(
         if w != last_w {
             writeln!(out, ";WIDTH:{w}")?;
             last_w = w;
+            line += 1;
         }
         if h != last_h {
             writeln!(out, ";HEIGHT:{h}")?;
             last_h = h;
+            line += 1;
         }
         let de = ex.volume[i] * f.e_per_mm3;
         let p = points[i];
@@ -152,15 +182,25 @@ pub fn emit_moves<W: Write>(
             p[1] + o[1],
             p[2]
         )?;
+        line += 1;
+        lines.push(line);
     }
-    Ok(())
+    Ok(lines)
 }
 
 /// [`emit`] into a string.
 pub fn to_string(s: &Sliced) -> String {
+    to_string_with_lines(s).0
+}
+
+/// [`emit`] into a string, with the line of each toolpath point.
+pub fn to_string_with_lines(s: &Sliced) -> (String, Vec<usize>) {
     let mut v = Vec::with_capacity(s.toolpath.points.len() * 48 + 2048);
-    emit(s, &mut v).expect("writing to memory cannot fail");
-    String::from_utf8(v).expect("G-code is ASCII or the design name's UTF-8")
+    let lines = emit(s, &mut v).expect("writing to memory cannot fail");
+    (
+        String::from_utf8(v).expect("G-code is ASCII or the design name's UTF-8"),
+        lines,
+    )
 }
 
 fn one_line(s: &str) -> String {
@@ -204,7 +244,8 @@ mod tests {
             vec![0.0, 3.75, 3.75, 5.0],
         );
         let mut out = Vec::new();
-        emit_moves(&mut out, &pts, &e, &FMT).unwrap();
+        let lines = emit_moves(&mut out, &pts, &e, &FMT).unwrap();
+        assert_eq!(lines, vec![1, 4, 5, 7]);
         assert_eq!(
             String::from_utf8(out).unwrap(),
             "G0 F2400 X100.000 Y50.000 Z1.250\n\
@@ -215,6 +256,26 @@ mod tests {
              ;WIDTH:3.500\n\
              G1 X103.000 Y50.000 Z2.500 E1.25000\n"
         );
+    }
+
+    #[test]
+    fn lines_map_back_to_points() {
+        let d = crate::Design::from_json(crate::examples::example("t2").unwrap()).unwrap();
+        let s = crate::slice(&d).unwrap();
+        let (text, lines) = to_string_with_lines(&s);
+        let all: Vec<&str> = text.lines().collect();
+        assert_eq!(lines.len(), s.toolpath.points.len());
+        for (i, &l) in lines.iter().enumerate().step_by(97) {
+            let p = s.toolpath.points[i].pos;
+            let o = s.corrected.surface.printer.origin;
+            let want = format!("X{:.3} Y{:.3} Z{:.3}", p[0] + o[0], p[1] + o[1], p[2]);
+            assert!(
+                all[l - 1].contains(&want),
+                "line {l}: `{}` is not point {i} ({want})",
+                all[l - 1]
+            );
+        }
+        assert!(all[lines[0] - 1].starts_with("G0"));
     }
 
     #[test]
