@@ -243,6 +243,11 @@ fn slice(a: SliceArgs) -> Result<i32> {
                 format!("NOT printable: {}", report.failures.join("; "))
             }
         );
+        for line in failure_lines(&report).into_iter().take(5) {
+            if let Some(at) = locate(&sliced, &point_lines, line) {
+                println!("  where              {at}");
+            }
+        }
     }
     if !report.printable && !a.force {
         eprintln!("error: the G-code fails the clay printability check; nothing written (use --force to write it anyway)");
