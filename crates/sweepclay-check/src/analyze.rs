@@ -331,7 +331,7 @@ pub fn check(text: &str, cfg: &CheckConfig) -> Report {
                 if b.step || b.s_end >= s_start - 1e-9 {
                     return;
                 }
-                let (t, d, z, at) = b.closest(mid);
+                let (_, d, z, at) = b.closest(mid);
                 // A bead laid earlier in this run lies behind the
                 // nozzle, not below it: its end is its point nearest to
                 // the new bead, the new bead moves away from that end,
@@ -339,7 +339,9 @@ pub fn check(text: &str, cfg: &CheckConfig) -> Report {
                 // the path returns over, after a turn or a step-up, is
                 // approached, not left.)
                 let from_end = (m.from[0] - at[0]).hypot(m.from[1] - at[1]);
-                if t >= 1.0 - 1e-9 && d > from_end && s_start - b.s_end <= 1.5 * d + 1e-6 {
+                if s_start - b.s_end <= 1.5 * d + 1e-6
+                    && (d > from_end || m.from[2] - z < cfg.min_layer_mm)
+                {
                     return;
                 }
                 if z <= mid[2] - cfg.min_layer_mm {
@@ -358,6 +360,9 @@ pub fn check(text: &str, cfg: &CheckConfig) -> Report {
                     }
                 } else if (z - mid[2]).abs() < cfg.min_layer_mm
                     && d < 0.5 * b.width.min(cfg.width_min)
+                    // Clay laid in the last 2 w_max of path is the run's own
+                    // fresh clay (a corner piles up, it is not laid twice).
+                    && s_start - b.s_end > 2.0 * cfg.width_max
                 {
                     double = true;
                 }

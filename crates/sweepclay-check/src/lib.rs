@@ -78,7 +78,8 @@ pub struct CheckConfig {
     pub first_layer_max_mm: f64,
     /// Clay deeper than this below a bead does not support it. Default 6.
     pub max_gap_mm: f64,
-    /// Clay this little above the nozzle tip is not a collision. Default 0.05.
+    /// Clay this little above the nozzle tip is not a collision: a graze
+    /// on a bead's rounded edge. Default 0.2.
     pub collision_tolerance_mm: f64,
 }
 
@@ -98,7 +99,7 @@ impl Default for CheckConfig {
             min_layer_mm: 0.3,
             first_layer_max_mm: 3.0,
             max_gap_mm: 6.0,
-            collision_tolerance_mm: 0.05,
+            collision_tolerance_mm: 0.2,
         }
     }
 }

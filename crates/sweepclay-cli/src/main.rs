@@ -48,6 +48,10 @@ struct SliceArgs {
     /// Override a parameter, e.g. `--set layer_height=1.5` (repeatable). Keys: layer_height, max_layer_height, spacing, nozzle_height, width_min, width_max, overlap, max_overhang_deg, feedrate.
     #[arg(long = "set", value_name = "KEY=VALUE")]
     sets: Vec<String>,
+    /// Refuse the G-code if a bead overlaps the bead below by less than
+    /// this fraction of its width (the checker's hard floor).
+    #[arg(long, default_value_t = 0.5)]
+    min_overlap: f64,
     /// Also write a picture of the toolpath (SVG).
     #[arg(long, value_name = "FILE.svg")]
     preview: Option<PathBuf>,
@@ -181,10 +185,11 @@ fn slice(a: SliceArgs) -> Result<i32> {
     let sliced = sweepclay_core::slice(&design).with_context(|| source.clone())?;
     let (text, point_lines) = gcode::to_string_with_lines(&sliced);
     let printer = &sliced.corrected.surface.printer;
-    let report = check(
-        &text,
-        &check_config(printer, &sliced.corrected.surface.params),
-    );
+    let cfg = CheckConfig {
+        overlap_min: a.min_overlap,
+        ..check_config(printer, &sliced.corrected.surface.params)
+    };
+    let report = check(&text, &cfg);
     let out = a.output.clone().unwrap_or_else(|| {
         let stem = Path::new(&a.design)
             .file_stem()

@@ -194,10 +194,10 @@ fn bad_design_names_the_key_and_writes_nothing() {
 }
 
 #[test]
-fn failing_check_writes_nothing_unless_forced() {
+fn a_wide_extruder_body_gets_flatter_layers_not_collisions() {
+    // A 40 mm body reaches across t5's wave: the layering prints flat
+    // layers (no tilted pass to scrape) and the check passes.
     let tmp = tempfile::tempdir().unwrap();
-    // An extruder body of radius 40 mm reaches across t5's wave to clay
-    // printed on the other side: the pipeline slices, the check says no.
     std::fs::write(
         tmp.path().join("fat.json"),
         r#"{"name":"fat","nozzle_radius":40}"#,
@@ -205,6 +205,17 @@ fn failing_check_writes_nothing_unless_forced() {
     .unwrap();
     sweepclay(tmp.path())
         .args(["slice", "t5", "-o", "x.gcode", "--printer", "fat.json"])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("check              printable"));
+}
+
+#[test]
+fn failing_check_writes_nothing_unless_forced() {
+    let tmp = tempfile::tempdir().unwrap();
+    // t5's smallest bead overlap is 85 %: demanding 95 % fails the check.
+    sweepclay(tmp.path())
+        .args(["slice", "t5", "-o", "x.gcode", "--min-overlap", "0.95"])
         .assert()
         .code(1)
         .stdout(predicate::str::contains("NOT printable"))
@@ -220,8 +231,8 @@ fn failing_check_writes_nothing_unless_forced() {
             "t5",
             "-o",
             "x.gcode",
-            "--printer",
-            "fat.json",
+            "--min-overlap",
+            "0.95",
             "--force",
         ])
         .assert()

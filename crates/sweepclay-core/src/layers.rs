@@ -22,6 +22,10 @@
 use crate::design::{Params, COLLISION_MARGIN_MM};
 use crate::error::{Error, Result};
 
+/// Clay of the same pass this little above the nozzle tip, at the edge of
+/// the extruder body's reach, is a graze on a rounded bead edge (mm).
+const SAME_PASS_GRAZE_MM: f64 = 0.1;
+
 /// The layering of one design.
 #[derive(Clone, Debug, PartialEq)]
 pub struct LayerPlan {
@@ -134,22 +138,19 @@ impl LayerPlan {
     }
 
     /// Chooses the layering for columns of heights `h` (ordered short end
-    /// first, non-decreasing), `ds` mm apart along Ψ, for an extruder body
-    /// of radius `nozzle_radius`.
+    /// first, non-decreasing), with the tallest columns within reach of the
+    /// extruder body around each (see [`reach_max`]).
     ///
     /// Tries the paper's single stage first (N' = ⌊h_short/Δz_min⌋); then
     /// two stages with the same N'; then fewer tilted passes until tilted
     /// passes are flat enough that the nozzle body clears the layer below
     /// (see `docs/ALGORITHMS.md`, "slope condition").
-    pub fn choose(h: &[f64], ds: f64, params: &Params, nozzle_radius: f64) -> Result<LayerPlan> {
+    pub fn choose(h: &[f64], reach: &Reach, params: &Params) -> Result<LayerPlan> {
         let (dmin, dmax) = (params.layer_height, params.max_layer_height);
         let h_short = h[0];
         let h_tall = *h.last().expect("at least one column");
         let spread = params.nozzle_height - COLLISION_MARGIN_MM - dmax;
         let n = ((h_short / dmin + 1e-9).floor() as u32).max(1);
-        // Arc window ≥ chord reach of the nozzle body, with 20 % for curvature.
-        let reach = 1.2 * (nozzle_radius + params.width_max / 2.0);
-        let window = (reach / ds).ceil() as usize;
         let mut last_err = None;
         for lower in (1..=n).rev() {
             let Some((k, low, up)) = Self::tall_layers(h_short, h_tall, lower, spread, dmin, dmax)
@@ -168,11 +169,11 @@ impl LayerPlan {
                 first_toward_tall: k == lower || lower % 2 == 1,
                 min_top_bead_mm: 0.5 * dmin,
             };
-            match plan.slope_violation(h, window) {
+            match plan.slope_violation(h, reach) {
                 None => return Ok(plan),
                 Some(at) => {
                     last_err = Some(format!(
-                        "no layering keeps the extruder body (radius {nozzle_radius} mm) clear of the layer below; the top edge rises too steeply near column {at}"
+                        "no layering keeps the extruder body clear of the layer below; the top edge rises too steeply near column {at}"
                     ))
                 }
             }
@@ -216,26 +217,79 @@ impl LayerPlan {
         ok.then_some((lower + m as u32, low, up))
     }
 
-    /// The first column where a pass would bring the nozzle lower than the
-    /// previous pass's clay within `window` columns (the slope condition).
-    fn slope_violation(&self, h: &[f64], window: usize) -> Option<usize> {
+    /// The first column where a pass would bring the nozzle lower than clay
+    /// within reach of the body (the slope condition): the previous pass's
+    /// clay at any column near in plan, or this pass's clay at columns near
+    /// in plan but far along Ψ (round a sharp corner).
+    fn slope_violation(&self, h: &[f64], reach: &Reach) -> Option<usize> {
         for (j, &hj) in h.iter().enumerate() {
-            let far = (j + window).min(h.len() - 1);
-            let hf = h[far];
-            if hf <= hj {
+            let (near, far) = (reach.near[j], reach.far[j]);
+            if near <= hj && far <= hj {
                 continue;
             }
             let q = self.column(hj).passes;
-            for k in 2..=q {
+            for k in 1..=q {
                 let mine = self.height(k, hj).min(hj);
-                let theirs = self.nominal(k - 1, hf).min(hf);
-                if theirs > mine + 1e-9 {
+                let previous = if k > 1 {
+                    self.nominal(k - 1, near).min(near)
+                } else {
+                    0.0
+                };
+                // Only a pass toward the short end has laid its taller
+                // columns before this one. A graze of ≤ 0.1 mm on a bead's
+                // rounded edge is allowed (the checker allows 0.2 mm).
+                let same = if far > f64::MIN && !self.toward_tall(k) {
+                    self.nominal(k, far).min(far)
+                } else {
+                    f64::MIN
+                };
+                if previous > mine + 1e-9 || same > mine + SAME_PASS_GRAZE_MM {
                     return Some(j);
                 }
             }
         }
         None
     }
+}
+
+/// The tallest columns within reach of each column's extruder body.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Reach {
+    /// Largest height among the columns within reach in plan (itself
+    /// included): the clay of the previous pass the body can touch.
+    pub near: Vec<f64>,
+    /// Largest height among the columns within reach in plan but more than
+    /// `exempt` columns away along Ψ (or `f64::MIN`): clay of the same pass
+    /// laid long enough ago to count, round a sharp corner.
+    pub far: Vec<f64>,
+}
+
+/// [`Reach`] for points evenly spaced along Ψ: `reach` is the body's reach
+/// in plan (mm), `exempt` how many neighbours along Ψ count as just laid.
+/// A grid of cells `reach` wide: linear time.
+pub fn reach_max(points: &[[f64; 2]], h: &[f64], reach: f64, exempt: usize) -> Reach {
+    let mut grid = crate::grid::Grid2::new(reach.max(1e-3));
+    for (i, p) in points.iter().enumerate() {
+        grid.insert_segment(*p, *p, i as u32);
+    }
+    let r2 = reach * reach;
+    let mut near = Vec::with_capacity(points.len());
+    let mut far = Vec::with_capacity(points.len());
+    for (i, p) in points.iter().enumerate() {
+        let (mut n, mut f) = (h[i], f64::MIN);
+        grid.for_each_near_segment(*p, *p, reach, |j| {
+            let q = points[j as usize];
+            if (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) <= r2 {
+                n = n.max(h[j as usize]);
+                if (j as usize).abs_diff(i) > exempt {
+                    f = f.max(h[j as usize]);
+                }
+            }
+        });
+        near.push(n);
+        far.push(f);
+    }
+    Reach { near, far }
 }
 
 #[cfg(test)]
@@ -248,10 +302,26 @@ mod tests {
             .collect()
     }
 
+    /// The layering of columns 1.1 mm apart on a straight line.
+    fn choose(h: &[f64], p: &Params) -> Result<LayerPlan> {
+        let pts: Vec<[f64; 2]> = (0..h.len()).map(|i| [1.1 * i as f64, 0.0]).collect();
+        LayerPlan::choose(h, &reach_max(&pts, h, 9.6, 9), p)
+    }
+
+    #[test]
+    fn reach_is_measured_in_plan() {
+        // A hairpin: the two arms 5 mm apart; the far arm is taller.
+        let pts = [[0.0, 0.0], [20.0, 0.0], [20.0, 5.0], [0.0, 5.0]];
+        let h = [1.0, 2.0, 3.0, 4.0];
+        let r = reach_max(&pts, &h, 6.0, 1);
+        assert_eq!(r.near, vec![4.0, 3.0, 3.0, 4.0]);
+        assert_eq!(r.far, vec![4.0, f64::MIN, f64::MIN, 1.0]);
+    }
+
     #[test]
     fn equal_heights_give_the_papers_single_stage() {
         let p = Params::default();
-        let plan = LayerPlan::choose(&heights(50.0, 50.0, 100), 1.1, &p, 5.0).unwrap();
+        let plan = choose(&heights(50.0, 50.0, 100), &p).unwrap();
         assert_eq!(plan.passes, 40, "⌊50 / 1.25⌋ = 40 passes");
         assert!(!plan.two_stage());
         let c = plan.column(50.0);
@@ -264,7 +334,7 @@ mod tests {
     #[test]
     fn small_difference_tilts_layers_between_the_ends() {
         let p = Params::default();
-        let plan = LayerPlan::choose(&heights(40.0, 50.0, 400), 1.1, &p, 5.0).unwrap();
+        let plan = choose(&heights(40.0, 50.0, 400), &p).unwrap();
         assert_eq!((plan.passes, plan.lower_passes), (32, 32));
         // Pass k at k/N of each column's height.
         assert!((plan.height(16, 40.0) - 20.0).abs() < 1e-12);
@@ -275,7 +345,7 @@ mod tests {
     fn large_difference_needs_two_stages() {
         let p = Params::default();
         let h = heights(20.0, 60.0, 2000);
-        let plan = LayerPlan::choose(&h, 1.1, &p, 5.0).unwrap();
+        let plan = choose(&h, &p).unwrap();
         assert!(plan.two_stage(), "{plan:?}");
         for d in [plan.lower_layer_mm, plan.upper_layer_mm] {
             assert!(d >= p.layer_height && d <= p.max_layer_height, "{plan:?}");
@@ -310,7 +380,7 @@ mod tests {
     fn spread_within_a_pass_is_bounded() {
         let p = Params::default();
         let h = heights(10.0, 90.0, 3000);
-        let plan = LayerPlan::choose(&h, 1.1, &p, 5.0).unwrap();
+        let plan = choose(&h, &p).unwrap();
         for k in 1..=plan.passes {
             let zs: Vec<f64> = h
                 .iter()
@@ -333,8 +403,11 @@ mod tests {
         let p = Params::default();
         // 20 mm of rise over 22 mm of trajectory.
         let h = heights(30.0, 50.0, 21);
-        let plan = LayerPlan::choose(&h, 1.1, &p, 5.0).unwrap();
+        let plan = choose(&h, &p).unwrap();
         assert!(plan.lower_passes < 24, "{plan:?}");
-        assert!(plan.slope_violation(&h, 12).is_none());
+        let pts: Vec<[f64; 2]> = (0..h.len()).map(|i| [1.1 * i as f64, 0.0]).collect();
+        assert!(plan
+            .slope_violation(&h, &reach_max(&pts, &h, 9.6, 9))
+            .is_none());
     }
 }

@@ -171,7 +171,20 @@ pub fn sample_surface(design: &Design) -> Result<Surface> {
         columns.iter().rev().map(|c| c.height).collect()
     };
     let spacing = traj.length / (n - 1) as f64;
-    let plan = LayerPlan::choose(&ordered, spacing, &params, printer.nozzle_radius)?;
+    let ordered_points: Vec<[f64; 2]> = if tall_at_end {
+        columns.iter().map(|c| c.p).collect()
+    } else {
+        columns.iter().rev().map(|c| c.p).collect()
+    };
+    // The extruder body reaches r + w_max/2 around the nozzle; 20 % more
+    // for the profiles' radial offsets, which move columns in plan.
+    let reach = 1.2 * (printer.nozzle_radius + params.width_max / 2.0);
+    // Clay laid within r + w_max of path is the bead just laid (exempt, as
+    // in the checker); one column less for safety.
+    let exempt =
+        (((printer.nozzle_radius + params.width_max) / spacing) as usize).saturating_sub(1);
+    let reach = crate::layers::reach_max(&ordered_points, &ordered, reach, exempt);
+    let plan = LayerPlan::choose(&ordered, &reach, &params)?;
     let mut surface = Surface {
         name: design.name.clone(),
         columns,

@@ -112,71 +112,132 @@ fn design(s: &Spec) -> Design {
     Design::from_json(&v.to_string()).expect("generated designs parse")
 }
 
+/// Slices `d` and checks every invariant of DESIGN.md §6–9, directly and
+/// with the independent checker. A design whose trajectory folds within a
+/// bead width is refused, which is correct.
+fn prints_in_clay(d: &Design) -> Result<(), TestCaseError> {
+    let sliced = match slice(d) {
+        Ok(x) => x,
+        // A design whose trajectory folds within a bead width is refused,
+        // which is correct; everything else must slice.
+        Err(sweepclay_core::Error::SelfIntersection(_)) => return Ok(()),
+        Err(e) => return Err(TestCaseError::fail(format!("{e}"))),
+    };
+    let p = &sliced.corrected.surface.params;
+    let t = &sliced.toolpath;
+    let ex = &sliced.extrusion;
+
+    // Every surface sample is on the path exactly once.
+    prop_assert_eq!(t.points.len(), sliced.corrected.surface.samples.len());
+
+    // Layer steps within [Δz_min, Δz_max]; top-edge beads may be thinner.
+    for (i, b) in t.below.iter().enumerate() {
+        let z = t.points[i].pos[2];
+        let step = match b {
+            Some(b) => z - t.points[*b as usize].pos[2],
+            None => z,
+        };
+        prop_assert!(
+            step <= p.max_layer_height + 1e-9,
+            "step {} at point {}",
+            step,
+            i
+        );
+        if t.points[i].kind == PointKind::Pass {
+            prop_assert!(
+                step >= p.layer_height - 1e-9,
+                "step {} at point {}",
+                step,
+                i
+            );
+        } else {
+            prop_assert!(step > 0.0);
+        }
+    }
+
+    // The printed clay never rises more than H (minus a margin) above the nozzle.
+    let mut top = 0.0f64;
+    for q in &t.points {
+        top = top.max(q.pos[2]);
+        prop_assert!(
+            top - q.pos[2] <= p.nozzle_height - 1.0 + 1e-9,
+            "clay {} mm above the nozzle",
+            top - q.pos[2]
+        );
+    }
+
+    // Coverage: each transition curve is printed to within one upper-stage
+    // layer of its top edge (exactly to it in a single stage).
+    for (c, col) in sliced.corrected.surface.columns.iter().enumerate() {
+        let highest = t
+            .points
+            .iter()
+            .filter(|q| q.column as usize == c)
+            .map(|q| q.pos[2])
+            .fold(0.0, f64::max);
+        let plan = &sliced.corrected.surface.plan;
+        prop_assert!(
+            col.height - highest <= plan.upper_layer_mm + 1e-6,
+            "curve {} printed to {} of {} (upper layer {})",
+            c,
+            highest,
+            col.height,
+            plan.upper_layer_mm
+        );
+        prop_assert!(highest <= col.height + 0.5 * p.layer_height + 1e-9);
+    }
+
+    // Widths in range; every bead overlaps the one below by the target.
+    for (i, b) in t.below.iter().enumerate() {
+        prop_assert!(ex.width[i] >= p.width_min - 1e-12 && ex.width[i] <= p.width_max + 1e-12);
+        if let Some(b) = b {
+            let (a, q) = (t.points[i].pos, t.points[*b as usize].pos);
+            let f = sweepclay_core::extrude::overlap_fraction(
+                ex.width[i],
+                ex.width[*b as usize],
+                (a[0] - q[0]).hypot(a[1] - q[1]),
+            );
+            prop_assert!(f >= p.overlap - 1e-9, "overlap {} at point {}", f, i);
+        }
+    }
+
+    // The independent checker agrees the G-code prints in clay.
+    let r = common::check_sliced(&sliced);
+    prop_assert!(r.printable, "{}\ndesign:\n{}", r.render(), d.to_json());
+    prop_assert_eq!(r.extrusion_runs, 1);
+    prop_assert_eq!(r.support.under_min.count, 0);
+    Ok(())
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 300, failure_persistence: None, .. ProptestConfig::default() })]
 
     #[test]
     fn random_designs_print_in_clay(s in spec()) {
-        let d = design(&s);
-        let sliced = match slice(&d) {
-            Ok(x) => x,
-            // A design whose trajectory folds within a bead width is refused,
-            // which is correct; everything else must slice.
-            Err(sweepclay_core::Error::SelfIntersection(_)) => return Ok(()),
-            Err(e) => return Err(TestCaseError::fail(format!("{e}"))),
-        };
-        let p = &sliced.corrected.surface.params;
-        let t = &sliced.toolpath;
-        let ex = &sliced.extrusion;
+        prints_in_clay(&design(&s))?;
+    }
 
-        // Every surface sample is on the path exactly once.
-        prop_assert_eq!(t.points.len(), sliced.corrected.surface.samples.len());
-
-        // Layer steps within [Δz_min, Δz_max]; top-edge beads may be thinner.
-        for (i, b) in t.below.iter().enumerate() {
-            let z = t.points[i].pos[2];
-            let step = match b { Some(b) => z - t.points[*b as usize].pos[2], None => z };
-            prop_assert!(step <= p.max_layer_height + 1e-9, "step {} at point {}", step, i);
-            if t.points[i].kind == PointKind::Pass {
-                prop_assert!(step >= p.layer_height - 1e-9, "step {} at point {}", step, i);
-            } else {
-                prop_assert!(step > 0.0);
-            }
-        }
-
-        // The printed clay never rises more than H (minus a margin) above the nozzle.
-        let mut top = 0.0f64;
-        for q in &t.points {
-            top = top.max(q.pos[2]);
-            prop_assert!(top - q.pos[2] <= p.nozzle_height - 1.0 + 1e-9,
-                "clay {} mm above the nozzle", top - q.pos[2]);
-        }
-
-        // Coverage: each transition curve is printed to within one upper-stage
-        // layer of its top edge (exactly to it in a single stage).
-        for (c, col) in sliced.corrected.surface.columns.iter().enumerate() {
-            let highest = t.points.iter().filter(|q| q.column as usize == c).map(|q| q.pos[2]).fold(0.0, f64::max);
-            let plan = &sliced.corrected.surface.plan;
-            prop_assert!(col.height - highest < plan.upper_layer_mm + 1e-9,
-                "curve {} printed to {} of {} (upper layer {})", c, highest, col.height, plan.upper_layer_mm);
-            prop_assert!(highest <= col.height + 0.5 * p.layer_height + 1e-9);
-        }
-
-        // Widths in range; every bead overlaps the one below by the target.
-        for (i, b) in t.below.iter().enumerate() {
-            prop_assert!(ex.width[i] >= p.width_min - 1e-12 && ex.width[i] <= p.width_max + 1e-12);
-            if let Some(b) = b {
-                let (a, q) = (t.points[i].pos, t.points[*b as usize].pos);
-                let f = sweepclay_core::extrude::overlap_fraction(ex.width[i], ex.width[*b as usize], (a[0]-q[0]).hypot(a[1]-q[1]));
-                prop_assert!(f >= p.overlap - 1e-9, "overlap {} at point {}", f, i);
-            }
-        }
-
-        // The independent checker agrees the G-code prints in clay.
-        let r = common::check_sliced(&sliced);
-        prop_assert!(r.printable, "{}\ndesign:\n{}", r.render(), d.to_json());
-        prop_assert_eq!(r.extrusion_runs, 1);
-        prop_assert_eq!(r.support.under_min.count, 0);
+    #[test]
+    fn polyline_trajectories_with_corners_print_in_clay(
+        zs in 6.0..50.0f64, zt in 6.0..50.0f64,
+        radius in 30.0..60.0f64, start in -180.0..180.0f64, span in 90.0..250.0f64,
+        jitter in prop::collection::vec((-6.0..6.0f64, -0.4..0.4f64), 4..12),
+    ) {
+        let n = jitter.len();
+        let pts: Vec<[f64; 2]> = jitter.iter().enumerate().map(|(i, (dr, da))| {
+            let a = (start + span * (i as f64 + da) / (n - 1) as f64).to_radians();
+            [(radius + dr) * a.cos(), (radius + dr) * a.sin()]
+        }).collect();
+        let len: f64 = pts.windows(2).map(|w| (w[0][0] - w[1][0]).hypot(w[0][1] - w[1][1])).sum();
+        prop_assume!((zs - zt).abs() < 0.5 * len);
+        let v = serde_json::json!({
+            "sweepclay": 1, "name": "polyline",
+            "profile_start": { "control_points": [[0.0, 0.0], [2.0, zs / 2.0], [0.0, zs]] },
+            "profile_end": { "control_points": [[0.0, 0.0], [-2.0, zt / 2.0], [1.0, zt]] },
+            "trajectory": { "points": pts },
+            "printer": "generic",
+        });
+        prints_in_clay(&Design::from_json(&v.to_string()).unwrap())?;
     }
 
     #[test]

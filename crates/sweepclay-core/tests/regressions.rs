@@ -3,6 +3,11 @@
 //! r1: returning turn over a just-laid pass end; r2: tilted pass beside a
 //! wider bead; r3: first layer thicker than 3 mm; r4: steep climbing turn;
 //! r5: lean-out step at the trajectory's start; r6: steep tilted pass.
+//! Polylines with sharp corners (SVG-like imports): p1, p2: a corner's
+//! pile-up of fresh clay read as double deposition; p3: the same tilted
+//! pass within the extruder body's reach round a corner (fixed in the
+//! layering: reach measured in plan); p4: a returning turn turning back at
+//! a corner.
 
 mod common;
 
@@ -24,4 +29,4 @@ macro_rules! regression {
     )*};
 }
 
-regression!(r1, r2, r3, r4, r5, r6);
+regression!(r1, r2, r3, r4, r5, r6, p1, p2, p3, p4);
