@@ -332,15 +332,18 @@ pub fn check(text: &str, cfg: &CheckConfig) -> Report {
                     return;
                 }
                 let (_, d, z, at) = b.closest(mid);
-                // A bead laid earlier in this run lies behind the
-                // nozzle, not below it: its end is its point nearest to
-                // the new bead, the new bead moves away from that end,
-                // and little path lies between them. (A bead below that
-                // the path returns over, after a turn or a step-up, is
-                // approached, not left.)
+                // A bead laid earlier in this run lies behind the nozzle,
+                // not below it: little more path than the distance lies
+                // between them, and the new bead clearly moves away from it
+                // (its middle ≥ 0.1 mm farther from it than its start) or
+                // starts less than 0.5 mm above it (round a sharp corner it
+                // may turn back toward it). A bead below that the path returns over after
+                // a turn or a step-up is approached (or passed alongside)
+                // and a layer down; a bead laid again right on top of an
+                // earlier one (d ≈ 0) is neither.
                 let from_end = (m.from[0] - at[0]).hypot(m.from[1] - at[1]);
                 if s_start - b.s_end <= 1.5 * d + 1e-6
-                    && (d > from_end || m.from[2] - z < cfg.min_layer_mm)
+                    && (d > from_end + 0.1 || m.from[2] - z < 0.5)
                 {
                     return;
                 }

@@ -7,7 +7,9 @@
 //! pile-up of fresh clay read as double deposition; p3: the same tilted
 //! pass within the extruder body's reach round a corner (fixed in the
 //! layering: reach measured in plan); p4: a returning turn turning back at
-//! a corner.
+//! a corner. p5 (smooth): the first top-edge bead after an outward step,
+//! running back over the pass below. p6: a returning turn running into a
+//! polyline corner.
 
 mod common;
 
@@ -29,4 +31,4 @@ macro_rules! regression {
     )*};
 }
 
-regression!(r1, r2, r3, r4, r5, r6, p1, p2, p3, p4);
+regression!(r1, r2, r3, r4, r5, r6, p1, p2, p3, p4, p5, p6);
