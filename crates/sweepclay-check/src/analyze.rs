@@ -519,3 +519,60 @@ fn verdict(r: &mut Report, cfg: &CheckConfig) {
     r.printable = f.is_empty();
     r.failures = f;
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn cand(z: f64, x: f64, d: f64) -> Candidate {
+        Candidate {
+            z,
+            at: [x, 0.0],
+            d,
+            width: 3.0,
+            covers: d <= 1.5,
+        }
+    }
+
+    #[test]
+    fn climbs_a_leaning_stack_to_its_top() {
+        // Layers 1.2 mm apart, each 0.8 mm further out (a 34° lean); the
+        // lowest is nearest the new bead's middle.
+        let c = [
+            cand(1.2, 0.0, 0.2),
+            cand(2.4, 0.8, 0.6),
+            cand(3.6, 1.6, 1.4),
+        ];
+        let s = pick_support(&c, 0.3, false).unwrap();
+        assert_eq!(s.z, 3.6);
+    }
+
+    #[test]
+    fn does_not_slide_along_a_tilted_ridge() {
+        // One pass rising 0.3 mm per mm: the bead below is the nearest.
+        let c = [
+            cand(5.0, 0.0, 0.1),
+            cand(5.3, 1.0, 1.0),
+            cand(5.6, 2.0, 1.45),
+        ];
+        let s = pick_support(&c, 0.3, false).unwrap();
+        assert_eq!(s.z, 5.0);
+    }
+
+    #[test]
+    fn bed_when_nothing_covers_and_low() {
+        let c = [cand(1.2, 5.0, 5.0)];
+        assert!(pick_support(&c, 0.3, true).is_none());
+        assert_eq!(pick_support(&c, 0.3, false).unwrap().z, 1.2, "an overhang");
+        assert!(pick_support(&[], 0.3, false).is_none());
+    }
+
+    #[test]
+    fn overlap_fraction_closed_forms() {
+        assert_eq!(overlap_fraction(3.0, 3.0, 0.0), 1.0);
+        assert!((overlap_fraction(3.0, 3.0, 1.5) - 0.5).abs() < 1e-12);
+        assert_eq!(overlap_fraction(3.0, 3.0, 3.5), 0.0);
+        // A narrow bead on a wide one, centred: fully supported.
+        assert_eq!(overlap_fraction(3.0, 6.0, 1.0), 1.0);
+    }
+}
