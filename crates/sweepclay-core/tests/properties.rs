@@ -241,6 +241,35 @@ proptest! {
     }
 
     #[test]
+    fn spirals_print_in_clay(
+        zs in 8.0..50.0f64, zt in 8.0..50.0f64,
+        r0 in 12.0..25.0f64, growth in 8.0..20.0f64, turns in 0.6..1.6f64, start in -180.0..180.0f64,
+        f in prop::option::of((0.2..0.8f64, 0.0..1.0f64)),
+    ) {
+        // An Archimedean spiral, coils `growth` mm apart, as a B-spline.
+        let n = (turns * 12.0).ceil() as usize + 1;
+        let cp: Vec<[f64; 2]> = (0..n).map(|i| {
+            let t = i as f64 / (n - 1) as f64;
+            let a = (start + 360.0 * turns * t).to_radians();
+            let r = r0 + growth * turns * t;
+            [r * a.cos(), r * a.sin()]
+        }).collect();
+        let len = std::f64::consts::PI * turns * (2.0 * r0 + growth * turns);
+        prop_assume!((zs - zt).abs() < 0.4 * len);
+        let mut v = serde_json::json!({
+            "sweepclay": 1, "name": "spiral",
+            "profile_start": { "control_points": [[0.0, 0.0], [3.0, zs / 2.0], [0.0, zs]] },
+            "profile_end": { "control_points": [[0.0, 0.0], [-2.0, zt / 2.0], [1.0, zt]] },
+            "trajectory": { "control_points": cp },
+            "printer": "generic",
+        });
+        if let Some((a, b)) = f {
+            v["interpolation"] = serde_json::json!({ "control_points": [[0.0, 0.0], [a, b], [1.0, 1.0]] });
+        }
+        prints_in_clay(&Design::from_json(&v.to_string()).unwrap())?;
+    }
+
+    #[test]
     fn arbitrary_text_never_panics(s in ".{0,400}") {
         let _ = Design::from_json(&s);
     }
