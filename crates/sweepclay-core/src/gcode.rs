@@ -132,6 +132,11 @@ pub fn emit_moves<W: Write>(
     ex: &Extrusion,
     f: &MoveFormat,
 ) -> io::Result<Vec<usize>> {
+    let mut out = Lines {
+        inner: out,
+        count: 0,
+    };
+    let out = &mut out;
     let o = f.origin;
     let p0 = points[0];
     writeln!(
@@ -142,9 +147,8 @@ pub fn emit_moves<W: Write>(
         p0[1] + o[1],
         p0[2]
     )?;
-    let mut line = 1;
     let mut lines = Vec::with_capacity(points.len());
-    lines.push(line);
+    lines.push(out.count);
     let mut e_total = 0.0f64;
     let mut e_printed = 0.0f64;
     let (mut last_w, mut last_h) = (String::new(), String::new());
@@ -154,12 +158,10 @@ pub fn emit_moves<W: Write>(
         if w != last_w {
             writeln!(out, ";WIDTH:{w}")?;
             last_w = w;
-            line += 1;
         }
         if h != last_h {
             writeln!(out, ";HEIGHT:{h}")?;
             last_h = h;
-            line += 1;
         }
         let de = ex.volume[i] * f.e_per_mm3;
         let p = points[i];
@@ -182,8 +184,7 @@ pub fn emit_moves<W: Write>(
             p[1] + o[1],
             p[2]
         )?;
-        line += 1;
-        lines.push(line);
+        lines.push(out.count);
     }
     Ok(lines)
 }
