@@ -352,14 +352,15 @@ pub fn check(text: &str, cfg: &CheckConfig) -> Report {
                         return;
                     }
                     if d <= cfg.width_max.max(b.width / 2.0) {
+                        let covers = d <= b.width / 2.0;
+                        covered.set(covered.get() || covers);
                         cands.push(Candidate {
                             z,
                             at,
                             d,
                             width: b.width,
-                            covers: d <= b.width / 2.0,
+                            covers,
                         });
-                        covered.set(covered.get() || d <= b.width / 2.0);
                     }
                 } else if (z - mid[2]).abs() < cfg.min_layer_mm
                     && d < 0.5 * b.width.min(cfg.width_min)

@@ -65,7 +65,7 @@ pub struct Report {
     pub printable: bool,
     /// The reasons it is not (empty when printable).
     pub failures: Vec<String>,
-    /// Lines read and moves replayed.
+    /// Lines in the file.
     pub lines: usize,
     /// Moves replayed.
     pub moves: usize,

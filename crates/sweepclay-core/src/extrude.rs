@@ -119,7 +119,6 @@ mod tests {
             passes: offsets.len() as u32,
             stages: 1,
             returning_points: 0,
-            lower_passes: 1,
         }
     }
 

@@ -49,8 +49,6 @@ pub struct Toolpath {
     pub stages: u8,
     /// Number of returning turns that climb the top edge.
     pub returning_points: u32,
-    /// Passes of the lower stage (N').
-    pub lower_passes: u32,
 }
 
 /// Orders the samples of a corrected surface into one continuous path.
@@ -128,7 +126,6 @@ pub fn plan_path(c: &Corrected) -> Toolpath {
         passes: k_max,
         stages: if s.plan.two_stage() { 2 } else { 1 },
         returning_points: returning,
-        lower_passes: s.plan.lower_passes,
     }
 }
 
