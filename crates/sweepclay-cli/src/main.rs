@@ -140,20 +140,28 @@ fn load_printer(spec: &str) -> Result<Printer> {
     r.resolve().with_context(|| spec.to_string())
 }
 
-fn check_config(p: &Printer, params: &sweepclay_core::Params) -> CheckConfig {
+/// The checker's defaults with the printer's build volume, calibration and
+/// extruder body.
+fn printer_check(p: &Printer) -> CheckConfig {
     CheckConfig {
         build_volume: p.build_volume,
         e_per_mm3: p.e_per_mm3,
         nozzle_radius: p.nozzle_radius,
+        ..CheckConfig::default()
+    }
+}
+
+/// The check `slice` runs: the printer's, with the design's parameters.
+fn check_config(p: &Printer, params: &sweepclay_core::Params) -> CheckConfig {
+    let base = printer_check(p);
+    CheckConfig {
         nozzle_height: params.nozzle_height,
         width_min: params.width_min,
         width_max: params.width_max,
         overlap_target: params.overlap,
         max_overhang_deg: params.max_overhang_deg,
-        first_layer_max_mm: CheckConfig::default()
-            .first_layer_max_mm
-            .max(params.max_layer_height + 0.05),
-        ..CheckConfig::default()
+        first_layer_max_mm: base.first_layer_max_mm.max(params.max_layer_height + 0.05),
+        ..base
     }
 }
 
@@ -313,9 +321,6 @@ fn check_cmd(a: CheckArgs) -> Result<i32> {
     let text = String::from_utf8_lossy(&text);
     let p = load_printer(&a.printer)?;
     let cfg = CheckConfig {
-        build_volume: p.build_volume,
-        e_per_mm3: p.e_per_mm3,
-        nozzle_radius: p.nozzle_radius,
         nozzle_height: a.nozzle_height,
         width_min: a.width_min,
         width_max: a.width_max,
@@ -323,7 +328,7 @@ fn check_cmd(a: CheckArgs) -> Result<i32> {
         overlap_min: a.min_overlap,
         max_overhang_deg: a.max_overhang_deg,
         first_layer_max_mm: a.first_layer_max,
-        ..CheckConfig::default()
+        ..printer_check(&p)
     };
     let report = check(&text, &cfg);
     if a.json {

@@ -165,17 +165,14 @@ pub fn sample_surface(design: &Design) -> Result<Surface> {
         });
     }
     let tall_at_end = end.height >= start.height;
-    let ordered: Vec<f64> = if tall_at_end {
-        columns.iter().map(|c| c.height).collect()
-    } else {
-        columns.iter().rev().map(|c| c.height).collect()
-    };
+    // Columns from the short end (the order the layering works in).
+    let mut short_first: Vec<&Column> = columns.iter().collect();
+    if !tall_at_end {
+        short_first.reverse();
+    }
+    let ordered: Vec<f64> = short_first.iter().map(|c| c.height).collect();
+    let ordered_points: Vec<[f64; 2]> = short_first.iter().map(|c| c.p).collect();
     let spacing = traj.length / (n - 1) as f64;
-    let ordered_points: Vec<[f64; 2]> = if tall_at_end {
-        columns.iter().map(|c| c.p).collect()
-    } else {
-        columns.iter().rev().map(|c| c.p).collect()
-    };
     // The extruder body reaches r + w_max/2 around the nozzle; 20 % more
     // for the profiles' radial offsets, which move columns in plan.
     let reach = 1.2 * (printer.nozzle_radius + params.width_max / 2.0);
