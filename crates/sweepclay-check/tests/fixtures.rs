@@ -68,14 +68,15 @@ impl G {
 
 /// A zig-zag wall along y = 50 from x = 50 to 90, `layers` high.
 fn wall(layers: usize) -> G {
-    let mut g = G::new([50.0, 50.0, LAYER]);
+    wall_from(50.0, 90.0, layers)
+}
+
+/// A zig-zag wall along y = 50 from x = `a` to `b`, `layers` high.
+fn wall_from(a: f64, b: f64, layers: usize) -> G {
+    let mut g = G::new([a, 50.0, LAYER]);
     for k in 1..=layers {
         let z = LAYER * k as f64;
-        let (x0, x1) = if k % 2 == 1 {
-            (50.0, 90.0)
-        } else {
-            (90.0, 50.0)
-        };
+        let (x0, x1) = if k % 2 == 1 { (a, b) } else { (b, a) };
         if k > 1 {
             g.bead([x0, 50.0, z], W, LAYER);
         }
@@ -282,19 +283,8 @@ fn unsupported_overhang_fails() {
 
 #[test]
 fn out_of_bounds_fails() {
-    let mut g = G::new([170.0, 50.0, LAYER]);
-    for k in 1..=3 {
-        let z = LAYER * k as f64;
-        let (x0, x1) = if k % 2 == 1 {
-            (170.0, 210.0)
-        } else {
-            (210.0, 170.0)
-        };
-        if k > 1 {
-            g.bead([x0, 50.0, z], W, LAYER);
-        }
-        g.run([x1, 50.0, z], W, LAYER);
-    }
+    // A wall from x = 170 to 210 on a 200 mm bed.
+    let g = wall_from(170.0, 210.0, 3);
     let r = verdict(&g.out);
     only(&r, "outside the build volume");
     assert!((r.out_of_bounds.worst.unwrap().0 - 10.0).abs() < 1e-6);
