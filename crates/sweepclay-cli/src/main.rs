@@ -6,7 +6,8 @@ use clap::{Args, Parser, Subcommand};
 use std::io::Write;
 use std::path::{Path, PathBuf};
 use sweepclay_check::{check, CheckConfig};
-use sweepclay_core::{examples, gcode, printer::PRESETS, Design, Printer, PrinterRef};
+use sweepclay_core::{examples, printer::PRESETS, Design, Printer, PrinterRef};
+use sweepclay_web::verify::{printer_check, verify, Verified};
 
 /// Clay 3D printing of sweeping surfaces: design file → one continuous,
 /// collision-free, self-supporting G-code path, and a checker that says
@@ -33,6 +34,22 @@ enum Command {
         /// Directory to write into (created if missing).
         dir: PathBuf,
     },
+    /// Start the modeler: a local web page to draw, preview and print
+    /// designs. Prints its URL; Ctrl+C stops it.
+    Serve(ServeArgs),
+}
+
+#[derive(Args, Debug)]
+struct ServeArgs {
+    /// Address to listen on (use 0.0.0.0 to let other machines in).
+    #[arg(long, default_value = "127.0.0.1")]
+    host: String,
+    /// Port (0 picks a free one).
+    #[arg(long, default_value_t = 8080)]
+    port: u16,
+    /// Refuse designs with more surface samples than this (estimated).
+    #[arg(long, default_value_t = 1_500_000)]
+    max_samples: u64,
 }
 
 #[derive(Args, Debug)]
@@ -112,6 +129,7 @@ fn run(cli: Cli) -> Result<i32> {
     match cli.command {
         Command::Slice(a) => slice(a),
         Command::Check(a) => check_cmd(a),
+        Command::Serve(a) => serve(a),
         Command::Examples { dir } => {
             std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
             for (name, text) in examples::EXAMPLES {
@@ -140,31 +158,6 @@ fn load_printer(spec: &str) -> Result<Printer> {
     r.resolve().with_context(|| spec.to_string())
 }
 
-/// The checker's defaults with the printer's build volume, calibration and
-/// extruder body.
-fn printer_check(p: &Printer) -> CheckConfig {
-    CheckConfig {
-        build_volume: p.build_volume,
-        e_per_mm3: p.e_per_mm3,
-        nozzle_radius: p.nozzle_radius,
-        ..CheckConfig::default()
-    }
-}
-
-/// The check `slice` runs: the printer's, with the design's parameters.
-fn check_config(p: &Printer, params: &sweepclay_core::Params) -> CheckConfig {
-    let base = printer_check(p);
-    CheckConfig {
-        nozzle_height: params.nozzle_height,
-        width_min: params.width_min,
-        width_max: params.width_max,
-        overlap_target: params.overlap,
-        max_overhang_deg: params.max_overhang_deg,
-        first_layer_max_mm: base.first_layer_max_mm.max(params.max_layer_height + 0.05),
-        ..base
-    }
-}
-
 fn slice(a: SliceArgs) -> Result<i32> {
     let (text, source) = match std::fs::read_to_string(&a.design) {
         Ok(t) => (t, a.design.clone()),
@@ -191,13 +184,12 @@ fn slice(a: SliceArgs) -> Result<i32> {
         design.params.set(k, v)?;
     }
     let sliced = sweepclay_core::slice(&design).with_context(|| source.clone())?;
-    let (text, point_lines) = gcode::to_string_with_lines(&sliced);
+    let Verified {
+        gcode: text,
+        report,
+        locations,
+    } = verify(&sliced, a.min_overlap);
     let printer = &sliced.corrected.surface.printer;
-    let cfg = CheckConfig {
-        overlap_min: a.min_overlap,
-        ..check_config(printer, &sliced.corrected.surface.params)
-    };
-    let report = check(&text, &cfg);
     let out = a.output.clone().unwrap_or_else(|| {
         let stem = Path::new(&a.design)
             .file_stem()
@@ -256,10 +248,8 @@ fn slice(a: SliceArgs) -> Result<i32> {
                 format!("NOT printable: {}", report.failures.join("; "))
             }
         );
-        for line in failure_lines(&report).into_iter().take(5) {
-            if let Some(at) = locate(&sliced, &point_lines, line) {
-                println!("  where              {at}");
-            }
+        for at in &locations {
+            println!("  where              {at}");
         }
     }
     if !report.printable && !a.force {
@@ -273,47 +263,28 @@ fn slice(a: SliceArgs) -> Result<i32> {
     Ok(if report.printable { 0 } else { 1 })
 }
 
-/// The first line of each kind of failure in a report.
-fn failure_lines(r: &sweepclay_check::Report) -> Vec<usize> {
-    let sp = &r.support;
-    let mut v: Vec<usize> = [
-        &r.travel_moves,
-        &r.retractions,
-        &r.pauses,
-        &r.extrusion_without_motion,
-        &r.out_of_bounds,
-        &r.nozzle_collisions,
-        &r.carriage_collisions,
-        &sp.unsupported,
-        &sp.double_deposition,
-        &sp.under_min,
-        &sp.overhang,
-    ]
-    .iter()
-    .filter_map(|c| c.first_line)
-    .collect();
-    v.sort_unstable();
-    v.dedup();
-    v
-}
-
-/// Where in the design a G-code line of our own output is.
-fn locate(s: &sweepclay_core::Sliced, lines: &[usize], line: usize) -> Option<String> {
-    let i = lines.partition_point(|&l| l < line);
-    if lines.get(i) != Some(&line) {
-        return None;
-    }
-    let p = &s.toolpath.points[i];
-    let col = &s.corrected.surface.columns[p.column as usize];
-    let top = if p.kind == sweepclay_core::toolpath::PointKind::Top {
-        ", top-edge bead"
-    } else {
-        ""
-    };
-    Some(format!(
-        "line {line}: pass {}, transition curve {} (u = {:.3}), z = {:.2} mm{top}",
-        p.pass, p.column, col.u, p.pos[2]
-    ))
+fn serve(a: ServeArgs) -> Result<i32> {
+    let rt = tokio::runtime::Runtime::new().context("starting the async runtime")?;
+    rt.block_on(async {
+        let listener = tokio::net::TcpListener::bind((a.host.as_str(), a.port))
+            .await
+            .with_context(|| format!("listening on {}:{}", a.host, a.port))?;
+        let addr = listener.local_addr()?;
+        let host = if addr.ip().is_unspecified() {
+            "127.0.0.1".to_string()
+        } else {
+            addr.ip().to_string()
+        };
+        println!(
+            "sweepclay modeler: http://{host}:{}/  (Ctrl+C to stop)",
+            addr.port()
+        );
+        let limits = sweepclay_web::api::Limits {
+            max_samples: a.max_samples as f64,
+        };
+        sweepclay_web::run(listener, limits).await?;
+        Ok(0)
+    })
 }
 
 fn check_cmd(a: CheckArgs) -> Result<i32> {

@@ -222,6 +222,26 @@ impl Design {
     pub fn to_json(&self) -> String {
         serde_json::to_string_pretty(self).expect("a design always serialises")
     }
+
+    /// An upper bound on the number of surface samples, computed from the
+    /// control polygons without sampling anything: (polygon length of Ψ /
+    /// spacing + 1) × (tallest profile / layer height + 1). A server can
+    /// refuse a design before it allocates anything for it. NaN when a
+    /// coordinate is not a number (slicing then names it).
+    pub fn estimated_samples(&self) -> f64 {
+        let poly = |pts: &[[f64; 2]]| -> f64 {
+            pts.windows(2)
+                .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
+                .sum()
+        };
+        let t = &self.trajectory;
+        let length = poly(t.control_points.as_deref().unwrap_or(&[]))
+            + poly(t.points.as_deref().unwrap_or(&[]));
+        let top = |c: &CurveSpec| c.control_points.iter().map(|p| p[1]).fold(0.0, f64::max);
+        let height = top(&self.profile_start).max(top(&self.profile_end));
+        let p = &self.params;
+        (length / p.spacing + 1.0) * (height / p.layer_height + 1.0)
+    }
 }
 
 #[cfg(test)]
@@ -234,6 +254,16 @@ mod tests {
         "profile_end": { "control_points": [[0, 0], [0, 20]] },
         "trajectory": { "control_points": [[-50, 10], [50, 10]] }
     }"#;
+
+    #[test]
+    fn sample_estimate_bounds_the_real_count() {
+        for (name, text) in crate::examples::EXAMPLES {
+            let d = Design::from_json(text).unwrap();
+            let real = crate::surface::sample_surface(&d).unwrap().samples.len() as f64;
+            let est = d.estimated_samples();
+            assert!(est >= real && est < 3.0 * real, "{name}: {est} vs {real}");
+        }
+    }
 
     #[test]
     fn minimal_design_takes_defaults() {

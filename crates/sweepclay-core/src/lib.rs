@@ -43,7 +43,9 @@ pub mod examples;
 pub mod extrude;
 pub mod gcode;
 pub mod grid;
+pub mod import;
 pub mod layers;
+pub mod mesh;
 pub mod preview;
 pub mod printer;
 pub mod surface;
@@ -101,7 +103,12 @@ pub struct Sliced {
 /// extrusion, and check that the result fits the printer.
 pub fn slice(design: &Design) -> Result<Sliced> {
     let surface = surface::sample_surface(design)?;
-    let corrected = correct::correct(&surface)?;
+    finish(correct::correct(&surface)?)
+}
+
+/// The stages after the corrections: plan the path and the extrusion,
+/// compute the statistics and check that the result fits the printer.
+pub fn finish(corrected: Corrected) -> Result<Sliced> {
     let toolpath = toolpath::plan_path(&corrected);
     let extrusion = extrude::plan_extrusion(&toolpath, &corrected.surface.params);
     let stats = stats(&corrected, &toolpath, &extrusion);

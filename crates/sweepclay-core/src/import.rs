@@ -1,0 +1,447 @@
+//! Trajectories from other tools: the first open curve of an SVG file, or a
+//! CSV of points, as the polyline `trajectory.points` of a design
+//! (DESIGN.md §3). Pure: text in, points out.
+//!
+//! SVG: the first `path`, `polyline`, `polygon` or `line` outside `<defs>`,
+//! with the `transform`s of the element and its ancestors applied. Curves
+//! (cubic, quadratic, arcs, smooth variants) are flattened to segments of at
+//! most [`FLATTEN_MM`]. Units: user units are CSS pixels (25.4/96 mm)
+//! unless the root `<svg>` gives its `width` in mm, cm or in with a
+//! `viewBox`, which fixes the scale. The y axis is flipped (SVG's points
+//! down) and the curve is centred on `o`.
+//!
+//! CSV: one `x, y` pair per line (comma, semicolon, tab or spaces), in mm;
+//! blank lines and `#` comments are skipped, and so is a header on line 1.
+
+use crate::error::{Error, Result};
+use std::str::FromStr;
+use svgtypes::{PointsParser, SimplePathSegment, SimplifyingPathParser, Transform};
+
+/// Longest segment of a flattened curve (mm).
+pub const FLATTEN_MM: f64 = 0.5;
+/// Most points an imported trajectory keeps (resampled by arc length).
+pub const MAX_POINTS: usize = 2000;
+
+const PX_MM: f64 = 25.4 / 96.0;
+
+/// The first open curve of an SVG document as trajectory points (mm,
+/// centred on `o`, y up).
+pub fn svg_trajectory(text: &str) -> Result<Vec<[f64; 2]>> {
+    let doc = roxmltree::Document::parse(text)
+        .map_err(|e| Error::invalid("svg", format!("not an SVG document: {e}")))?;
+    let root = doc.root_element();
+    if root.tag_name().name() != "svg" {
+        return Err(Error::invalid(
+            "svg",
+            format!(
+                "the root element is <{}>, not <svg>",
+                root.tag_name().name()
+            ),
+        ));
+    }
+    let mm_per_unit = unit_scale(&root)?;
+    let node = root
+        .descendants()
+        .filter(|n| n.is_element())
+        .filter(|n| !n.ancestors().any(|a| a.tag_name().name() == "defs"))
+        .find(|n| {
+            matches!(
+                n.tag_name().name(),
+                "path" | "polyline" | "polygon" | "line"
+            )
+        })
+        .ok_or_else(|| {
+            Error::invalid(
+                "svg",
+                "no <path>, <polyline>, <polygon> or <line> element to import",
+            )
+        })?;
+    let tag = node.tag_name().name();
+    // Accumulated transform, outermost first.
+    let mut ts = Transform::default();
+    let chain: Vec<_> = node.ancestors().collect();
+    for n in chain.iter().rev() {
+        if let Some(t) = n.attribute("transform") {
+            let t = Transform::from_str(t).map_err(|e| {
+                Error::invalid(
+                    format!("svg <{}> transform", n.tag_name().name()),
+                    e.to_string(),
+                )
+            })?;
+            ts = compose(&ts, &t);
+        }
+    }
+    let scale = mm_per_unit * (ts.a * ts.d - ts.b * ts.c).abs().sqrt().max(1e-12);
+    let step = FLATTEN_MM / scale;
+    let attr = |name: &str| {
+        node.attribute(name)
+            .ok_or_else(|| Error::invalid(format!("svg <{tag}>"), format!("has no `{name}`")))
+    };
+    let num = |name: &str| -> Result<f64> {
+        let v = attr(name)?;
+        v.trim().parse().map_err(|_| {
+            Error::invalid(
+                format!("svg <{tag}> {name}"),
+                format!("`{v}` is not a number"),
+            )
+        })
+    };
+    let local: Vec<[f64; 2]> = match tag {
+        "path" => flatten_path(attr("d")?, step)?,
+        "line" => vec![[num("x1")?, num("y1")?], [num("x2")?, num("y2")?]],
+        _ => {
+            let mut pts: Vec<[f64; 2]> = PointsParser::from(attr("points")?)
+                .map(|(x, y)| [x, y])
+                .collect();
+            if tag == "polygon" && !pts.is_empty() {
+                pts.push(pts[0]);
+            }
+            pts
+        }
+    };
+    let pts: Vec<[f64; 2]> = local
+        .iter()
+        .map(|&[x, y]| {
+            let (x, y) = (ts.a * x + ts.c * y + ts.e, ts.b * x + ts.d * y + ts.f);
+            [x * mm_per_unit, -y * mm_per_unit]
+        })
+        .collect();
+    let mut pts = finish(pts, &format!("svg <{tag}>"))?;
+    centre(&mut pts);
+    Ok(pts)
+}
+
+/// Points of a CSV file as a trajectory (mm, as given: not centred).
+pub fn csv_trajectory(text: &str) -> Result<Vec<[f64; 2]>> {
+    let mut pts = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let line = line.split('#').next().unwrap_or("").trim();
+        if line.is_empty() {
+            continue;
+        }
+        let fields: Vec<&str> = line
+            .split([',', ';', '\t', ' '])
+            .map(str::trim)
+            .filter(|f| !f.is_empty())
+            .collect();
+        let parsed: Vec<Option<f64>> = fields.iter().map(|f| f.parse().ok()).collect();
+        if i == 0 && parsed.iter().all(Option::is_none) {
+            continue; // a header
+        }
+        let key = format!("csv line {}", i + 1);
+        if fields.len() < 2 {
+            return Err(Error::invalid(
+                key,
+                format!("expected `x, y`, got `{line}`"),
+            ));
+        }
+        let mut xy = [0.0; 2];
+        for k in 0..2 {
+            xy[k] = parsed[k]
+                .filter(|v: &f64| v.is_finite())
+                .ok_or_else(|| Error::invalid(&key, format!("`{}` is not a number", fields[k])))?;
+        }
+        pts.push(xy);
+    }
+    finish(pts, "csv")
+}
+
+fn finish(pts: Vec<[f64; 2]>, key: &str) -> Result<Vec<[f64; 2]>> {
+    let mut out: Vec<[f64; 2]> = Vec::with_capacity(pts.len());
+    for p in pts {
+        if !(p[0].is_finite() && p[1].is_finite()) {
+            return Err(Error::invalid(key, "has a coordinate that is not a number"));
+        }
+        if out
+            .last()
+            .is_none_or(|q| (p[0] - q[0]).hypot(p[1] - q[1]) > 1e-6)
+        {
+            out.push(p);
+        }
+    }
+    if out.len() < 2 {
+        return Err(Error::invalid(key, "needs at least two distinct points"));
+    }
+    Ok(resample(&out, MAX_POINTS))
+}
+
+/// Moves the points so that the centre of their bounding box is at `o`.
+pub fn centre(pts: &mut [[f64; 2]]) {
+    let (mut lo, mut hi) = ([f64::MAX; 2], [f64::MIN; 2]);
+    for p in pts.iter() {
+        for a in 0..2 {
+            lo[a] = lo[a].min(p[a]);
+            hi[a] = hi[a].max(p[a]);
+        }
+    }
+    let c = [(lo[0] + hi[0]) / 2.0, (lo[1] + hi[1]) / 2.0];
+    for p in pts.iter_mut() {
+        p[0] -= c[0];
+        p[1] -= c[1];
+    }
+}
+
+/// At most `max` points, equally spaced by arc length, ends kept.
+fn resample(pts: &[[f64; 2]], max: usize) -> Vec<[f64; 2]> {
+    if pts.len() <= max {
+        return pts.to_vec();
+    }
+    let mut cum = vec![0.0];
+    for w in pts.windows(2) {
+        cum.push(cum.last().unwrap() + (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]));
+    }
+    let total = *cum.last().unwrap();
+    let mut out = Vec::with_capacity(max);
+    let mut j = 0;
+    for i in 0..max {
+        let s = total * i as f64 / (max - 1) as f64;
+        while j + 2 < cum.len() && cum[j + 1] < s {
+            j += 1;
+        }
+        let t = ((s - cum[j]) / (cum[j + 1] - cum[j]).max(1e-12)).clamp(0.0, 1.0);
+        out.push([
+            pts[j][0] + t * (pts[j + 1][0] - pts[j][0]),
+            pts[j][1] + t * (pts[j + 1][1] - pts[j][1]),
+        ]);
+    }
+    out
+}
+
+fn compose(outer: &Transform, inner: &Transform) -> Transform {
+    Transform::new(
+        outer.a * inner.a + outer.c * inner.b,
+        outer.b * inner.a + outer.d * inner.b,
+        outer.a * inner.c + outer.c * inner.d,
+        outer.b * inner.c + outer.d * inner.d,
+        outer.a * inner.e + outer.c * inner.f + outer.e,
+        outer.b * inner.e + outer.d * inner.f + outer.f,
+    )
+}
+
+/// Millimetres per user unit of the root `<svg>`.
+fn unit_scale(root: &roxmltree::Node) -> Result<f64> {
+    let Some(width) = root.attribute("width") else {
+        return Ok(PX_MM);
+    };
+    let w = width.trim();
+    let split = w
+        .find(|c: char| !(c.is_ascii_digit() || c == '.' || c == '-' || c == '+' || c == 'e'))
+        .unwrap_or(w.len());
+    let (value, unit) = w.split_at(split);
+    let Ok(value) = value.parse::<f64>() else {
+        return Ok(PX_MM);
+    };
+    let mm = match unit.trim() {
+        "mm" => value,
+        "cm" => 10.0 * value,
+        "in" => 25.4 * value,
+        "pt" => value * 25.4 / 72.0,
+        "" | "px" => value * PX_MM,
+        _ => return Ok(PX_MM), // %, em: no absolute size
+    };
+    let vb_width = root.attribute("viewBox").and_then(|vb| {
+        vb.split([' ', ','])
+            .filter(|s| !s.is_empty())
+            .nth(2)
+            .and_then(|s| s.parse::<f64>().ok())
+    });
+    Ok(match vb_width {
+        Some(vw) if vw > 0.0 && mm > 0.0 => mm / vw,
+        // Without a viewBox a user unit is a CSS pixel.
+        _ => PX_MM,
+    })
+}
+
+fn flatten_path(d: &str, step: f64) -> Result<Vec<[f64; 2]>> {
+    let mut pts: Vec<[f64; 2]> = Vec::new();
+    let mut start = [0.0, 0.0];
+    let mut cur = [0.0, 0.0];
+    let mut subpaths = 0;
+    for seg in SimplifyingPathParser::from(d) {
+        let seg = seg.map_err(|e| Error::invalid("svg <path> d", e.to_string()))?;
+        match seg {
+            SimplePathSegment::MoveTo { x, y } => {
+                subpaths += 1;
+                if subpaths > 1 {
+                    break; // the first sub-path is the trajectory
+                }
+                cur = [x, y];
+                start = cur;
+                pts.push(cur);
+            }
+            SimplePathSegment::LineTo { x, y } => {
+                cur = [x, y];
+                pts.push(cur);
+            }
+            SimplePathSegment::ClosePath => {
+                cur = start;
+                pts.push(cur);
+            }
+            SimplePathSegment::CurveTo {
+                x1,
+                y1,
+                x2,
+                y2,
+                x,
+                y,
+            } => {
+                let (p0, p1, p2, p3) = (cur, [x1, y1], [x2, y2], [x, y]);
+                let n = pieces(&[p0, p1, p2, p3], step);
+                for i in 1..=n {
+                    let t = i as f64 / n as f64;
+                    let s = 1.0 - t;
+                    let b = [s * s * s, 3.0 * s * s * t, 3.0 * s * t * t, t * t * t];
+                    pts.push([
+                        b[0] * p0[0] + b[1] * p1[0] + b[2] * p2[0] + b[3] * p3[0],
+                        b[0] * p0[1] + b[1] * p1[1] + b[2] * p2[1] + b[3] * p3[1],
+                    ]);
+                }
+                cur = p3;
+            }
+            SimplePathSegment::Quadratic { x1, y1, x, y } => {
+                let (p0, p1, p2) = (cur, [x1, y1], [x, y]);
+                let n = pieces(&[p0, p1, p2], step);
+                for i in 1..=n {
+                    let t = i as f64 / n as f64;
+                    let s = 1.0 - t;
+                    let b = [s * s, 2.0 * s * t, t * t];
+                    pts.push([
+                        b[0] * p0[0] + b[1] * p1[0] + b[2] * p2[0],
+                        b[0] * p0[1] + b[1] * p1[1] + b[2] * p2[1],
+                    ]);
+                }
+                cur = p2;
+            }
+        }
+    }
+    if pts.is_empty() {
+        return Err(Error::invalid("svg <path> d", "is empty"));
+    }
+    Ok(pts)
+}
+
+/// Segments for a Bézier curve so each is at most `step` long (the control
+/// polygon bounds the curve's length), capped for absurd inputs.
+fn pieces(ctrl: &[[f64; 2]], step: f64) -> usize {
+    let poly: f64 = ctrl
+        .windows(2)
+        .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
+        .sum();
+    ((poly / step).ceil() as usize).clamp(1, 10_000)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn length(p: &[[f64; 2]]) -> f64 {
+        p.windows(2)
+            .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
+            .sum()
+    }
+
+    #[test]
+    fn svg_arc_in_mm_is_flattened_and_flipped() {
+        // A half circle of radius 40 mm, drawn with an arc command, in a
+        // 200 mm wide document with a matching viewBox.
+        let svg = r#"<svg xmlns="http://www.w3.org/2000/svg" width="200mm" height="100mm" viewBox="0 0 200 100">
+            <defs><path d="M 0 0 L 1 1"/></defs>
+            <path d="M 60 60 A 40 40 0 0 1 140 60"/></svg>"#;
+        let p = svg_trajectory(svg).unwrap();
+        assert!(
+            (length(&p) - std::f64::consts::PI * 40.0).abs() < 0.2,
+            "{}",
+            length(&p)
+        );
+        // Sweep flag 1 turns clockwise on screen: over the top (y = 20 in
+        // SVG). Flipped and centred on the bounding box (100, −40): the
+        // ends at (±40, −20), the middle at (0, 20).
+        assert!(
+            (p[0][0] + 40.0).abs() < 1e-9 && (p[0][1] + 20.0).abs() < 1e-9,
+            "{:?}",
+            p[0]
+        );
+        let mid = p[p.len() / 2];
+        assert!(
+            mid[0].abs() < 0.5 && (mid[1] - 20.0).abs() < 1e-3,
+            "{mid:?}"
+        );
+        for w in p.windows(2) {
+            assert!((w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]) <= FLATTEN_MM + 1e-9);
+        }
+    }
+
+    #[test]
+    fn svg_transforms_and_pixel_units_apply() {
+        let svg = r#"<svg xmlns="http://www.w3.org/2000/svg"><g transform="translate(10,0) scale(2)">
+            <polyline points="0,0 96,0 96,96"/></g></svg>"#;
+        let p = svg_trajectory(svg).unwrap();
+        // 96 user units × 2 = 192 px = 50.8 mm.
+        assert_eq!(p.len(), 3);
+        assert!((p[1][0] - p[0][0] - 50.8).abs() < 1e-9);
+        assert!((p[2][1] - p[1][1] + 50.8).abs() < 1e-9);
+    }
+
+    #[test]
+    fn svg_cubic_and_quadratic_curves() {
+        let svg = r#"<svg xmlns="http://www.w3.org/2000/svg" width="100mm" viewBox="0 0 100 100">
+            <path d="M0,0 C 0,50 100,50 100,0 q 10 -20 20 0"/></svg>"#;
+        let p = svg_trajectory(svg).unwrap();
+        let (first, last) = (p[0], p[p.len() - 1]);
+        assert!(
+            (last[0] - first[0] - 120.0).abs() < 1e-9,
+            "{first:?} {last:?}"
+        );
+        assert!((last[1] - first[1]).abs() < 1e-9);
+        assert!(length(&p) > 150.0);
+    }
+
+    #[test]
+    fn svg_errors_name_the_problem() {
+        for (svg, want) in [
+            ("not xml", "not an SVG document"),
+            ("<html/>", "not <svg>"),
+            (
+                r#"<svg xmlns="http://www.w3.org/2000/svg"><rect/></svg>"#,
+                "no <path>",
+            ),
+            (
+                r#"<svg xmlns="http://www.w3.org/2000/svg"><path/></svg>"#,
+                "has no `d`",
+            ),
+            (
+                r#"<svg xmlns="http://www.w3.org/2000/svg"><path d="M 0 0"/></svg>"#,
+                "two distinct points",
+            ),
+            (
+                r#"<svg xmlns="http://www.w3.org/2000/svg"><line x1="a" x2="1" y1="0" y2="0"/></svg>"#,
+                "`a` is not a number",
+            ),
+        ] {
+            let e = svg_trajectory(svg).unwrap_err().to_string();
+            assert!(e.contains(want), "{svg}: {e}");
+        }
+    }
+
+    #[test]
+    fn csv_with_header_comments_and_separators() {
+        let p = csv_trajectory("x,y\n0,0\n\n# a comment\n10;0\n10\t10  # end\n20 20\n").unwrap();
+        assert_eq!(p, vec![[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [20.0, 20.0]]);
+        let e = csv_trajectory("0,0\n1,zz\n").unwrap_err().to_string();
+        assert_eq!(e, "csv line 2: `zz` is not a number");
+        let e = csv_trajectory("0,0\n5\n").unwrap_err().to_string();
+        assert!(e.starts_with("csv line 2: expected `x, y`"), "{e}");
+        assert!(csv_trajectory("").is_err());
+    }
+
+    #[test]
+    fn long_imports_are_resampled_and_centred() {
+        let text: String = (0..5000).map(|i| format!("{i},{}\n", i % 2)).collect();
+        let mut p = csv_trajectory(&text).unwrap();
+        assert_eq!(p.len(), MAX_POINTS);
+        assert_eq!(p[0], [0.0, 0.0]);
+        assert_eq!(p[MAX_POINTS - 1], [4999.0, 1.0]);
+        centre(&mut p);
+        assert!((p[0][0] + 2499.5).abs() < 1e-9);
+    }
+}

@@ -1,0 +1,518 @@
+// The modeler page: the design (DESIGN.md §3) is the one state; the editors
+// and the parameters change it, every change is recorded for undo, saved to
+// the browser, and re-sliced by the server; the preview, the statistics and
+// the checker's verdict follow.
+
+import { CurveEditor, fmt } from './editor.js';
+import { View3D } from './view3d.js';
+import { sample } from './bspline.js';
+
+const $ = (id) => document.getElementById(id);
+const STORE = 'sweepclay.design.v1';
+
+const PARAMS = [
+  ['layer_height', 'layer height Δz₀', 'mm', 0.05],
+  ['max_layer_height', 'max layer height', 'mm', 0.05],
+  ['spacing', 'spacing along Ψ', 'mm', 0.05],
+  ['nozzle_height', 'extruder height H', 'mm', 1],
+  ['width_min', 'bead width min', 'mm', 0.1],
+  ['width_max', 'bead width max', 'mm', 0.1],
+  ['overlap', 'overlap target', '', 0.01],
+  ['max_overhang_deg', 'overhang threshold', '°', 1],
+  ['feedrate', 'feedrate', 'mm/min', 50],
+];
+
+const state = {
+  meta: null,
+  design: null,
+  history: [],
+  at: -1,
+  inFlight: false,
+  pending: null,
+  lastEdit: null,
+  roundTrips: [],
+  verifyTimer: 0,
+  verifySeq: 0,
+  sliced: null,
+};
+// For tests and the curious: the last round trips (edit → preview drawn), ms.
+window.sweepclay = state;
+window.sweepclayErrors = [];
+window.addEventListener('error', (e) => window.sweepclayErrors.push(String(e.message)));
+window.addEventListener('unhandledrejection', (e) => window.sweepclayErrors.push(String(e.reason)));
+
+// ---------------------------------------------------------------- design
+
+function clone(d) {
+  return JSON.parse(JSON.stringify(d));
+}
+
+function trajectoryPoints(d) {
+  return d.trajectory.points || d.trajectory.control_points;
+}
+
+function interpolationPoints(d) {
+  return d.interpolation ? d.interpolation.control_points : [[0, 0], [1, 1]];
+}
+
+/** Replaces the design; `record` adds an undo step. */
+function setDesign(d, { record = true, fit = false } = {}) {
+  state.design = d;
+  if (record) {
+    state.history = state.history.slice(0, state.at + 1);
+    state.history.push(JSON.stringify(d));
+    if (state.history.length > 200) state.history.shift();
+    state.at = state.history.length - 1;
+  }
+  try {
+    localStorage.setItem(STORE, JSON.stringify(d));
+  } catch (e) {
+    /* private mode: no autosave */
+  }
+  for (const ed of editors) {
+    if (fit) ed.fitted = false;
+    if (fit) ed.fit();
+    ed.refresh();
+  }
+  fillParams();
+  updateUndo();
+  requestSlice(fit);
+}
+
+function edit(mutate, final) {
+  const d = clone(state.design);
+  mutate(d);
+  state.lastEdit = state.lastEdit ?? performance.now();
+  setDesign(d, { record: final });
+}
+
+function updateUndo() {
+  $('undo').disabled = state.at <= 0;
+  $('redo').disabled = state.at >= state.history.length - 1;
+}
+
+function undo() {
+  if (state.at <= 0) return;
+  state.at--;
+  setDesign(JSON.parse(state.history[state.at]), { record: false });
+}
+
+function redo() {
+  if (state.at >= state.history.length - 1) return;
+  state.at++;
+  setDesign(JSON.parse(state.history[state.at]), { record: false });
+}
+
+// ---------------------------------------------------------------- editors
+
+const curve = (pts) => (pts.length >= 2 ? sample(pts, 160) : pts);
+const MIN_DZ = 0.5;
+
+function profileEditor(id, key, otherKey) {
+  return new CurveEditor($(id), {
+    get: () => state.design[key].control_points,
+    set: (pts, final) => edit((d) => { d[key].control_points = pts; }, final),
+    curve,
+    ghost: () => state.design[otherKey].control_points,
+    ground: true,
+    snap: 1,
+    grid: 5,
+    minPoints: 2,
+    constrain: (i, [x, z], pts) => {
+      // z = 0 for the first point, strictly increasing along the curve.
+      if (i === 0) return [x, 0];
+      const lo = pts[i - 1][1] + MIN_DZ;
+      const hi = i + 1 < pts.length ? pts[i + 1][1] - MIN_DZ : Infinity;
+      if (lo > hi) return null;
+      return [x, Math.min(hi, Math.max(lo, z))];
+    },
+    label: ([x, z]) => `x ${fmt(x)}, z ${fmt(z)} mm`,
+  });
+}
+
+const editors = [
+  profileEditor('ed-start', 'profile_start', 'profile_end'),
+  profileEditor('ed-end', 'profile_end', 'profile_start'),
+  new CurveEditor($('ed-traj'), {
+    get: () => trajectoryPoints(state.design),
+    set: (pts, final) => edit((d) => {
+      if (d.trajectory.points) d.trajectory.points = pts;
+      else d.trajectory.control_points = pts;
+    }, final),
+    curve: (pts) => (state.design.trajectory.points ? pts : curve(pts)),
+    centre: true,
+    snap: 1,
+    grid: 10,
+    minPoints: 2,
+    label: ([x, y]) => `x ${fmt(x)}, y ${fmt(y)} mm`,
+  }),
+  new CurveEditor($('ed-interp'), {
+    get: () => interpolationPoints(state.design),
+    set: (pts, final) => edit((d) => { d.interpolation = { control_points: pts }; }, final),
+    curve,
+    fixed: [-0.04, -0.04, 1.04, 1.04],
+    snap: 0.02,
+    grid: 0.1,
+    minPoints: 2,
+    pinned: (i, pts) => i === 0 || i === pts.length - 1,
+    constrain: (i, [u, f], pts) => {
+      // Endpoints pinned; u strictly and f weakly increasing: monotone.
+      if (i === 0) return [0, 0];
+      if (i === pts.length - 1) return [1, 1];
+      const [pu, pf] = pts[i - 1];
+      const [nu, nf] = pts[i + 1];
+      if (nu - pu < 0.02) return null;
+      return [Math.min(nu - 0.01, Math.max(pu + 0.01, u)), Math.min(nf, Math.max(pf, f))];
+    },
+    label: ([u, f]) => `u ${fmt(u)}, λ ${fmt(f)}`,
+  }),
+];
+
+$('snap').addEventListener('change', (e) => editors.forEach((ed) => { ed.snapOn = e.target.checked; }));
+
+// ---------------------------------------------------------------- slicing
+
+let view = null;
+try {
+  view = new View3D($('view3d'));
+} catch (e) {
+  showError(String(e.message || e));
+}
+
+function requestSlice(fit) {
+  state.pending = { design: JSON.stringify(state.design), edit: state.lastEdit, fit: fit || state.pending?.fit };
+  state.lastEdit = null;
+  if (!state.inFlight) sendSlice();
+}
+
+async function sendSlice() {
+  const job = state.pending;
+  state.pending = null;
+  if (!job) return;
+  state.inFlight = true;
+  const t0 = performance.now();
+  setBusy(true);
+  try {
+    const r = await fetch('/api/slice', { method: 'POST', headers: { 'content-type': 'application/json' }, body: job.design });
+    const body = await r.json();
+    if (!r.ok) {
+      showError(body.error, body.key);
+      setVerdict(null);
+    } else {
+      showError(null);
+      render(body, job.fit);
+      const now = performance.now();
+      const since = job.edit ?? t0;
+      state.roundTrips.push({ ms: now - since, request_ms: now - t0, server_ms: body.slice_ms, samples: body.stats.sample_points });
+      if (state.roundTrips.length > 100) state.roundTrips.shift();
+      showTiming();
+      scheduleVerify(job.design);
+    }
+  } catch (e) {
+    showError(`the server did not answer: ${e.message || e}`);
+  } finally {
+    state.inFlight = false;
+    setBusy(false);
+    if (state.pending) sendSlice();
+  }
+}
+
+function render(data, fit) {
+  state.sliced = data;
+  if (view) {
+    view.update(data, state.design.params ? { ...state.meta.params, ...state.design.params } : state.meta.params, fit || !state.fittedOnce);
+    state.fittedOnce = true;
+    $('legend').innerHTML = view.legend();
+  }
+  const s = data.stats;
+  const rows = [
+    ['size', `${s.size_mm.map((v) => v.toFixed(1)).join(' × ')} mm`],
+    ['sample points', s.sample_points.toLocaleString('en')],
+    ['transition curves', s.curves.toLocaleString('en')],
+    ['passes', `${s.passes} (${s.stages} stage${s.stages > 1 ? 's' : ''})`],
+    ['returning turns', s.returning_points],
+    ['path length', `${(s.path_length_mm / 1000).toFixed(2)} m`],
+    ['clay volume', `${s.volume_ml.toFixed(1)} ml`],
+    ['printing time', `${s.time_min.toFixed(1)} min`],
+  ];
+  $('stats').innerHTML = rows.map(([k, v]) => `<tr><td>${k}</td><td data-stat="${k}">${v}</td></tr>`).join('');
+  list($('corrections'), data.corrections);
+  list($('warnings'), data.warnings);
+}
+
+function showTiming() {
+  const rt = state.roundTrips[state.roundTrips.length - 1];
+  const el = $('timing') || document.createElement('tr');
+  el.id = 'timing';
+  el.innerHTML = `<td>preview</td><td>${rt.ms.toFixed(0)} ms (server ${rt.server_ms.toFixed(0)} ms)</td>`;
+  $('stats').appendChild(el);
+}
+
+function list(ul, items) {
+  ul.innerHTML = '';
+  for (const t of items) {
+    const li = document.createElement('li');
+    li.textContent = t;
+    ul.appendChild(li);
+  }
+}
+
+function scheduleVerify(design) {
+  clearTimeout(state.verifyTimer);
+  const seq = ++state.verifySeq;
+  setVerdict('checking');
+  state.verifyTimer = setTimeout(async () => {
+    try {
+      const r = await fetch('/api/verify', { method: 'POST', headers: { 'content-type': 'application/json' }, body: design });
+      const body = await r.json();
+      if (seq !== state.verifySeq) return;
+      setVerdict(r.ok ? body : { printable: false, failures: [body.error], locations: [] });
+    } catch (e) {
+      if (seq === state.verifySeq) setVerdict(null);
+    }
+  }, 250);
+}
+
+function setVerdict(v) {
+  const el = $('verdict');
+  el.className = '';
+  if (v === null) {
+    el.textContent = '—';
+  } else if (v === 'checking') {
+    el.textContent = 'checking…';
+  } else if (v.printable) {
+    el.className = 'ok';
+    const ov = v.min_overlap != null ? `, smallest overlap ${(100 * v.min_overlap).toFixed(0)} %` : '';
+    el.textContent = `✓ printable: one continuous path, no collision, every bead supported${ov}`;
+  } else {
+    el.className = 'bad';
+    el.innerHTML = '✗ not printable<ul></ul>';
+    list(el.querySelector('ul'), [...v.failures, ...v.locations]);
+  }
+  el.dataset.printable = v && v !== 'checking' ? String(!!v.printable) : '';
+}
+
+function setBusy(on) {
+  const s = $('status');
+  if (on && !s.querySelector('.error')) s.innerHTML = '<span class="busy">slicing…</span>';
+  if (!on) s.querySelector('.busy')?.remove();
+}
+
+function showError(msg, key) {
+  const s = $('status');
+  document.querySelectorAll('#params input.bad').forEach((i) => i.classList.remove('bad'));
+  if (!msg) {
+    s.querySelector('.error')?.remove();
+    return;
+  }
+  s.innerHTML = '';
+  const div = document.createElement('div');
+  div.className = 'error';
+  div.textContent = msg;
+  s.appendChild(div);
+  const m = /^params\.(\w+)/.exec(key || msg);
+  if (m && $(`p-${m[1]}`)) $(`p-${m[1]}`).classList.add('bad');
+}
+
+// ---------------------------------------------------------------- parameters
+
+function buildParams() {
+  const form = $('params');
+  const printer = document.createElement('label');
+  printer.innerHTML = 'printer <select id="p-printer"></select>';
+  form.appendChild(printer);
+  const sel = printer.querySelector('select');
+  for (const p of state.meta.presets) {
+    const o = document.createElement('option');
+    o.value = p.name;
+    o.textContent = `${p.name} (${p.build_volume.join('×')})`;
+    sel.appendChild(o);
+  }
+  const custom = document.createElement('option');
+  custom.value = '';
+  custom.textContent = 'custom (from the file)';
+  sel.appendChild(custom);
+  sel.addEventListener('change', () => {
+    if (sel.value) edit((d) => { d.printer = sel.value; }, true);
+  });
+  for (const [key, label, unit, step] of PARAMS) {
+    const l = document.createElement('label');
+    l.innerHTML = `<span>${label} <small>${unit}</small></span>`;
+    const inp = document.createElement('input');
+    inp.type = 'number';
+    inp.step = step;
+    inp.id = `p-${key}`;
+    inp.addEventListener('change', () => {
+      const v = parseFloat(inp.value);
+      if (!Number.isFinite(v)) {
+        showError(`params.${key}: enter a number`, `params.${key}`);
+        return;
+      }
+      edit((d) => { d.params = { ...(d.params || {}), [key]: v }; }, true);
+    });
+    l.appendChild(inp);
+    form.appendChild(l);
+  }
+  $('name').addEventListener('change', () => edit((d) => { d.name = $('name').value; }, true));
+}
+
+function fillParams() {
+  const d = state.design;
+  const p = { ...state.meta.params, ...(d.params || {}) };
+  for (const [key] of PARAMS) {
+    const inp = $(`p-${key}`);
+    if (document.activeElement !== inp) inp.value = p[key];
+  }
+  const printer = typeof d.printer === 'string' ? d.printer : d.printer ? '' : 'generic';
+  $('p-printer').value = printer;
+  if (document.activeElement !== $('name')) $('name').value = d.name || '';
+}
+
+// ---------------------------------------------------------------- files
+
+function download(blob, name) {
+  const a = document.createElement('a');
+  a.href = URL.createObjectURL(blob);
+  a.download = name;
+  document.body.appendChild(a);
+  a.click();
+  a.remove();
+  setTimeout(() => URL.revokeObjectURL(a.href), 10000);
+}
+
+function baseName() {
+  const n = (state.design.name || 'sweepclay').replace(/[^A-Za-z0-9-]+/g, '_').replace(/^_+|_+$/g, '');
+  return n || 'sweepclay';
+}
+
+async function downloadFrom(route, ext, button) {
+  button.disabled = true;
+  const label = button.textContent;
+  button.textContent = 'working…';
+  try {
+    const r = await fetch(route, { method: 'POST', headers: { 'content-type': 'application/json' }, body: JSON.stringify(state.design) });
+    if (!r.ok) {
+      const body = await r.json();
+      if (body.failures) setVerdict({ printable: false, failures: body.failures, locations: body.locations || [] });
+      showError(`No ${ext.toUpperCase()} file: ${body.error}`, body.key);
+      return;
+    }
+    download(await r.blob(), `${baseName()}.${ext}`);
+  } catch (e) {
+    showError(`the server did not answer: ${e.message || e}`);
+  } finally {
+    button.disabled = false;
+    button.textContent = label;
+  }
+}
+
+function readFile(input) {
+  return new Promise((resolve, reject) => {
+    const f = input.files[0];
+    input.value = '';
+    if (!f) return;
+    const r = new FileReader();
+    r.onload = () => resolve({ name: f.name, text: String(r.result) });
+    r.onerror = () => reject(r.error);
+    r.readAsText(f);
+  });
+}
+
+$('save').addEventListener('click', () => {
+  download(new Blob([JSON.stringify(state.design, null, 1) + '\n'], { type: 'application/json' }), `${baseName()}.json`);
+});
+$('open').addEventListener('click', () => $('open-file').click());
+$('open-file').addEventListener('change', async () => {
+  const { name, text } = await readFile($('open-file'));
+  let d;
+  try {
+    d = JSON.parse(text);
+  } catch (e) {
+    showError(`${name}: not JSON: ${e.message}`);
+    return;
+  }
+  if (typeof d !== 'object' || !d || !d.profile_start || !d.profile_end || !d.trajectory) {
+    showError(`${name}: not a sweepclay design (it needs profile_start, profile_end and trajectory)`);
+    return;
+  }
+  setDesign(d, { fit: true });
+});
+$('import').addEventListener('click', () => $('import-file').click());
+$('import-file').addEventListener('change', async () => {
+  const { name, text } = await readFile($('import-file'));
+  const format = /\.svg$/i.test(name) || text.trimStart().startsWith('<') ? 'svg' : 'csv';
+  const r = await fetch(`/api/import/${format}`, { method: 'POST', body: text });
+  const body = await r.json();
+  if (!r.ok) {
+    showError(`${name}: ${body.error}`);
+    return;
+  }
+  edit((d) => { d.trajectory = { points: body.points }; }, true);
+  editors[2].fitted = false;
+  editors[2].fit();
+  editors[2].refresh();
+});
+$('download-gcode').addEventListener('click', (e) => downloadFrom('/api/gcode', 'gcode', e.currentTarget));
+$('download-stl').addEventListener('click', (e) => downloadFrom('/api/stl', 'stl', e.currentTarget));
+$('undo').addEventListener('click', undo);
+$('redo').addEventListener('click', redo);
+$('new').addEventListener('click', () => setDesign(clone(NEW_DESIGN), { fit: true }));
+$('example').addEventListener('change', (e) => {
+  const ex = state.meta.examples.find((x) => x.name === e.target.value);
+  if (ex) setDesign(clone(ex.design), { fit: true });
+  e.target.value = '';
+});
+$('colour-by').addEventListener('change', (e) => {
+  if (!view) return;
+  view.colourBy = e.target.value;
+  view.recolour();
+  $('legend').innerHTML = view.legend();
+});
+$('show-surface').addEventListener('change', (e) => { if (view) { view.showSurface = e.target.checked; view.redraw(); } });
+$('show-path').addEventListener('change', (e) => { if (view) { view.showPath = e.target.checked; view.redraw(); } });
+$('fit-view').addEventListener('click', () => view && view.fit());
+
+document.addEventListener('keydown', (e) => {
+  if (e.target instanceof HTMLInputElement || e.target instanceof HTMLSelectElement) return;
+  const mod = e.ctrlKey || e.metaKey;
+  if (mod && e.key.toLowerCase() === 'z') {
+    e.preventDefault();
+    if (e.shiftKey) redo();
+    else undo();
+  } else if (mod && e.key.toLowerCase() === 'y') {
+    e.preventDefault();
+    redo();
+  }
+});
+
+const NEW_DESIGN = {
+  sweepclay: 1,
+  name: 'new wall',
+  profile_start: { control_points: [[0, 0], [4, 20], [0, 40]] },
+  profile_end: { control_points: [[0, 0], [6, 25], [0, 50]] },
+  trajectory: { control_points: [[-50, 20], [-20, 55], [20, 55], [50, 20]] },
+  printer: 'cerambot-plus',
+};
+
+// ---------------------------------------------------------------- start
+
+async function start() {
+  const r = await fetch('/api/meta');
+  state.meta = await r.json();
+  for (const ex of state.meta.examples) {
+    const o = document.createElement('option');
+    o.value = ex.name;
+    o.textContent = `${ex.name}: ${ex.design.name || ''}`;
+    $('example').appendChild(o);
+  }
+  buildParams();
+  let d = null;
+  try {
+    d = JSON.parse(localStorage.getItem(STORE));
+  } catch (e) {
+    d = null;
+  }
+  setDesign(d && d.trajectory ? d : clone(state.meta.examples[0].design), { fit: true });
+}
+
+start().catch((e) => showError(`could not start: ${e.message || e}`));

@@ -1,0 +1,367 @@
+// A 2D control-point editor on a canvas: grid, snapping, zoom and pan, and
+// points that can be added, dragged and deleted with a mouse, a finger or a
+// pen (pointer events). The caller says what the points mean through
+// options: how to draw the curve, which moves are allowed, what happens on
+// a change.
+
+const HIT_PX = 9;
+
+export class CurveEditor {
+  /**
+   * @param {HTMLCanvasElement} canvas
+   * @param {object} o
+   *   get(): the points [[x, y], …] in model units
+   *   set(points, final): a change (final = the end of a gesture: record it)
+   *   curve(points): the polyline to draw through them
+   *   constrain(i, p, points): the allowed position for point i near p
+   *   pinned(i, points): the point can be neither moved nor deleted
+   *   minPoints: fewest points allowed
+   *   snap: grid step for snapping; grid: grid line spacing
+   *   fixed: [xmin, ymin, xmax, ymax]: a fixed view (no zoom or pan)
+   *   ground: draw the line y = 0
+   *   centre: draw and drag the centre o (the trajectory's top view)
+   *   ghost(): another curve to draw faintly, e.g. the other profile
+   *   label(p): text beside the selected point
+   */
+  constructor(canvas, o) {
+    this.canvas = canvas;
+    this.o = o;
+    this.scale = 1;
+    this.ox = 0;
+    this.oy = 0;
+    this.selected = -1;
+    this.drag = null;
+    this.snapOn = true;
+    this.fitted = false;
+    this.points = [];
+    canvas.addEventListener('pointerdown', (e) => this.down(e));
+    canvas.addEventListener('pointermove', (e) => this.move(e));
+    canvas.addEventListener('pointerup', (e) => this.up(e));
+    canvas.addEventListener('pointercancel', (e) => this.up(e));
+    canvas.addEventListener('dblclick', (e) => this.dbl(e));
+    canvas.addEventListener('contextmenu', (e) => e.preventDefault());
+    canvas.addEventListener('wheel', (e) => this.wheel(e), { passive: false });
+    canvas.addEventListener('keydown', (e) => {
+      if ((e.key === 'Delete' || e.key === 'Backspace') && this.selected >= 0) {
+        e.preventDefault();
+        this.remove(this.selected);
+      }
+    });
+    new ResizeObserver(() => this.resize()).observe(canvas);
+  }
+
+  resize() {
+    const r = this.canvas.getBoundingClientRect();
+    const dpr = window.devicePixelRatio || 1;
+    this.canvas.width = Math.max(1, Math.round(r.width * dpr));
+    this.canvas.height = Math.max(1, Math.round(r.height * dpr));
+    this.w = r.width;
+    this.h = r.height;
+    if (this.o.fixed || !this.fitted) this.fit();
+    this.draw();
+  }
+
+  /** Reads the points from the model and redraws. */
+  refresh() {
+    this.points = this.o.get().map((p) => p.slice());
+    if (this.selected >= this.points.length) this.selected = -1;
+    this.draw();
+  }
+
+  /** Frames all points (and o, for the trajectory). */
+  fit() {
+    if (!this.w) return;
+    let [x0, y0, x1, y1] = this.o.fixed || bounds(this.o.get(), this.o.centre || this.o.ground);
+    const m = 28;
+    const sx = (this.w - 2 * m) / Math.max(x1 - x0, 1e-6);
+    const sy = (this.h - 2 * m) / Math.max(y1 - y0, 1e-6);
+    this.scale = this.o.fixed ? null : Math.min(sx, sy);
+    this.sx = this.o.fixed ? sx : this.scale;
+    this.sy = this.o.fixed ? sy : this.scale;
+    this.ox = m + (this.w - 2 * m - (x1 - x0) * this.sx) / 2 - x0 * this.sx;
+    this.oy = this.h - m - (this.h - 2 * m - (y1 - y0) * this.sy) / 2 + y0 * this.sy;
+    this.fitted = true;
+  }
+
+  toScreen([x, y]) {
+    return [this.ox + x * this.sx, this.oy - y * this.sy];
+  }
+
+  toModel(px, py) {
+    return [(px - this.ox) / this.sx, (this.oy - py) / this.sy];
+  }
+
+  local(e) {
+    const r = this.canvas.getBoundingClientRect();
+    return [e.clientX - r.left, e.clientY - r.top];
+  }
+
+  hit(px, py) {
+    let best = -1;
+    let bd = HIT_PX;
+    this.points.forEach((p, i) => {
+      const [sx, sy] = this.toScreen(p);
+      const d = Math.hypot(sx - px, sy - py);
+      if (d <= bd) {
+        bd = d;
+        best = i;
+      }
+    });
+    return best;
+  }
+
+  snap(p) {
+    const s = this.o.snap;
+    if (!this.snapOn || !s) return p;
+    return p.map((v) => Math.round(v / s) * s);
+  }
+
+  down(e) {
+    this.canvas.focus();
+    const [px, py] = this.local(e);
+    this.canvas.setPointerCapture(e.pointerId);
+    const i = this.hit(px, py);
+    if (i >= 0 && e.button === 0) {
+      this.selected = i;
+      this.drag = { kind: 'point', i, moved: false };
+    } else if (this.o.centre && e.button === 0 && this.nearCentre(px, py)) {
+      this.drag = { kind: 'centre', last: this.toModel(px, py), moved: false };
+    } else if (!this.o.fixed) {
+      this.selected = i >= 0 ? i : -1;
+      this.drag = { kind: 'pan', px, py, ox: this.ox, oy: this.oy };
+    } else {
+      this.selected = -1;
+    }
+    this.draw();
+  }
+
+  nearCentre(px, py) {
+    const [sx, sy] = this.toScreen([0, 0]);
+    return Math.hypot(sx - px, sy - py) <= HIT_PX + 3;
+  }
+
+  move(e) {
+    const [px, py] = this.local(e);
+    const d = this.drag;
+    if (!d) {
+      const over = this.hit(px, py) >= 0 || (this.o.centre && this.nearCentre(px, py));
+      this.canvas.style.cursor = over ? 'grab' : this.o.fixed ? 'crosshair' : 'move';
+      return;
+    }
+    if (d.kind === 'pan') {
+      this.ox = d.ox + px - d.px;
+      this.oy = d.oy + py - d.py;
+      this.draw();
+    } else if (d.kind === 'point') {
+      if (this.o.pinned && this.o.pinned(d.i, this.points)) return;
+      let p = this.snap(this.toModel(px, py));
+      p = this.o.constrain ? this.o.constrain(d.i, p, this.points) : p;
+      if (!p) return;
+      this.points[d.i] = p;
+      d.moved = true;
+      this.o.set(this.points.map((q) => q.slice()), false);
+      this.draw();
+    } else if (d.kind === 'centre') {
+      // Moving o moves the curve the other way: o stays the origin.
+      const m = this.snap(this.toModel(px, py));
+      const dx = m[0] - d.last[0];
+      const dy = m[1] - d.last[1];
+      if (dx === 0 && dy === 0) return;
+      d.last = m;
+      this.points = this.points.map(([x, y]) => [x - dx, y - dy]);
+      this.ox += dx * this.sx;
+      this.oy -= dy * this.sy;
+      d.moved = true;
+      this.o.set(this.points.map((q) => q.slice()), false);
+      this.draw();
+    }
+  }
+
+  up(e) {
+    const d = this.drag;
+    this.drag = null;
+    if (this.canvas.hasPointerCapture(e.pointerId)) this.canvas.releasePointerCapture(e.pointerId);
+    if (d && d.moved) this.o.set(this.points.map((q) => q.slice()), true);
+  }
+
+  dbl(e) {
+    const [px, py] = this.local(e);
+    const i = this.hit(px, py);
+    if (i >= 0) {
+      this.remove(i);
+      return;
+    }
+    // Insert on the nearest segment of the control polygon.
+    const m = this.snap(this.toModel(px, py));
+    let best = 0;
+    let bd = Infinity;
+    for (let k = 0; k + 1 < this.points.length; k++) {
+      const dist = segDist(this.toScreen(this.points[k]), this.toScreen(this.points[k + 1]), [px, py]);
+      if (dist < bd) {
+        bd = dist;
+        best = k;
+      }
+    }
+    const pts = this.points.slice();
+    pts.splice(best + 1, 0, m);
+    const p = this.o.constrain ? this.o.constrain(best + 1, m, pts) : m;
+    if (!p) return;
+    pts[best + 1] = p;
+    this.points = pts;
+    this.selected = best + 1;
+    this.o.set(pts.map((q) => q.slice()), true);
+    this.draw();
+  }
+
+  remove(i) {
+    if (this.points.length <= (this.o.minPoints || 2)) return;
+    if (this.o.pinned && this.o.pinned(i, this.points)) return;
+    this.points.splice(i, 1);
+    this.selected = -1;
+    this.o.set(this.points.map((q) => q.slice()), true);
+    this.draw();
+  }
+
+  wheel(e) {
+    if (this.o.fixed) return;
+    e.preventDefault();
+    const [px, py] = this.local(e);
+    const f = Math.exp(-e.deltaY * 0.0015);
+    this.ox = px - (px - this.ox) * f;
+    this.oy = py - (py - this.oy) * f;
+    this.sx *= f;
+    this.sy *= f;
+    this.draw();
+  }
+
+  draw() {
+    const c = this.canvas.getContext('2d');
+    if (!this.w) return;
+    const dpr = this.canvas.width / this.w;
+    c.setTransform(dpr, 0, 0, dpr, 0, 0);
+    c.clearRect(0, 0, this.w, this.h);
+    this.drawGrid(c);
+    const ghost = this.o.ghost ? this.o.ghost() : null;
+    if (ghost) this.polyline(c, this.o.curve(ghost), '#c9c2b8', 1.5, [4, 3]);
+    // Control polygon, curve, points.
+    this.polyline(c, this.points, '#bbb', 1, [3, 3]);
+    this.polyline(c, this.o.curve(this.points), '#b5653a', 2.2);
+    const many = this.points.length > 150;
+    this.points.forEach((p, i) => {
+      const [x, y] = this.toScreen(p);
+      const pinned = this.o.pinned && this.o.pinned(i, this.points);
+      c.beginPath();
+      c.arc(x, y, i === this.selected ? 6 : many ? 2 : 4.5, 0, 2 * Math.PI);
+      c.fillStyle = i === this.selected ? '#1d5fbf' : pinned ? '#888' : '#fff';
+      c.fill();
+      c.strokeStyle = '#1d5fbf';
+      c.lineWidth = 1.5;
+      if (!many || i === this.selected) c.stroke();
+    });
+    if (this.o.centre) {
+      const [x, y] = this.toScreen([0, 0]);
+      c.strokeStyle = '#b3261e';
+      c.lineWidth = 2;
+      c.beginPath();
+      c.moveTo(x - 8, y);
+      c.lineTo(x + 8, y);
+      c.moveTo(x, y - 8);
+      c.lineTo(x, y + 8);
+      c.stroke();
+      c.fillStyle = '#b3261e';
+      c.font = '12px system-ui';
+      c.fillText('o', x + 5, y - 5);
+    }
+    if (this.selected >= 0 && this.points[this.selected]) {
+      const p = this.points[this.selected];
+      const [x, y] = this.toScreen(p);
+      c.fillStyle = '#1d5fbf';
+      c.font = '11px system-ui';
+      const text = this.o.label ? this.o.label(p) : `${fmt(p[0])}, ${fmt(p[1])}`;
+      c.fillText(text, Math.min(x + 8, this.w - 90), Math.max(y - 8, 12));
+    }
+  }
+
+  drawGrid(c) {
+    const step = this.o.grid || 10;
+    const [x0, y1] = this.toModel(0, 0);
+    const [x1, y0] = this.toModel(this.w, this.h);
+    const pxStep = step * this.sx;
+    const k = pxStep < 12 ? Math.ceil(12 / pxStep) : 1;
+    const s = step * k;
+    c.lineWidth = 1;
+    c.font = '10px system-ui';
+    c.fillStyle = '#999';
+    for (let x = Math.ceil(x0 / s) * s; x <= x1; x += s) {
+      const [sx] = this.toScreen([x, 0]);
+      const major = Math.abs(Math.round(x / s) % 5) === 0;
+      c.strokeStyle = major ? '#e3ded6' : '#f1eee9';
+      c.beginPath();
+      c.moveTo(sx, 0);
+      c.lineTo(sx, this.h);
+      c.stroke();
+      if (major) c.fillText(fmt(x), sx + 2, this.h - 3);
+    }
+    for (let y = Math.ceil(y0 / s) * s; y <= y1; y += s) {
+      const [, sy] = this.toScreen([0, y]);
+      const major = Math.abs(Math.round(y / s) % 5) === 0;
+      c.strokeStyle = major ? '#e3ded6' : '#f1eee9';
+      c.beginPath();
+      c.moveTo(0, sy);
+      c.lineTo(this.w, sy);
+      c.stroke();
+      if (major) c.fillText(fmt(y), 2, sy - 2);
+    }
+    if (this.o.ground) {
+      const [, gy] = this.toScreen([0, 0]);
+      c.strokeStyle = '#6b5a48';
+      c.lineWidth = 2;
+      c.beginPath();
+      c.moveTo(0, gy);
+      c.lineTo(this.w, gy);
+      c.stroke();
+    }
+  }
+
+  polyline(c, pts, colour, width, dash = []) {
+    if (!pts || pts.length < 2) return;
+    c.strokeStyle = colour;
+    c.lineWidth = width;
+    c.setLineDash(dash);
+    c.beginPath();
+    pts.forEach((p, i) => {
+      const [x, y] = this.toScreen(p);
+      if (i === 0) c.moveTo(x, y);
+      else c.lineTo(x, y);
+    });
+    c.stroke();
+    c.setLineDash([]);
+  }
+}
+
+function bounds(pts, withOrigin) {
+  let x0 = Infinity, y0 = Infinity, x1 = -Infinity, y1 = -Infinity;
+  const all = withOrigin ? pts.concat([[0, 0]]) : pts;
+  for (const [x, y] of all) {
+    x0 = Math.min(x0, x);
+    y0 = Math.min(y0, y);
+    x1 = Math.max(x1, x);
+    y1 = Math.max(y1, y);
+  }
+  if (!isFinite(x0)) return [-10, -10, 10, 10];
+  const pad = Math.max(x1 - x0, y1 - y0) * 0.12 + 5;
+  return [x0 - pad, y0 - pad, x1 + pad, y1 + pad];
+}
+
+function segDist(a, b, p) {
+  const dx = b[0] - a[0];
+  const dy = b[1] - a[1];
+  const l2 = dx * dx + dy * dy;
+  const t = l2 > 0 ? Math.max(0, Math.min(1, ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2)) : 0;
+  return Math.hypot(a[0] + t * dx - p[0], a[1] + t * dy - p[1]);
+}
+
+/** A number with at most two decimals. */
+export function fmt(v) {
+  return String(Math.round(v * 100) / 100);
+}

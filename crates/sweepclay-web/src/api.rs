@@ -1,0 +1,414 @@
+//! What the modeler's JSON API computes, without the HTTP: design text in,
+//! plain serialisable answers out. Every function is a thin composition of
+//! the library's stages (`sweepclay-core`) and the checker.
+
+use crate::verify::{verify, Verified};
+use serde::Serialize;
+use sweepclay_core::mesh;
+use sweepclay_core::toolpath::PointKind;
+use sweepclay_core::{correct, surface, Design, Error, Sliced};
+
+/// An answer the page shows as an error: an HTTP status and a message that
+/// names the key (or line) at fault.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ApiError {
+    /// HTTP status: 400 unreadable input, 413 too large, 422 a valid design
+    /// that cannot be printed or has values out of range.
+    #[serde(skip)]
+    pub status: u16,
+    /// The message, e.g. `params.layer_height: must be between …`.
+    pub error: String,
+    /// The offending key, when there is one.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub key: Option<String>,
+    /// The checker's failures, for a design whose G-code is not printable.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub failures: Vec<String>,
+    /// Where in the design the failures are.
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub locations: Vec<String>,
+}
+
+impl ApiError {
+    /// An error with a status and message.
+    pub fn new(status: u16, error: impl Into<String>) -> Self {
+        ApiError {
+            status,
+            error: error.into(),
+            key: None,
+            failures: Vec::new(),
+            locations: Vec::new(),
+        }
+    }
+}
+
+impl From<Error> for ApiError {
+    fn from(e: Error) -> Self {
+        let (status, key) = match &e {
+            Error::Parse { .. } => (400, None),
+            Error::Invalid { key, .. } => (422, Some(key.clone())),
+            _ => (422, None),
+        };
+        ApiError {
+            key,
+            ..ApiError::new(status, e.to_string())
+        }
+    }
+}
+
+/// Limits that keep one request from exhausting the machine.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub struct Limits {
+    /// Most surface samples a design may have (estimated before slicing).
+    pub max_samples: f64,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        Limits { max_samples: 1.5e6 }
+    }
+}
+
+/// Parses a design and refuses one whose sample count is over the limit.
+pub fn parse_design(text: &str, limits: &Limits) -> Result<Design, ApiError> {
+    let d = Design::from_json(text)?;
+    let est = d.estimated_samples();
+    if est > limits.max_samples {
+        return Err(ApiError {
+            key: Some("params.spacing".into()),
+            ..ApiError::new(
+                413,
+                format!(
+                    "params.spacing / params.layer_height: the design would have about {:.1} million samples, over this server's limit of {:.1} million; raise the spacing or the layer height",
+                    est / 1e6,
+                    limits.max_samples / 1e6
+                ),
+            )
+        });
+    }
+    Ok(d)
+}
+
+/// The layering the path follows.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PlanView {
+    /// K: passes.
+    pub passes: u32,
+    /// N': passes of the lower (tilted) stage; passes above it are the
+    /// upper stage.
+    pub lower_passes: u32,
+    /// 1 or 2.
+    pub stages: u8,
+    /// Layer height at the tall end in the lower stage (mm).
+    pub lower_layer_mm: f64,
+    /// Layer height of the upper stage (mm).
+    pub upper_layer_mm: f64,
+}
+
+/// The surface as an indexed triangle mesh.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SurfaceView {
+    /// x, y, z of each sample, flat, in mm relative to `o` (0.01 mm).
+    pub positions: Vec<f32>,
+    /// Triangles, flat, as sample indices.
+    pub triangles: Vec<u32>,
+    /// Samples that a correction moved by more than 0.05 mm.
+    pub moved: Vec<u32>,
+    /// Number of transition curves.
+    pub curves: usize,
+}
+
+/// The toolpath over the surface's samples.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PathView {
+    /// The sample each path point visits, in print order.
+    pub order: Vec<u32>,
+    /// Bead width per path point (mm, 0.01).
+    pub width: Vec<f32>,
+    /// Pass per path point (1-based).
+    pub pass: Vec<u32>,
+    /// Path points that are top-edge beads of returning turns.
+    pub top: Vec<u32>,
+}
+
+/// Everything the preview shows for one design.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct SliceView {
+    /// The Table-1 statistics.
+    pub stats: sweepclay_core::Stats,
+    /// The layering.
+    pub plan: PlanView,
+    /// The corrected surface.
+    pub surface: SurfaceView,
+    /// The toolpath.
+    pub path: PathView,
+    /// One line per correction (which curve, where, by how much).
+    pub corrections: Vec<String>,
+    /// Things the designer should know that are not errors.
+    pub warnings: Vec<String>,
+    /// Where the design's `o` lands on the bed (mm): positions + origin =
+    /// bed coordinates, as in `stats.bounds_mm`.
+    pub origin: [f64; 2],
+    /// Time spent slicing on the server (ms).
+    pub slice_ms: f64,
+}
+
+fn round2(x: f64) -> f32 {
+    ((x * 100.0).round() / 100.0) as f32
+}
+
+/// Slices a design and keeps what the preview shows, including which
+/// samples the corrections moved (the stages run one by one to keep the
+/// uncorrected surface).
+pub fn slice_view(design: &Design) -> Result<SliceView, ApiError> {
+    let t0 = std::time::Instant::now();
+    let sampled = surface::sample_surface(design)?;
+    let corrected = correct::correct(&sampled)?;
+    let moved: Vec<u32> = sampled
+        .samples
+        .iter()
+        .zip(&corrected.surface.samples)
+        .enumerate()
+        .filter(|(_, (a, b))| (a.xi - b.xi).abs() > 0.05)
+        .map(|(i, _)| i as u32)
+        .collect();
+    drop(sampled);
+    let sliced = sweepclay_core::finish(corrected)?;
+    let slice_ms = t0.elapsed().as_secs_f64() * 1e3;
+    Ok(view(&sliced, moved, slice_ms))
+}
+
+fn view(s: &Sliced, moved: Vec<u32>, slice_ms: f64) -> SliceView {
+    let surf = &s.corrected.surface;
+    let mut positions = Vec::with_capacity(3 * surf.samples.len());
+    for (c, col) in surf.columns.iter().enumerate() {
+        for si in col.samples() {
+            positions.extend(surf.position(c, si).map(round2));
+        }
+    }
+    let triangles = mesh::surface_triangles(surf)
+        .into_iter()
+        .flatten()
+        .collect();
+    let pts = &s.toolpath.points;
+    let path = PathView {
+        order: pts
+            .iter()
+            .map(|p| mesh::sample_of_point(surf, p) as u32)
+            .collect(),
+        width: s.extrusion.width.iter().map(|&w| round2(w)).collect(),
+        pass: pts.iter().map(|p| p.pass).collect(),
+        top: (0..pts.len() as u32)
+            .filter(|&i| pts[i as usize].kind == PointKind::Top)
+            .collect(),
+    };
+    let plan = &surf.plan;
+    let mut warnings = Vec::new();
+    if s.toolpath.stages == 2 {
+        warnings.push(format!(
+            "two stages: the ends differ by more than the extruder allows in one tilted stage; the upper {} passes climb the top edge with {} returning turns, so the rim is a sawtooth of up to one layer",
+            plan.passes - plan.lower_passes,
+            s.toolpath.returning_points
+        ));
+    }
+    let pr = &surf.printer;
+    let b = &s.stats.bounds_mm;
+    let fill = (0..3)
+        .map(|a| (b[1][a] - b[0][a]) / pr.build_volume[a])
+        .fold(0.0, f64::max);
+    if fill > 0.9 {
+        warnings.push(format!(
+            "the print fills {:.0} % of printer `{}`'s build volume along one axis",
+            100.0 * fill,
+            pr.name
+        ));
+    }
+    SliceView {
+        stats: s.stats.clone(),
+        plan: PlanView {
+            passes: plan.passes,
+            lower_passes: plan.lower_passes,
+            stages: s.toolpath.stages,
+            lower_layer_mm: plan.lower_layer_mm,
+            upper_layer_mm: plan.upper_layer_mm,
+        },
+        surface: SurfaceView {
+            positions,
+            triangles,
+            moved,
+            curves: surf.columns.len(),
+        },
+        path,
+        corrections: s.corrected.report.summary(),
+        warnings,
+        origin: pr.origin,
+        slice_ms,
+    }
+}
+
+/// The checker's verdict on a design's G-code.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Verdict {
+    /// Whether the G-code passes the check.
+    pub printable: bool,
+    /// Why not.
+    pub failures: Vec<String>,
+    /// Where in the design.
+    pub locations: Vec<String>,
+    /// Smallest overlap with the bead below (fraction of the width).
+    pub min_overlap: Option<f64>,
+    /// Lines of G-code.
+    pub lines: usize,
+}
+
+/// Slices, emits and checks a design.
+pub fn verified(design: &Design) -> Result<(Sliced, Verified), ApiError> {
+    let s = sweepclay_core::slice(design)?;
+    let v = verify(&s, 0.5);
+    Ok((s, v))
+}
+
+/// The verdict of [`verified`].
+pub fn verdict(v: &Verified) -> Verdict {
+    Verdict {
+        printable: v.report.printable,
+        failures: v.report.failures.clone(),
+        locations: v.locations.clone(),
+        min_overlap: v.report.support.min_overlap.map(|(f, _)| f),
+        lines: v.report.lines,
+    }
+}
+
+/// The G-code of a design, only if it passes the check; otherwise a 422
+/// that says why and where.
+pub fn gcode(design: &Design) -> Result<String, ApiError> {
+    let (_, v) = verified(design)?;
+    if v.report.printable {
+        Ok(v.gcode)
+    } else {
+        Err(ApiError {
+            failures: v.report.failures.clone(),
+            locations: v.locations.clone(),
+            ..ApiError::new(
+                422,
+                format!("not printable: {}", v.report.failures.join("; ")),
+            )
+        })
+    }
+}
+
+/// A binary STL of the surface thickened to the bead width.
+pub fn stl(design: &Design) -> Result<Vec<u8>, ApiError> {
+    let s = sweepclay_core::slice(design)?;
+    let mut out = Vec::new();
+    mesh::write_stl(&s, &mut out).map_err(|e| ApiError::new(500, e.to_string()))?;
+    Ok(out)
+}
+
+/// Trajectory points imported from an SVG or CSV file.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Imported {
+    /// The points (mm, relative to `o`).
+    pub points: Vec<[f64; 2]>,
+    /// Arc length (mm).
+    pub length_mm: f64,
+}
+
+/// Imports a trajectory; `format` is `svg` or `csv`.
+pub fn import(format: &str, text: &str) -> Result<Imported, ApiError> {
+    let mut points = match format {
+        "svg" => sweepclay_core::import::svg_trajectory(text)?,
+        "csv" => sweepclay_core::import::csv_trajectory(text)?,
+        other => {
+            return Err(ApiError {
+                key: Some("format".into()),
+                ..ApiError::new(
+                    400,
+                    format!("format: `{other}` is not an import format (svg, csv)"),
+                )
+            })
+        }
+    };
+    for p in &mut points {
+        *p = p.map(|x| (x * 1000.0).round() / 1000.0);
+    }
+    let length_mm = points
+        .windows(2)
+        .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
+        .sum();
+    Ok(Imported { points, length_mm })
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sweepclay_core::examples;
+
+    fn design(name: &str) -> Design {
+        Design::from_json(examples::example(name).unwrap()).unwrap()
+    }
+
+    #[test]
+    fn slice_view_indexes_every_sample_once() {
+        let v = slice_view(&design("t2")).unwrap();
+        let n = v.surface.positions.len() / 3;
+        assert_eq!(v.stats.sample_points, n);
+        let mut seen = vec![false; n];
+        for &s in &v.path.order {
+            assert!(!seen[s as usize]);
+            seen[s as usize] = true;
+        }
+        assert!(seen.iter().all(|&s| s));
+        assert_eq!(v.path.width.len(), n);
+        assert!(v.surface.triangles.iter().all(|&i| (i as usize) < n));
+        assert_eq!(v.plan.stages, 2);
+        assert!(!v.path.top.is_empty());
+        assert!(v.warnings[0].starts_with("two stages"));
+    }
+
+    #[test]
+    fn corrections_mark_moved_samples() {
+        let plain = slice_view(&design("t4")).unwrap();
+        assert!(plain.corrections.is_empty() && plain.surface.moved.is_empty());
+        // An end profile leaning 45 mm over 20 mm of height overhangs far
+        // beyond 57°: the support correction moves its upper samples.
+        let mut d = design("t4");
+        d.profile_end.control_points = vec![[0.0, 0.0], [45.0, 20.0], [45.0, 40.0]];
+        let v = slice_view(&d).unwrap();
+        assert!(!v.corrections.is_empty());
+        assert!(!v.surface.moved.is_empty());
+        let n = (v.surface.positions.len() / 3) as u32;
+        assert!(v.surface.moved.iter().all(|&i| i < n));
+    }
+
+    #[test]
+    fn sample_cap_refuses_before_slicing() {
+        let mut d = design("t1");
+        d.params.spacing = 0.02;
+        d.params.layer_height = 0.5;
+        let text = d.to_json();
+        let e = parse_design(&text, &Limits::default()).unwrap_err();
+        assert_eq!(e.status, 413);
+        assert!(e.error.contains("params.spacing"), "{}", e.error);
+    }
+
+    #[test]
+    fn errors_carry_status_and_key() {
+        let e = parse_design("{", &Limits::default()).unwrap_err();
+        assert_eq!(e.status, 400);
+        let mut d = design("t1");
+        d.params.layer_height = 0.1;
+        let e = slice_view(&d).unwrap_err();
+        assert_eq!(
+            (e.status, e.key.as_deref()),
+            (422, Some("params.layer_height"))
+        );
+        assert_eq!(import("dxf", "").unwrap_err().status, 400);
+    }
+
+    #[test]
+    fn gcode_is_verified() {
+        let text = gcode(&design("t5")).unwrap();
+        assert!(text.contains("G1"));
+    }
+}

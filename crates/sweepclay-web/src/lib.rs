@@ -1,0 +1,306 @@
+//! # sweepclay-web
+//!
+//! The interactive modeler of the paper (Zhong et al. 2020, §3 and Fig. 2):
+//! `sweepclay serve` starts a local web server whose page lets a designer
+//! draw the two profile curves, the trajectory and the interpolation curve,
+//! and see at once the surface, the toolpath and the statistics of what
+//! will print. It is a thin shell over the library: the same design file
+//! (DESIGN.md §3), the same pipeline (`sweepclay-core`) and the same
+//! checker (`sweepclay-check`).
+//!
+//! | route | body | answer |
+//! |---|---|---|
+//! | `GET /` | | the page (assets are built into the binary) |
+//! | `GET /api/meta` | | presets, default parameters, examples, limits |
+//! | `POST /api/slice` | design JSON | [`api::SliceView`]: surface mesh, path with widths, stats, corrections, warnings |
+//! | `POST /api/verify` | design JSON | [`api::Verdict`]: the checker's verdict on its G-code |
+//! | `POST /api/gcode` | design JSON | the verified G-code, or 422 with the failures and where they are |
+//! | `POST /api/stl` | design JSON | binary STL of the surface thickened to the bead width |
+//! | `POST /api/check` | G-code text | the checker's report on any G-code (query: `printer`) |
+//! | `POST /api/import/svg`, `/api/import/csv` | file text | trajectory points |
+//!
+//! Errors are JSON `{"error": "...", "key": "..."}` with a 4xx status.
+//! Bodies are capped ([`DESIGN_BODY_LIMIT`], [`GCODE_BODY_LIMIT`]) and so is
+//! a design's estimated sample count ([`api::Limits`]).
+
+pub mod api;
+pub mod verify;
+
+use api::{ApiError, Limits};
+use axum::body::Bytes;
+use axum::extract::rejection::BytesRejection;
+use axum::extract::{DefaultBodyLimit, Path, Query, State};
+use axum::http::{header, StatusCode};
+use axum::response::{IntoResponse, Response};
+use axum::routing::{get, post};
+use axum::{Json, Router};
+use serde::Deserialize;
+use std::collections::HashMap;
+use std::sync::Arc;
+use sweepclay_core::printer::PRESETS;
+use sweepclay_core::{examples, Params, Printer};
+
+/// Largest design or imported file accepted (bytes).
+pub const DESIGN_BODY_LIMIT: usize = 4 << 20;
+/// Largest G-code file `/api/check` accepts (bytes).
+pub const GCODE_BODY_LIMIT: usize = 64 << 20;
+
+/// The page's files, built into the binary: (path, content type, text).
+pub const ASSETS: &[(&str, &str, &str)] = &[
+    (
+        "index.html",
+        "text/html; charset=utf-8",
+        include_str!("../assets/index.html"),
+    ),
+    (
+        "style.css",
+        "text/css; charset=utf-8",
+        include_str!("../assets/style.css"),
+    ),
+    (
+        "app.js",
+        "text/javascript; charset=utf-8",
+        include_str!("../assets/app.js"),
+    ),
+    (
+        "editor.js",
+        "text/javascript; charset=utf-8",
+        include_str!("../assets/editor.js"),
+    ),
+    (
+        "view3d.js",
+        "text/javascript; charset=utf-8",
+        include_str!("../assets/view3d.js"),
+    ),
+    (
+        "bspline.js",
+        "text/javascript; charset=utf-8",
+        include_str!("../assets/bspline.js"),
+    ),
+];
+
+impl IntoResponse for ApiError {
+    fn into_response(self) -> Response {
+        let status = StatusCode::from_u16(self.status).unwrap_or(StatusCode::BAD_REQUEST);
+        (status, Json(self)).into_response()
+    }
+}
+
+type Shared = Arc<Limits>;
+
+/// The modeler's routes, with the given limits.
+pub fn router(limits: Limits) -> Router {
+    let design_routes = Router::new()
+        .route("/api/slice", post(slice))
+        .route("/api/verify", post(verify_design))
+        .route("/api/gcode", post(gcode))
+        .route("/api/stl", post(stl))
+        .route("/api/import/{format}", post(import))
+        .layer(DefaultBodyLimit::max(DESIGN_BODY_LIMIT));
+    let check_route = Router::new()
+        .route("/api/check", post(check))
+        .layer(DefaultBodyLimit::max(GCODE_BODY_LIMIT));
+    Router::new()
+        .route("/", get(|| asset(Path("index.html".into()))))
+        .route("/assets/{name}", get(asset))
+        .route("/api/meta", get(meta))
+        .merge(design_routes)
+        .merge(check_route)
+        .fallback(|| async { ApiError::new(404, "no such page or API route") })
+        .with_state(Arc::new(limits))
+}
+
+async fn asset(Path(name): Path<String>) -> Response {
+    match ASSETS.iter().find(|(n, _, _)| *n == name) {
+        Some((_, ty, text)) => (
+            [
+                (header::CONTENT_TYPE, *ty),
+                (header::CACHE_CONTROL, "no-cache"),
+            ],
+            *text,
+        )
+            .into_response(),
+        None => ApiError::new(404, format!("no asset `{name}`")).into_response(),
+    }
+}
+
+async fn meta(State(limits): State<Shared>) -> Response {
+    let presets: Vec<Printer> = PRESETS.iter().filter_map(|n| Printer::preset(n)).collect();
+    let examples: Vec<serde_json::Value> = examples::EXAMPLES
+        .iter()
+        .filter_map(|(file, text)| {
+            let design: serde_json::Value = serde_json::from_str(text).ok()?;
+            Some(serde_json::json!({ "name": file.trim_end_matches(".json"), "design": design }))
+        })
+        .collect();
+    Json(serde_json::json!({
+        "version": env!("CARGO_PKG_VERSION"),
+        "presets": presets,
+        "params": Params::default(),
+        "examples": examples,
+        "max_samples": limits.max_samples,
+    }))
+    .into_response()
+}
+
+/// The request body as text, with size and encoding errors as JSON.
+fn text(body: Result<Bytes, BytesRejection>) -> Result<String, ApiError> {
+    let bytes = body.map_err(|e| {
+        let status = e.status().as_u16();
+        if status == 413 {
+            ApiError::new(413, "request body too large".to_string())
+        } else {
+            ApiError::new(status, e.body_text())
+        }
+    })?;
+    String::from_utf8(bytes.to_vec())
+        .map_err(|e| ApiError::new(400, format!("the body is not UTF-8 text: {e}")))
+}
+
+/// Runs CPU-bound work off the async threads.
+async fn blocking<T: Send + 'static>(
+    f: impl FnOnce() -> Result<T, ApiError> + Send + 'static,
+) -> Result<T, ApiError> {
+    tokio::task::spawn_blocking(f)
+        .await
+        .unwrap_or_else(|e| Err(ApiError::new(500, format!("internal error: {e}"))))
+}
+
+async fn with_design<T: Send + 'static>(
+    limits: Shared,
+    body: Result<Bytes, BytesRejection>,
+    f: impl FnOnce(sweepclay_core::Design) -> Result<T, ApiError> + Send + 'static,
+) -> Result<T, ApiError> {
+    let text = text(body)?;
+    blocking(move || f(api::parse_design(&text, &limits)?)).await
+}
+
+async fn slice(
+    State(limits): State<Shared>,
+    body: Result<Bytes, BytesRejection>,
+) -> Result<Json<api::SliceView>, ApiError> {
+    with_design(limits, body, |d| api::slice_view(&d))
+        .await
+        .map(Json)
+}
+
+async fn verify_design(
+    State(limits): State<Shared>,
+    body: Result<Bytes, BytesRejection>,
+) -> Result<Json<api::Verdict>, ApiError> {
+    with_design(limits, body, |d| Ok(api::verdict(&api::verified(&d)?.1)))
+        .await
+        .map(Json)
+}
+
+fn file_name(design: &sweepclay_core::Design, ext: &str) -> String {
+    let stem: String = design
+        .name
+        .chars()
+        .map(|c| {
+            if c.is_ascii_alphanumeric() || c == '-' {
+                c
+            } else {
+                '_'
+            }
+        })
+        .collect();
+    let stem = if stem.trim_matches('_').is_empty() {
+        "sweepclay".to_string()
+    } else {
+        stem
+    };
+    format!("attachment; filename=\"{stem}.{ext}\"")
+}
+
+async fn gcode(
+    State(limits): State<Shared>,
+    body: Result<Bytes, BytesRejection>,
+) -> Result<Response, ApiError> {
+    let (name, text) = with_design(limits, body, |d| {
+        Ok((file_name(&d, "gcode"), api::gcode(&d)?))
+    })
+    .await?;
+    Ok((
+        [
+            (
+                header::CONTENT_TYPE,
+                "text/x-gcode; charset=utf-8".to_string(),
+            ),
+            (header::CONTENT_DISPOSITION, name),
+        ],
+        text,
+    )
+        .into_response())
+}
+
+async fn stl(
+    State(limits): State<Shared>,
+    body: Result<Bytes, BytesRejection>,
+) -> Result<Response, ApiError> {
+    let (name, bytes) =
+        with_design(limits, body, |d| Ok((file_name(&d, "stl"), api::stl(&d)?))).await?;
+    Ok((
+        [
+            (header::CONTENT_TYPE, "model/stl".to_string()),
+            (header::CONTENT_DISPOSITION, name),
+        ],
+        bytes,
+    )
+        .into_response())
+}
+
+async fn import(
+    Path(format): Path<String>,
+    body: Result<Bytes, BytesRejection>,
+) -> Result<Json<api::Imported>, ApiError> {
+    let text = text(body)?;
+    blocking(move || api::import(&format, &text))
+        .await
+        .map(Json)
+}
+
+#[derive(Deserialize)]
+struct CheckQuery {
+    printer: Option<String>,
+    #[serde(flatten)]
+    rest: HashMap<String, String>,
+}
+
+async fn check(
+    Query(q): Query<CheckQuery>,
+    body: Result<Bytes, BytesRejection>,
+) -> Result<Json<sweepclay_check::Report>, ApiError> {
+    if let Some(k) = q.rest.keys().next() {
+        return Err(ApiError::new(
+            400,
+            format!("unknown query key `{k}` (only `printer`)"),
+        ));
+    }
+    let name = q.printer.unwrap_or_else(|| "generic".into());
+    let printer = Printer::preset(&name).ok_or_else(|| ApiError {
+        key: Some("printer".into()),
+        ..ApiError::new(
+            422,
+            format!("printer: `{name}` is not a preset ({})", PRESETS.join(", ")),
+        )
+    })?;
+    let text = text(body)?;
+    blocking(move || {
+        Ok(sweepclay_check::check(
+            &text,
+            &verify::printer_check(&printer),
+        ))
+    })
+    .await
+    .map(Json)
+}
+
+/// Serves the modeler on `listener` until Ctrl+C.
+pub async fn run(listener: tokio::net::TcpListener, limits: Limits) -> std::io::Result<()> {
+    axum::serve(listener, router(limits))
+        .with_graceful_shutdown(async {
+            let _ = tokio::signal::ctrl_c().await;
+        })
+        .await
+}

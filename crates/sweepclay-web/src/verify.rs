@@ -1,0 +1,133 @@
+//! Sliced design → G-code → independent check (DESIGN.md §9): what `slice`
+//! and the modeler's download both run before they hand out a file, and the
+//! way back from a failing G-code line to the place in the design.
+
+use sweepclay_check::{check, CheckConfig, Report};
+use sweepclay_core::toolpath::PointKind;
+use sweepclay_core::{gcode, Params, Printer, Sliced};
+
+/// The checker's defaults with the printer's build volume, calibration and
+/// extruder body.
+pub fn printer_check(p: &Printer) -> CheckConfig {
+    CheckConfig {
+        build_volume: p.build_volume,
+        e_per_mm3: p.e_per_mm3,
+        nozzle_radius: p.nozzle_radius,
+        ..CheckConfig::default()
+    }
+}
+
+/// The check a sliced design must pass: the printer's, with the design's
+/// parameters.
+pub fn check_config(p: &Printer, params: &Params) -> CheckConfig {
+    let base = printer_check(p);
+    CheckConfig {
+        nozzle_height: params.nozzle_height,
+        width_min: params.width_min,
+        width_max: params.width_max,
+        overlap_target: params.overlap,
+        max_overhang_deg: params.max_overhang_deg,
+        first_layer_max_mm: base.first_layer_max_mm.max(params.max_layer_height + 0.05),
+        ..base
+    }
+}
+
+/// G-code of a sliced design with the check's verdict on it.
+#[derive(Debug)]
+pub struct Verified {
+    /// The G-code text.
+    pub gcode: String,
+    /// The checker's report.
+    pub report: Report,
+    /// Where in the design the first failure of each kind is (see [`locate`]).
+    pub locations: Vec<String>,
+}
+
+/// Emits the G-code of `s` and checks it, refusing beads that overlap the
+/// bead below by less than `min_overlap` of their width.
+pub fn verify(s: &Sliced, min_overlap: f64) -> Verified {
+    let (text, point_lines) = gcode::to_string_with_lines(s);
+    let surface = &s.corrected.surface;
+    let cfg = CheckConfig {
+        overlap_min: min_overlap,
+        ..check_config(&surface.printer, &surface.params)
+    };
+    let report = check(&text, &cfg);
+    let locations = failure_lines(&report)
+        .into_iter()
+        .take(5)
+        .filter_map(|l| locate(s, &point_lines, l))
+        .collect();
+    Verified {
+        gcode: text,
+        report,
+        locations,
+    }
+}
+
+/// The first line of each kind of failure in a report.
+pub fn failure_lines(r: &Report) -> Vec<usize> {
+    let sp = &r.support;
+    let mut v: Vec<usize> = [
+        &r.travel_moves,
+        &r.retractions,
+        &r.pauses,
+        &r.extrusion_without_motion,
+        &r.out_of_bounds,
+        &r.nozzle_collisions,
+        &r.carriage_collisions,
+        &sp.unsupported,
+        &sp.double_deposition,
+        &sp.under_min,
+        &sp.overhang,
+    ]
+    .iter()
+    .filter_map(|c| c.first_line)
+    .collect();
+    v.sort_unstable();
+    v.dedup();
+    v
+}
+
+/// Where in the design a G-code line of our own output is, given the line
+/// of each path point (`gcode::to_string_with_lines`).
+pub fn locate(s: &Sliced, lines: &[usize], line: usize) -> Option<String> {
+    let i = lines.partition_point(|&l| l < line);
+    if lines.get(i) != Some(&line) {
+        return None;
+    }
+    let p = &s.toolpath.points[i];
+    let col = &s.corrected.surface.columns[p.column as usize];
+    let top = if p.kind == PointKind::Top {
+        ", top-edge bead"
+    } else {
+        ""
+    };
+    Some(format!(
+        "line {line}: pass {}, transition curve {} (u = {:.3}), z = {:.2} mm{top}",
+        p.pass, p.column, col.u, p.pos[2]
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use sweepclay_core::{examples, Design};
+
+    #[test]
+    fn examples_verify_and_a_strict_floor_fails_with_locations() {
+        let d = Design::from_json(examples::example("t4").unwrap()).unwrap();
+        let s = sweepclay_core::slice(&d).unwrap();
+        let ok = verify(&s, 0.5);
+        assert!(ok.report.printable, "{:?}", ok.report.failures);
+        assert!(ok.locations.is_empty());
+        // Beads overlap the bead below by 2/3 or a bit more, never 99 %.
+        let strict = verify(&s, 0.99);
+        assert!(!strict.report.printable);
+        assert!(
+            strict.locations[0].contains("pass") && strict.locations[0].starts_with("line "),
+            "{:?}",
+            strict.locations
+        );
+    }
+}

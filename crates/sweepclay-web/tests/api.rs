@@ -1,0 +1,223 @@
+//! The JSON API over a real server on a free loopback port.
+
+use serde_json::Value;
+use sweepclay_core::examples;
+use sweepclay_web::api::Limits;
+
+/// Starts the server on 127.0.0.1:0 in the background; returns its base URL.
+async fn server(limits: Limits) -> String {
+    let listener = tokio::net::TcpListener::bind("127.0.0.1:0").await.unwrap();
+    let addr = listener.local_addr().unwrap();
+    tokio::spawn(async move {
+        axum::serve(listener, sweepclay_web::router(limits))
+            .await
+            .unwrap()
+    });
+    format!("http://{addr}")
+}
+
+async fn post(url: &str, body: impl Into<reqwest::Body>) -> reqwest::Response {
+    reqwest::Client::new()
+        .post(url)
+        .body(body)
+        .send()
+        .await
+        .unwrap()
+}
+
+#[tokio::test]
+async fn page_and_assets_are_served() {
+    let base = server(Limits::default()).await;
+    let page = reqwest::get(&base).await.unwrap();
+    assert_eq!(page.status(), 200);
+    assert!(page.headers()["content-type"]
+        .to_str()
+        .unwrap()
+        .starts_with("text/html"));
+    let html = page.text().await.unwrap();
+    assert!(html.contains("/assets/app.js"));
+    for (name, ty, _) in sweepclay_web::ASSETS {
+        let r = reqwest::get(format!("{base}/assets/{name}")).await.unwrap();
+        assert_eq!(r.status(), 200, "{name}");
+        assert_eq!(r.headers()["content-type"].to_str().unwrap(), *ty);
+    }
+    let r = reqwest::get(format!("{base}/assets/nope.js"))
+        .await
+        .unwrap();
+    assert_eq!(r.status(), 404);
+    let meta: Value = reqwest::get(format!("{base}/api/meta"))
+        .await
+        .unwrap()
+        .json()
+        .await
+        .unwrap();
+    assert_eq!(meta["examples"].as_array().unwrap().len(), 6);
+    assert_eq!(meta["params"]["layer_height"], 1.25);
+    assert_eq!(meta["presets"][0]["name"], "cerambot-plus");
+}
+
+#[tokio::test]
+async fn a_valid_design_gives_geometry_and_stats() {
+    let base = server(Limits::default()).await;
+    let r = post(
+        &format!("{base}/api/slice"),
+        examples::example("t3").unwrap(),
+    )
+    .await;
+    assert_eq!(r.status(), 200);
+    let v: Value = r.json().await.unwrap();
+    let n = v["stats"]["sample_points"].as_u64().unwrap() as usize;
+    assert_eq!(n, 15_074);
+    assert_eq!(v["stats"]["stages"], 2);
+    assert_eq!(v["surface"]["positions"].as_array().unwrap().len(), 3 * n);
+    assert_eq!(v["path"]["order"].as_array().unwrap().len(), n);
+    assert_eq!(v["path"]["width"].as_array().unwrap().len(), n);
+    assert!(v["surface"]["triangles"].as_array().unwrap().len() > 3 * n);
+    assert!(!v["path"]["top"].as_array().unwrap().is_empty());
+    assert_eq!(v["plan"]["stages"], 2);
+
+    let verdict: Value = post(
+        &format!("{base}/api/verify"),
+        examples::example("t3").unwrap(),
+    )
+    .await
+    .json()
+    .await
+    .unwrap();
+    assert_eq!(verdict["printable"], true, "{verdict}");
+
+    let r = post(
+        &format!("{base}/api/gcode"),
+        examples::example("t5").unwrap(),
+    )
+    .await;
+    assert_eq!(r.status(), 200);
+    assert!(r.headers()["content-disposition"]
+        .to_str()
+        .unwrap()
+        .contains(".gcode"));
+    let text = r.text().await.unwrap();
+    let report = sweepclay_check::check(&text, &sweepclay_check::CheckConfig::default());
+    assert!(report.printable, "{:?}", report.failures);
+
+    let r = post(&format!("{base}/api/stl"), examples::example("t5").unwrap()).await;
+    assert_eq!(r.status(), 200);
+    let bytes = r.bytes().await.unwrap();
+    let tris = u32::from_le_bytes(bytes[80..84].try_into().unwrap()) as usize;
+    assert!(tris > 1000);
+    assert_eq!(bytes.len(), 84 + 50 * tris);
+}
+
+#[tokio::test]
+async fn bad_input_gets_4xx_with_messages() {
+    let base = server(Limits::default()).await;
+    let slice = format!("{base}/api/slice");
+    // Not JSON.
+    let r = post(&slice, "{ nope").await;
+    assert_eq!(r.status(), 400);
+    let v: Value = r.json().await.unwrap();
+    assert!(v["error"].as_str().unwrap().contains("line 1"), "{v}");
+    // Unknown key.
+    let r = post(&slice, r#"{"sweepclay":1,"profile_start":{"control_points":[[0,0],[0,20]]},"profile_end":{"control_points":[[0,0],[0,20]]},"trajectory":{"control_points":[[-50,10],[50,10]]},"colour":"red"}"#).await;
+    assert_eq!(r.status(), 400);
+    let v: Value = r.json().await.unwrap();
+    assert!(v["error"].as_str().unwrap().contains("colour"), "{v}");
+    // A value out of range names the key.
+    let mut d: Value = serde_json::from_str(examples::example("t1").unwrap()).unwrap();
+    d["params"] = serde_json::json!({ "layer_height": -1 });
+    let r = post(&slice, d.to_string()).await;
+    assert_eq!(r.status(), 422);
+    let v: Value = r.json().await.unwrap();
+    assert_eq!(v["key"], "params.layer_height", "{v}");
+    // A profile that turns down.
+    let mut d: Value = serde_json::from_str(examples::example("t1").unwrap()).unwrap();
+    d["profile_start"]["control_points"] = serde_json::json!([[0, 0], [0, 30], [0, 20]]);
+    let v: Value = post(&slice, d.to_string()).await.json().await.unwrap();
+    assert!(
+        v["error"]
+            .as_str()
+            .unwrap()
+            .starts_with("profile_start.control_points"),
+        "{v}"
+    );
+    // Not UTF-8.
+    let r = post(&slice, vec![0xff, 0xfe, 0x00]).await;
+    assert_eq!(r.status(), 400);
+    // A G-code download of a design that cannot print says why.
+    let mut d: Value = serde_json::from_str(examples::example("t1").unwrap()).unwrap();
+    d["printer"] = serde_json::json!("cerambot-mini");
+    let r = post(&format!("{base}/api/gcode"), d.to_string()).await;
+    assert_eq!(r.status(), 422);
+    let v: Value = r.json().await.unwrap();
+    assert!(v["error"].as_str().unwrap().contains("does not fit"), "{v}");
+    // Unknown import format and bad CSV.
+    assert_eq!(
+        post(&format!("{base}/api/import/dxf"), "x").await.status(),
+        400
+    );
+    let r = post(&format!("{base}/api/import/csv"), "0,0\n1,zz\n").await;
+    assert_eq!(r.status(), 422);
+    let v: Value = r.json().await.unwrap();
+    assert_eq!(v["error"], "csv line 2: `zz` is not a number");
+    // Unknown route.
+    let r = reqwest::get(format!("{base}/api/nothing")).await.unwrap();
+    assert_eq!(r.status(), 404);
+}
+
+#[tokio::test]
+async fn oversize_bodies_and_sample_counts_are_refused() {
+    let base = server(Limits {
+        max_samples: 50_000.0,
+    })
+    .await;
+    let big = vec![b' '; sweepclay_web::DESIGN_BODY_LIMIT + 1];
+    let r = post(&format!("{base}/api/slice"), big).await;
+    assert_eq!(r.status(), 413);
+    let v: Value = r.json().await.unwrap();
+    assert!(v["error"].as_str().unwrap().contains("too large"), "{v}");
+    // t1 has 18,432 samples; at a third of the spacing it is over 50,000.
+    let mut d: Value = serde_json::from_str(examples::example("t1").unwrap()).unwrap();
+    d["params"] = serde_json::json!({ "spacing": 0.4 });
+    let r = post(&format!("{base}/api/slice"), d.to_string()).await;
+    assert_eq!(r.status(), 413);
+    let v: Value = r.json().await.unwrap();
+    assert_eq!(v["key"], "params.spacing");
+}
+
+#[tokio::test]
+async fn imports_and_checks() {
+    let base = server(Limits::default()).await;
+    let svg = r#"<svg xmlns="http://www.w3.org/2000/svg" width="120mm" height="60mm" viewBox="0 0 120 60"><path d="M 10 50 C 30 0, 90 0, 110 50"/></svg>"#;
+    let r = post(&format!("{base}/api/import/svg"), svg).await;
+    assert_eq!(r.status(), 200);
+    let v: Value = r.json().await.unwrap();
+    let pts = v["points"].as_array().unwrap();
+    assert!(pts.len() > 100);
+    assert!(
+        (v["length_mm"].as_f64().unwrap() - 150.0).abs() < 20.0,
+        "{}",
+        v["length_mm"]
+    );
+    // The imported curve slices as a trajectory.
+    let mut d: Value = serde_json::from_str(examples::example("t4").unwrap()).unwrap();
+    d["trajectory"] = serde_json::json!({ "points": v["points"] });
+    let r = post(&format!("{base}/api/slice"), d.to_string()).await;
+    assert_eq!(r.status(), 200, "{}", r.text().await.unwrap());
+
+    let gcode =
+        "G21\nG90\nM82\nG1 X10 Y10 Z1 F1000\nG1 X60 Y10 Z1 E5\nG1 X60 Y60 Z1\nG1 X10 Y60 Z1 E10\n";
+    let r = post(&format!("{base}/api/check?printer=generic"), gcode).await;
+    assert_eq!(r.status(), 200);
+    let v: Value = r.json().await.unwrap();
+    assert_eq!(v["printable"], false);
+    assert!(
+        v["failures"]
+            .as_array()
+            .unwrap()
+            .iter()
+            .any(|f| f.as_str().unwrap().contains("travel")),
+        "{v}"
+    );
+    let r = post(&format!("{base}/api/check?printer=nope"), gcode).await;
+    assert_eq!(r.status(), 422);
+}
