@@ -110,10 +110,10 @@ const MIN_DZ = 0.5;
 
 function profileEditor(id, key, otherKey) {
   return new CurveEditor($(id), {
-    get: () => state.design[key].control_points,
+    get: () => (state.design ? state.design[key].control_points : []),
     set: (pts, final) => edit((d) => { d[key].control_points = pts; }, final),
     curve,
-    ghost: () => state.design[otherKey].control_points,
+    ghost: () => (state.design ? state.design[otherKey].control_points : null),
     ground: true,
     snap: 1,
     grid: 5,
@@ -134,12 +134,12 @@ const editors = [
   profileEditor('ed-start', 'profile_start', 'profile_end'),
   profileEditor('ed-end', 'profile_end', 'profile_start'),
   new CurveEditor($('ed-traj'), {
-    get: () => trajectoryPoints(state.design),
+    get: () => (state.design ? trajectoryPoints(state.design) : []),
     set: (pts, final) => edit((d) => {
       if (d.trajectory.points) d.trajectory.points = pts;
       else d.trajectory.control_points = pts;
     }, final),
-    curve: (pts) => (state.design.trajectory.points ? pts : curve(pts)),
+    curve: (pts) => (state.design?.trajectory.points ? pts : curve(pts)),
     centre: true,
     snap: 1,
     grid: 10,
@@ -147,7 +147,7 @@ const editors = [
     label: ([x, y]) => `x ${fmt(x)}, y ${fmt(y)} mm`,
   }),
   new CurveEditor($('ed-interp'), {
-    get: () => interpolationPoints(state.design),
+    get: () => (state.design ? interpolationPoints(state.design) : [[0, 0], [1, 1]]),
     set: (pts, final) => edit((d) => { d.interpolation = { control_points: pts }; }, final),
     curve,
     fixed: [-0.04, -0.04, 1.04, 1.04],
@@ -167,6 +167,8 @@ const editors = [
     label: ([u, f]) => `u ${fmt(u)}, λ ${fmt(f)}`,
   }),
 ];
+
+state.editors = editors;
 
 $('snap').addEventListener('change', (e) => editors.forEach((ed) => { ed.snapOn = e.target.checked; }));
 
@@ -193,17 +195,24 @@ async function sendSlice() {
   const t0 = performance.now();
   setBusy(true);
   try {
-    const r = await fetch('/api/slice', { method: 'POST', headers: { 'content-type': 'application/json' }, body: job.design });
-    const body = await r.json();
+    const r = await fetch('/api/slice?format=binary', { method: 'POST', headers: { 'content-type': 'application/json' }, body: job.design });
+    const body = r.ok ? decode(await r.arrayBuffer()) : await r.json();
     if (!r.ok) {
       showError(body.error, body.key);
       setVerdict(null);
     } else {
       showError(null);
+      const t1 = performance.now();
       render(body, job.fit);
       const now = performance.now();
       const since = job.edit ?? t0;
-      state.roundTrips.push({ ms: now - since, request_ms: now - t0, server_ms: body.slice_ms, samples: body.stats.sample_points });
+      state.roundTrips.push({
+        ms: now - since,
+        request_ms: t1 - t0,
+        render_ms: now - t1,
+        server_ms: body.slice_ms,
+        samples: body.stats.sample_points,
+      });
       if (state.roundTrips.length > 100) state.roundTrips.shift();
       showTiming();
       scheduleVerify(job.design);
@@ -215,6 +224,30 @@ async function sendSlice() {
     setBusy(false);
     if (state.pending) sendSlice();
   }
+}
+
+/** Reads the binary slice answer (SliceView::to_binary): typed arrays, no parsing. */
+function decode(buf) {
+  const dv = new DataView(buf);
+  const magic = String.fromCharCode(...new Uint8Array(buf, 0, 4));
+  if (magic !== 'SWCL') throw new Error('unexpected answer from /api/slice');
+  const jsonLen = dv.getUint32(4, true);
+  const head = JSON.parse(new TextDecoder().decode(new Uint8Array(buf, 8, jsonLen)));
+  let o = 8 + jsonLen;
+  const next = (Type) => {
+    const n = dv.getUint32(o, true);
+    const a = new Type(buf, o + 4, n);
+    o += 4 + 4 * n;
+    return a;
+  };
+  const positions = next(Float32Array);
+  const columns = next(Uint32Array);
+  const moved = next(Uint32Array);
+  const order = next(Uint32Array);
+  const width = next(Float32Array);
+  const pass = next(Uint32Array);
+  const top = next(Uint32Array);
+  return { ...head, surface: { positions, columns, moved, curves: head.curves }, path: { order, width, pass, top } };
 }
 
 function render(data, fit) {

@@ -80,7 +80,7 @@ export class View3D {
     const n = P.length / 3;
     // Smooth normals from the triangles.
     const N = new Float32Array(P.length);
-    const T = data.surface.triangles;
+    const T = zip(P, data.surface.columns);
     for (let t = 0; t < T.length; t += 3) {
       const [a, b, c] = [T[t] * 3, T[t + 1] * 3, T[t + 2] * 3];
       const u = [P[b] - P[a], P[b + 1] - P[a + 1], P[b + 2] - P[a + 2]];
@@ -97,7 +97,7 @@ export class View3D {
     const C = new Float32Array(P.length);
     for (let i = 0; i < n; i++) C.set(CLAY, 3 * i);
     for (const i of data.surface.moved) C.set(MOVED, 3 * i);
-    this.replace('surface', this.mesh(this.lit, { pos: P, nrm: N, col: C }, new Uint32Array(T)));
+    this.replace('surface', this.mesh(this.lit, { pos: P, nrm: N, col: C }, T));
     // The path: positions in print order.
     const order = data.path.order;
     const PP = new Float32Array(order.length * 3);
@@ -319,6 +319,32 @@ export class View3D {
   up(e) {
     this.pointers.delete(e.pointerId);
   }
+}
+
+/**
+ * Triangles between adjacent transition curves, always advancing along the
+ * curve whose next sample is lower (as mesh::surface_triangles in Rust).
+ * `cols` is [first, count, first, count, …].
+ */
+export function zip(P, cols) {
+  let total = 0;
+  for (let c = 0; c + 3 < cols.length; c += 2) total += cols[c + 1] + cols[c + 3] - 2;
+  const T = new Uint32Array(3 * total);
+  let t = 0;
+  for (let c = 0; c + 3 < cols.length; c += 2) {
+    let i = cols[c];
+    let j = cols[c + 2];
+    const ae = i + cols[c + 1];
+    const be = j + cols[c + 3];
+    while (i + 1 < ae || j + 1 < be) {
+      const advanceA = i + 1 >= ae ? false : j + 1 >= be ? true : P[3 * i + 5] <= P[3 * j + 5];
+      T[t++] = i;
+      T[t++] = j;
+      if (advanceA) T[t++] = ++i;
+      else T[t++] = ++j;
+    }
+  }
+  return T;
 }
 
 function grad() {

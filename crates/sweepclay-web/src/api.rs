@@ -105,13 +105,15 @@ pub struct PlanView {
     pub upper_layer_mm: f64,
 }
 
-/// The surface as an indexed triangle mesh.
+/// The surface samples, column by column: the page zips adjacent columns
+/// into triangles as [`mesh::surface_triangles`] does (sending the
+/// triangles would triple the answer's size).
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct SurfaceView {
     /// x, y, z of each sample, flat, in mm relative to `o` (0.01 mm).
     pub positions: Vec<f32>,
-    /// Triangles, flat, as sample indices.
-    pub triangles: Vec<u32>,
+    /// First sample and sample count of each transition curve, flat.
+    pub columns: Vec<u32>,
     /// Samples that a correction moved by more than 0.05 mm.
     pub moved: Vec<u32>,
     /// Number of transition curves.
@@ -153,6 +155,60 @@ pub struct SliceView {
     pub slice_ms: f64,
 }
 
+impl SliceView {
+    /// The same answer in a compact binary form the page reads without
+    /// parsing: `SWCL`, a u32 length and that many bytes of JSON (every
+    /// field but the arrays, padded with spaces to 4 bytes), then the
+    /// arrays, each a u32 count and its little-endian values, in this
+    /// order: surface positions (f32), columns (u32), moved (u32), path
+    /// order (u32), width (f32), pass (u32), top (u32).
+    pub fn to_binary(&self) -> Vec<u8> {
+        let mut json = serde_json::to_vec(&serde_json::json!({
+            "stats": self.stats,
+            "plan": self.plan,
+            "curves": self.surface.curves,
+            "corrections": self.corrections,
+            "warnings": self.warnings,
+            "origin": self.origin,
+            "slice_ms": self.slice_ms,
+        }))
+        .expect("plain data serialises");
+        while !json.len().is_multiple_of(4) {
+            json.push(b' ');
+        }
+        let s = &self.surface;
+        let p = &self.path;
+        let words = s.positions.len()
+            + s.columns.len()
+            + s.moved.len()
+            + 3 * p.order.len()
+            + p.top.len()
+            + 7;
+        let mut out = Vec::with_capacity(8 + json.len() + 4 * words);
+        out.extend_from_slice(b"SWCL");
+        out.extend_from_slice(&(json.len() as u32).to_le_bytes());
+        out.extend_from_slice(&json);
+        fn floats(out: &mut Vec<u8>, v: &[f32]) {
+            out.extend_from_slice(&(v.len() as u32).to_le_bytes());
+            v.iter()
+                .for_each(|x| out.extend_from_slice(&x.to_le_bytes()));
+        }
+        fn ints(out: &mut Vec<u8>, v: &[u32]) {
+            out.extend_from_slice(&(v.len() as u32).to_le_bytes());
+            v.iter()
+                .for_each(|x| out.extend_from_slice(&x.to_le_bytes()));
+        }
+        floats(&mut out, &s.positions);
+        ints(&mut out, &s.columns);
+        ints(&mut out, &s.moved);
+        ints(&mut out, &p.order);
+        floats(&mut out, &p.width);
+        ints(&mut out, &p.pass);
+        ints(&mut out, &p.top);
+        out
+    }
+}
+
 fn round2(x: f64) -> f32 {
     ((x * 100.0).round() / 100.0) as f32
 }
@@ -186,9 +242,10 @@ fn view(s: &Sliced, moved: Vec<u32>, slice_ms: f64) -> SliceView {
             positions.extend(surf.position(c, si).map(round2));
         }
     }
-    let triangles = mesh::surface_triangles(surf)
-        .into_iter()
-        .flatten()
+    let columns = surf
+        .columns
+        .iter()
+        .flat_map(|c| [c.first, c.len() as u32])
         .collect();
     let pts = &s.toolpath.points;
     let path = PathView {
@@ -234,7 +291,7 @@ fn view(s: &Sliced, moved: Vec<u32>, slice_ms: f64) -> SliceView {
         },
         surface: SurfaceView {
             positions,
-            triangles,
+            columns,
             moved,
             curves: surf.columns.len(),
         },
@@ -360,10 +417,56 @@ mod tests {
         }
         assert!(seen.iter().all(|&s| s));
         assert_eq!(v.path.width.len(), n);
-        assert!(v.surface.triangles.iter().all(|&i| (i as usize) < n));
+        let cols = &v.surface.columns;
+        assert_eq!(cols.len(), 2 * v.surface.curves);
+        assert_eq!(cols[cols.len() - 2] + cols[cols.len() - 1], n as u32);
         assert_eq!(v.plan.stages, 2);
         assert!(!v.path.top.is_empty());
         assert!(v.warnings[0].starts_with("two stages"));
+    }
+
+    #[test]
+    fn binary_form_carries_the_same_arrays() {
+        let v = slice_view(&design("t2")).unwrap();
+        let b = v.to_binary();
+        assert_eq!(&b[..4], b"SWCL");
+        let u32_at = |o: usize| u32::from_le_bytes(b[o..o + 4].try_into().unwrap()) as usize;
+        let json_len = u32_at(4);
+        assert_eq!(json_len % 4, 0);
+        let head: serde_json::Value = serde_json::from_slice(&b[8..8 + json_len]).unwrap();
+        assert_eq!(head["stats"]["sample_points"], v.stats.sample_points);
+        let mut o = 8 + json_len;
+        let mut arrays = Vec::new();
+        while o < b.len() {
+            let n = u32_at(o);
+            arrays.push((o + 4, n));
+            o += 4 + 4 * n;
+        }
+        assert_eq!(o, b.len());
+        let lens: Vec<usize> = arrays.iter().map(|a| a.1).collect();
+        let n = v.stats.sample_points;
+        assert_eq!(
+            lens,
+            vec![
+                3 * n,
+                v.surface.columns.len(),
+                v.surface.moved.len(),
+                n,
+                n,
+                n,
+                v.path.top.len()
+            ]
+        );
+        // Spot-check values: the last position and the last pass.
+        let (start, _) = arrays[0];
+        let last = f32::from_le_bytes(
+            b[start + 4 * (3 * n - 1)..start + 4 * 3 * n]
+                .try_into()
+                .unwrap(),
+        );
+        assert_eq!(last, v.surface.positions[3 * n - 1]);
+        let (start, _) = arrays[5];
+        assert_eq!(u32_at(start + 4 * (n - 1)) as u32, v.path.pass[n - 1]);
     }
 
     #[test]

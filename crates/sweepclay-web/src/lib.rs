@@ -12,7 +12,7 @@
 //! |---|---|---|
 //! | `GET /` | | the page (assets are built into the binary) |
 //! | `GET /api/meta` | | presets, default parameters, examples, limits |
-//! | `POST /api/slice` | design JSON | [`api::SliceView`]: surface mesh, path with widths, stats, corrections, warnings |
+//! | `POST /api/slice` | design JSON | [`api::SliceView`]: surface samples, path with widths, stats, corrections, warnings (`?format=binary`: [`api::SliceView::to_binary`], what the page uses) |
 //! | `POST /api/verify` | design JSON | [`api::Verdict`]: the checker's verdict on its G-code |
 //! | `POST /api/gcode` | design JSON | the verified G-code, or 422 with the failures and where they are |
 //! | `POST /api/stl` | design JSON | binary STL of the surface thickened to the bead width |
@@ -175,13 +175,39 @@ async fn with_design<T: Send + 'static>(
     blocking(move || f(api::parse_design(&text, &limits)?)).await
 }
 
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct SliceQuery {
+    /// `json` (default) or `binary` ([`api::SliceView::to_binary`]).
+    format: Option<String>,
+}
+
 async fn slice(
     State(limits): State<Shared>,
+    query: Result<Query<SliceQuery>, axum::extract::rejection::QueryRejection>,
     body: Result<Bytes, BytesRejection>,
-) -> Result<Json<api::SliceView>, ApiError> {
-    with_design(limits, body, |d| api::slice_view(&d))
-        .await
-        .map(Json)
+) -> Result<Response, ApiError> {
+    let Query(q) = query.map_err(|e| ApiError::new(400, e.body_text()))?;
+    let binary = match q.format.as_deref() {
+        None | Some("json") => false,
+        Some("binary") => true,
+        Some(other) => {
+            return Err(ApiError {
+                key: Some("format".into()),
+                ..ApiError::new(400, format!("format: `{other}` is not json or binary"))
+            })
+        }
+    };
+    let view = with_design(limits, body, |d| api::slice_view(&d)).await?;
+    Ok(if binary {
+        (
+            [(header::CONTENT_TYPE, "application/octet-stream")],
+            view.to_binary(),
+        )
+            .into_response()
+    } else {
+        Json(view).into_response()
+    })
 }
 
 async fn verify_design(

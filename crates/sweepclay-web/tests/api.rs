@@ -72,7 +72,10 @@ async fn a_valid_design_gives_geometry_and_stats() {
     assert_eq!(v["surface"]["positions"].as_array().unwrap().len(), 3 * n);
     assert_eq!(v["path"]["order"].as_array().unwrap().len(), n);
     assert_eq!(v["path"]["width"].as_array().unwrap().len(), n);
-    assert!(v["surface"]["triangles"].as_array().unwrap().len() > 3 * n);
+    assert_eq!(
+        v["surface"]["columns"].as_array().unwrap().len(),
+        2 * v["stats"]["curves"].as_u64().unwrap() as usize
+    );
     assert!(!v["path"]["top"].as_array().unwrap().is_empty());
     assert_eq!(v["plan"]["stages"], 2);
 

@@ -1,0 +1,332 @@
+//! End to end in a real headless Chromium (Debian's `chromium` and
+//! `chromium-driver`), driven over WebDriver: load the page, drag a control
+//! point, see the statistics change, undo, reload (autosave), download the
+//! G-code and run the checker on it.
+//!
+//! The browser is required: without it the test fails and says how to
+//! install it. `SWEEPCLAY_SKIP_BROWSER=1` skips it on purpose (never set in
+//! CI). `SWEEPCLAY_SCREENSHOT=FILE.png` saves a screenshot of the page;
+//! `SWEEPCLAY_URL=http://127.0.0.1:PORT` tests a running `sweepclay serve`
+//! instead of an in-process server.
+
+use fantoccini::actions::{InputSource, MouseActions, PointerAction, MOUSE_BUTTON_LEFT};
+use fantoccini::{Client, ClientBuilder};
+use serde_json::{json, Value};
+use std::path::{Path, PathBuf};
+use std::process::{Child, Command, Stdio};
+use std::time::{Duration, Instant};
+
+struct Driver(Child);
+
+impl Drop for Driver {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+fn find(env: &str, candidates: &[&str]) -> Option<PathBuf> {
+    if let Ok(p) = std::env::var(env) {
+        return Some(PathBuf::from(p));
+    }
+    candidates.iter().map(PathBuf::from).find(|p| p.exists())
+}
+
+fn free_port() -> u16 {
+    std::net::TcpListener::bind("127.0.0.1:0")
+        .unwrap()
+        .local_addr()
+        .unwrap()
+        .port()
+}
+
+async fn start_browser(download_dir: &Path, profile: &Path) -> Option<(Driver, Client)> {
+    if std::env::var("SWEEPCLAY_SKIP_BROWSER").is_ok_and(|v| v == "1") {
+        eprintln!("SWEEPCLAY_SKIP_BROWSER=1: browser test skipped");
+        return None;
+    }
+    let missing = "the browser test needs Chromium and ChromeDriver: \
+                   `apt-get install chromium chromium-driver` (or set CHROMIUM and CHROMEDRIVER; \
+                   SWEEPCLAY_SKIP_BROWSER=1 skips this test)";
+    let driver = find("CHROMEDRIVER", &["/usr/bin/chromedriver"]).expect(missing);
+    let chromium = find(
+        "CHROMIUM",
+        &["/usr/bin/chromium", "/usr/bin/chromium-browser"],
+    )
+    .expect(missing);
+    let port = free_port();
+    let child = Command::new(&driver)
+        .arg(format!("--port={port}"))
+        .stdout(Stdio::null())
+        .stderr(Stdio::null())
+        .spawn()
+        .unwrap_or_else(|e| panic!("starting {}: {e}; {missing}", driver.display()));
+    let guard = Driver(child);
+    let caps = json!({
+        "goog:chromeOptions": {
+            "binary": chromium,
+            "args": [
+                "--headless=new", "--no-sandbox", "--disable-dev-shm-usage",
+                "--use-angle=swiftshader", "--enable-unsafe-swiftshader",
+                "--disable-quic", "--no-first-run", "--disable-background-networking",
+                "--disable-component-update", "--disable-sync",
+                "--window-size=1440,900",
+                format!("--user-data-dir={}", profile.display()),
+            ],
+            "prefs": {
+                "download.default_directory": download_dir,
+                "download.prompt_for_download": false,
+            }
+        }
+    });
+    let caps: serde_json::Map<String, Value> = serde_json::from_value(caps).unwrap();
+    let deadline = Instant::now() + Duration::from_secs(20);
+    loop {
+        let connector = hyper_util::client::legacy::connect::HttpConnector::new();
+        match ClientBuilder::new(connector)
+            .capabilities(caps.clone())
+            .connect(&format!("http://127.0.0.1:{port}"))
+            .await
+        {
+            Ok(c) => return Some((guard, c)),
+            Err(e) if Instant::now() > deadline => panic!("ChromeDriver did not start: {e}"),
+            Err(_) => tokio::time::sleep(Duration::from_millis(200)).await,
+        }
+    }
+}
+
+async fn js(c: &Client, script: &str) -> Value {
+    c.execute(script, vec![]).await.unwrap()
+}
+
+/// Polls a script until it returns something other than null/false.
+async fn wait_js(c: &Client, script: &str, what: &str) -> Value {
+    let deadline = Instant::now() + Duration::from_secs(30);
+    loop {
+        let v = js(c, script).await;
+        if !(v.is_null() || v == Value::Bool(false)) {
+            return v;
+        }
+        if Instant::now() > deadline {
+            let errors = js(c, "return window.sweepclayErrors").await;
+            let status = js(c, "return document.getElementById('status').textContent").await;
+            panic!("timed out waiting for {what}; page errors {errors}, status {status}");
+        }
+        tokio::time::sleep(Duration::from_millis(50)).await;
+    }
+}
+
+const SAMPLES: &str = "const e = document.querySelector('[data-stat=\"sample points\"]'); return e ? e.textContent : null";
+
+/// Screen position (viewport px) of control point `i` of editor `e`.
+async fn point_at(c: &Client, e: usize, i: &str) -> (f64, f64) {
+    let v = js(
+        c,
+        &format!(
+            "const ed = window.sweepclay.editors[{e}]; const i = {i};
+             const p = ed.toScreen(ed.points[i]); const r = ed.canvas.getBoundingClientRect();
+             return [r.left + p[0], r.top + p[1]];"
+        ),
+    )
+    .await;
+    (v[0].as_f64().unwrap(), v[1].as_f64().unwrap())
+}
+
+async fn drag(c: &Client, from: (f64, f64), by: (f64, f64), steps: usize) {
+    let mut m = MouseActions::new("mouse".into())
+        .then(PointerAction::MoveTo {
+            duration: None,
+            x: from.0.round(),
+            y: from.1.round(),
+        })
+        .then(PointerAction::Down {
+            button: MOUSE_BUTTON_LEFT,
+        });
+    for k in 1..=steps {
+        let f = k as f64 / steps as f64;
+        m = m
+            .then(PointerAction::MoveTo {
+                duration: Some(Duration::from_millis(40)),
+                x: (from.0 + by.0 * f).round(),
+                y: (from.1 + by.1 * f).round(),
+            })
+            .pause(Duration::from_millis(60));
+    }
+    m = m.then(PointerAction::Up {
+        button: MOUSE_BUTTON_LEFT,
+    });
+    c.perform_actions(m).await.unwrap();
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn draw_preview_and_download_verified_gcode() {
+    let tmp = tempfile::tempdir().unwrap();
+    let downloads = tmp.path().join("downloads");
+    std::fs::create_dir_all(&downloads).unwrap();
+    let Some((_driver, c)) = start_browser(&downloads, &tmp.path().join("profile")).await else {
+        return;
+    };
+    // SWEEPCLAY_URL points the test at a running `sweepclay serve` (e.g. a
+    // release build, to measure the round trip users get).
+    let base = match std::env::var("SWEEPCLAY_URL") {
+        Ok(url) => url.trim_end_matches('/').to_string(),
+        Err(_) => {
+            let listener = tokio::net::TcpListener::bind("127.0.0.1:0").await.unwrap();
+            let base = format!("http://{}", listener.local_addr().unwrap());
+            tokio::spawn(async move {
+                axum::serve(listener, sweepclay_web::router(Default::default()))
+                    .await
+                    .unwrap()
+            });
+            base
+        }
+    };
+
+    c.goto(&base).await.unwrap();
+    // The first design is t1: 18,432 samples, verified printable.
+    let before = wait_js(&c, SAMPLES, "the statistics").await;
+    assert_eq!(before, "18,432");
+    wait_js(
+        &c,
+        "return document.getElementById('verdict').dataset.printable === 'true'",
+        "the verdict on t1",
+    )
+    .await;
+    assert_eq!(js(&c, "return window.sweepclayErrors").await, json!([]));
+
+    // Drag the top point of the end profile 40 px up: the design grows.
+    let top = point_at(&c, 1, "ed.points.length - 1").await;
+    let n0 = js(&c, "return window.sweepclay.roundTrips.length")
+        .await
+        .as_u64()
+        .unwrap();
+    drag(&c, top, (0.0, -40.0), 20).await;
+    let after = wait_js(
+        &c,
+        &format!("const s = (() => {{ {SAMPLES} }})(); return s !== {before} && !window.sweepclay.inFlight && !window.sweepclay.pending ? s : null"),
+        "the statistics to change after the drag",
+    )
+    .await;
+    let grown: f64 = after.as_str().unwrap().replace(',', "").parse().unwrap();
+    assert!(grown > 18_432.0, "{after}");
+    let height = js(
+        &c,
+        "return window.sweepclay.design.profile_end.control_points.at(-1)[1]",
+    )
+    .await;
+    assert!(height.as_f64().unwrap() > 102.5, "{height}");
+
+    // Round trips of the live re-slices during the drag (t1-sized designs).
+    let rts = js(
+        &c,
+        &format!("return window.sweepclay.roundTrips.slice({n0}).map(r => [r.ms, r.server_ms, r.request_ms, r.render_ms])"),
+    )
+    .await;
+    let mut ms: Vec<f64> = rts
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r[0].as_f64().unwrap())
+        .collect();
+    let mut server: Vec<f64> = rts
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|r| r[1].as_f64().unwrap())
+        .collect();
+    assert!(ms.len() >= 3, "the drag re-sliced only {} times", ms.len());
+    let median = |i: usize| {
+        let mut v: Vec<f64> = rts
+            .as_array()
+            .unwrap()
+            .iter()
+            .map(|r| r[i].as_f64().unwrap())
+            .collect();
+        v.sort_by(f64::total_cmp);
+        v[v.len() / 2]
+    };
+    ms.sort_by(f64::total_cmp);
+    server.sort_by(f64::total_cmp);
+    eprintln!(
+        "live re-slices during the drag: {} round trips (edit → preview drawn), median {:.1} ms, max {:.1} ms; medians: server slicing {:.1} ms, request with transfer and parsing {:.1} ms, drawing {:.1} ms",
+        ms.len(),
+        ms[ms.len() / 2],
+        ms[ms.len() - 1],
+        server[server.len() / 2],
+        median(2),
+        median(3),
+    );
+
+    // Undo restores t1; redo brings the edit back.
+    c.execute("document.body.dispatchEvent(new KeyboardEvent('keydown', {key: 'z', ctrlKey: true, bubbles: true}))", vec![])
+        .await
+        .unwrap();
+    wait_js(
+        &c,
+        &format!("const s = (() => {{ {SAMPLES} }})(); return s === {before}"),
+        "undo",
+    )
+    .await;
+    c.execute("document.body.dispatchEvent(new KeyboardEvent('keydown', {key: 'Z', ctrlKey: true, shiftKey: true, bubbles: true}))", vec![])
+        .await
+        .unwrap();
+    wait_js(
+        &c,
+        &format!("const s = (() => {{ {SAMPLES} }})(); return s === {after}"),
+        "redo",
+    )
+    .await;
+
+    // A reload keeps the design (autosave).
+    c.refresh().await.unwrap();
+    wait_js(
+        &c,
+        &format!("const s = (() => {{ {SAMPLES} }})(); return s === {after}"),
+        "the autosaved design after a reload",
+    )
+    .await;
+
+    // Colour by stage, then a screenshot for the README.
+    c.execute("const s = document.getElementById('colour-by'); s.value = 'width'; s.dispatchEvent(new Event('change'));", vec![])
+        .await
+        .unwrap();
+    wait_js(
+        &c,
+        "return document.getElementById('verdict').dataset.printable === 'true'",
+        "the verdict on the edited design",
+    )
+    .await;
+    if let Ok(path) = std::env::var("SWEEPCLAY_SCREENSHOT") {
+        let png = c.screenshot().await.unwrap();
+        std::fs::write(&path, png).unwrap();
+        eprintln!("screenshot written to {path}");
+    }
+
+    // Download the G-code and check it independently.
+    c.find(fantoccini::Locator::Id("download-gcode"))
+        .await
+        .unwrap()
+        .click()
+        .await
+        .unwrap();
+    let deadline = Instant::now() + Duration::from_secs(30);
+    let file = loop {
+        let done = std::fs::read_dir(&downloads)
+            .unwrap()
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .find(|p| p.extension().is_some_and(|x| x == "gcode"));
+        if let Some(p) = done {
+            break p;
+        }
+        assert!(Instant::now() < deadline, "no G-code was downloaded");
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    };
+    assert_eq!(file.file_name().unwrap(), "t1_wave_ring.gcode");
+    let text = std::fs::read_to_string(&file).unwrap();
+    let printer = sweepclay_core::Printer::preset("cerambot-plus").unwrap();
+    let report = sweepclay_check::check(&text, &sweepclay_web::verify::printer_check(&printer));
+    assert!(report.printable, "{:?}", report.failures);
+    assert!(report.extruding_moves as f64 > grown - 2.0);
+    assert_eq!(js(&c, "return window.sweepclayErrors").await, json!([]));
+    c.close().await.unwrap();
+}
