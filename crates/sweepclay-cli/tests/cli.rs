@@ -286,7 +286,8 @@ fn help_documents_every_command() {
         .stdout(
             predicate::str::contains("slice")
                 .and(predicate::str::contains("check"))
-                .and(predicate::str::contains("examples")),
+                .and(predicate::str::contains("examples"))
+                .and(predicate::str::contains("serve")),
         );
     sweepclay(tmp.path())
         .args(["slice", "--help"])
@@ -298,4 +299,63 @@ fn help_documents_every_command() {
         .assert()
         .success()
         .stdout(predicate::str::contains("--nozzle-height"));
+}
+
+/// Kills the server when the test ends, even on a failed assertion.
+struct Server(std::process::Child);
+
+impl Drop for Server {
+    fn drop(&mut self) {
+        let _ = self.0.kill();
+        let _ = self.0.wait();
+    }
+}
+
+fn http_get(addr: &str, path: &str) -> String {
+    use std::io::{Read, Write};
+    let mut s = std::net::TcpStream::connect(addr).unwrap();
+    write!(
+        s,
+        "GET {path} HTTP/1.1\r\nHost: {addr}\r\nConnection: close\r\n\r\n"
+    )
+    .unwrap();
+    let mut out = String::new();
+    s.read_to_string(&mut out).unwrap();
+    out
+}
+
+#[test]
+fn serve_prints_its_url_and_answers() {
+    use std::io::BufRead;
+    let child = std::process::Command::new(assert_cmd::cargo::cargo_bin("sweepclay"))
+        .args(["serve", "--port", "0"])
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut server = Server(child);
+    let mut line = String::new();
+    std::io::BufReader::new(server.0.stdout.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    // "sweepclay modeler: http://127.0.0.1:PORT/  (Ctrl+C to stop)"
+    let url = line
+        .split_whitespace()
+        .find(|w| w.starts_with("http://127.0.0.1:"))
+        .unwrap_or_else(|| panic!("no loopback URL in {line:?}"));
+    let addr = url.trim_start_matches("http://").trim_end_matches('/');
+    let page = http_get(addr, "/");
+    assert!(page.starts_with("HTTP/1.1 200"), "{page}");
+    assert!(page.contains("sweepclay modeler"));
+    let meta = http_get(addr, "/api/meta");
+    assert!(meta.contains("cerambot-plus"), "{meta}");
+    // A second server on the same port is refused with a clear error.
+    let port = addr.rsplit(':').next().unwrap();
+    let tmp = tempfile::tempdir().unwrap();
+    sweepclay(tmp.path())
+        .args(["serve", "--port", port])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains(format!(
+            "listening on 127.0.0.1:{port}"
+        )));
 }

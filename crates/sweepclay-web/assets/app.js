@@ -394,7 +394,7 @@ function fillParams() {
   const p = { ...state.meta.params, ...(d.params || {}) };
   for (const [key] of PARAMS) {
     const inp = $(`p-${key}`);
-    if (document.activeElement !== inp) inp.value = p[key];
+    if (document.activeElement !== inp) inp.value = Number(Number(p[key]).toFixed(4));
   }
   const printer = typeof d.printer === 'string' ? d.printer : d.printer ? '' : 'generic';
   $('p-printer').value = printer;
@@ -539,12 +539,27 @@ async function start() {
     $('example').appendChild(o);
   }
   buildParams();
+  // ?example=t3 opens a bundled example; ?colour=pass|stage|width picks the
+  // toolpath colouring; ?surface=0 / ?path=0 hide one of the two.
+  const q = new URLSearchParams(location.search);
+  if (q.get('colour') && view) {
+    view.colourBy = q.get('colour');
+    $('colour-by').value = q.get('colour');
+  }
+  for (const [key, box, prop] of [['surface', 'show-surface', 'showSurface'], ['path', 'show-path', 'showPath']]) {
+    if (q.get(key) === '0' && view) {
+      view[prop] = false;
+      $(box).checked = false;
+    }
+  }
+  const asked = state.meta.examples.find((x) => x.name === q.get('example'));
   let d = null;
   try {
     d = JSON.parse(localStorage.getItem(STORE));
   } catch (e) {
     d = null;
   }
+  if (asked) d = clone(asked.design);
   setDesign(d && d.trajectory ? d : clone(state.meta.examples[0].design), { fit: true });
 }
 
