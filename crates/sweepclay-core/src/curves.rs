@@ -207,6 +207,41 @@ pub struct Trajectory {
     pub length: f64,
 }
 
+/// Arc length at each vertex of a polyline (0 at the first).
+pub fn arc_lengths(poly: &[[f64; 2]]) -> Vec<f64> {
+    let mut cum = Vec::with_capacity(poly.len());
+    let mut acc = 0.0;
+    cum.push(0.0);
+    for w in poly.windows(2) {
+        acc += dist(w[0], w[1]);
+        cum.push(acc);
+    }
+    cum
+}
+
+/// `n ≥ 2` points equally spaced by arc length along a polyline of at least
+/// two vertices, ends kept; `cum` is [`arc_lengths`] of it.
+pub fn resample_polyline(poly: &[[f64; 2]], cum: &[f64], n: usize) -> Vec<[f64; 2]> {
+    let length = cum[cum.len() - 1];
+    let mut points = Vec::with_capacity(n);
+    let mut seg = 0;
+    for m in 0..n {
+        let s = length * m as f64 / (n - 1) as f64;
+        while seg + 2 < poly.len() && cum[seg + 1] < s {
+            seg += 1;
+        }
+        let (a, b) = (poly[seg], poly[seg + 1]);
+        let l = cum[seg + 1] - cum[seg];
+        let f = if l > 0.0 {
+            ((s - cum[seg]) / l).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        points.push([a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1])]);
+    }
+    points
+}
+
 impl Trajectory {
     /// Validates Ψ (not closed, no self-intersection, non-zero length) and
     /// resamples it into `round(length / spacing) + 1` points.
@@ -249,14 +284,8 @@ impl Trajectory {
                 v
             }
         };
-        let mut cum = Vec::with_capacity(poly.len());
-        let mut acc = 0.0;
-        cum.push(0.0);
-        for w in poly.windows(2) {
-            acc += dist(w[0], w[1]);
-            cum.push(acc);
-        }
-        let length = acc;
+        let cum = arc_lengths(&poly);
+        let length = cum[cum.len() - 1];
         if length < 2.0 * spacing.max(0.5) {
             return Err(Error::invalid(
                 "trajectory",
@@ -264,22 +293,7 @@ impl Trajectory {
             ));
         }
         let n = ((length / spacing).round() as usize).max(1) + 1;
-        let mut points = Vec::with_capacity(n);
-        let mut seg = 0;
-        for m in 0..n {
-            let s = length * m as f64 / (n - 1) as f64;
-            while seg + 2 < poly.len() && cum[seg + 1] < s {
-                seg += 1;
-            }
-            let (a, b) = (poly[seg], poly[seg + 1]);
-            let l = cum[seg + 1] - cum[seg];
-            let f = if l > 0.0 {
-                ((s - cum[seg]) / l).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            points.push([a[0] + f * (b[0] - a[0]), a[1] + f * (b[1] - a[1])]);
-        }
+        let points = resample_polyline(&poly, &cum, n);
         let traj = Trajectory { points, length };
         traj.check_self_intersection()?;
         Ok(traj)

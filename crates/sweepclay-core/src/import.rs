@@ -186,25 +186,7 @@ fn resample(pts: &[[f64; 2]], max: usize) -> Vec<[f64; 2]> {
     if pts.len() <= max {
         return pts.to_vec();
     }
-    let mut cum = vec![0.0];
-    for w in pts.windows(2) {
-        cum.push(cum.last().unwrap() + (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]));
-    }
-    let total = *cum.last().unwrap();
-    let mut out = Vec::with_capacity(max);
-    let mut j = 0;
-    for i in 0..max {
-        let s = total * i as f64 / (max - 1) as f64;
-        while j + 2 < cum.len() && cum[j + 1] < s {
-            j += 1;
-        }
-        let t = ((s - cum[j]) / (cum[j + 1] - cum[j]).max(1e-12)).clamp(0.0, 1.0);
-        out.push([
-            pts[j][0] + t * (pts[j + 1][0] - pts[j][0]),
-            pts[j][1] + t * (pts[j + 1][1] - pts[j][1]),
-        ]);
-    }
-    out
+    crate::curves::resample_polyline(pts, &crate::curves::arc_lengths(pts), max)
 }
 
 fn compose(outer: &Transform, inner: &Transform) -> Transform {

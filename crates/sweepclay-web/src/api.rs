@@ -389,10 +389,9 @@ pub fn import(format: &str, text: &str) -> Result<Imported, ApiError> {
     for p in &mut points {
         *p = p.map(|x| (x * 1000.0).round() / 1000.0);
     }
-    let length_mm = points
-        .windows(2)
-        .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
-        .sum();
+    let length_mm = *sweepclay_core::curves::arc_lengths(&points)
+        .last()
+        .expect("an import has at least two points");
     Ok(Imported { points, length_mm })
 }
 

@@ -219,7 +219,13 @@ async fn verify_design(
         .map(Json)
 }
 
-fn file_name(design: &sweepclay_core::Design, ext: &str) -> String {
+/// A file download: the design's name (made safe) with `ext`.
+fn attachment(
+    design: &sweepclay_core::Design,
+    ext: &str,
+    content_type: &'static str,
+    body: impl Into<axum::body::Body>,
+) -> Response {
     let stem: String = design
         .name
         .chars()
@@ -231,49 +237,43 @@ fn file_name(design: &sweepclay_core::Design, ext: &str) -> String {
             }
         })
         .collect();
-    let stem = if stem.trim_matches('_').is_empty() {
-        "sweepclay".to_string()
-    } else {
-        stem
+    let stem = match stem.trim_matches('_') {
+        "" => "sweepclay",
+        s => s,
     };
-    format!("attachment; filename=\"{stem}.{ext}\"")
+    (
+        [
+            (header::CONTENT_TYPE, content_type.to_string()),
+            (
+                header::CONTENT_DISPOSITION,
+                format!("attachment; filename=\"{stem}.{ext}\""),
+            ),
+        ],
+        body.into(),
+    )
+        .into_response()
 }
 
 async fn gcode(
     State(limits): State<Shared>,
     body: Result<Bytes, BytesRejection>,
 ) -> Result<Response, ApiError> {
-    let (name, text) = with_design(limits, body, |d| {
-        Ok((file_name(&d, "gcode"), api::gcode(&d)?))
+    with_design(limits, body, |d| {
+        let text = api::gcode(&d)?;
+        Ok(attachment(&d, "gcode", "text/x-gcode; charset=utf-8", text))
     })
-    .await?;
-    Ok((
-        [
-            (
-                header::CONTENT_TYPE,
-                "text/x-gcode; charset=utf-8".to_string(),
-            ),
-            (header::CONTENT_DISPOSITION, name),
-        ],
-        text,
-    )
-        .into_response())
+    .await
 }
 
 async fn stl(
     State(limits): State<Shared>,
     body: Result<Bytes, BytesRejection>,
 ) -> Result<Response, ApiError> {
-    let (name, bytes) =
-        with_design(limits, body, |d| Ok((file_name(&d, "stl"), api::stl(&d)?))).await?;
-    Ok((
-        [
-            (header::CONTENT_TYPE, "model/stl".to_string()),
-            (header::CONTENT_DISPOSITION, name),
-        ],
-        bytes,
-    )
-        .into_response())
+    with_design(limits, body, |d| {
+        let bytes = api::stl(&d)?;
+        Ok(attachment(&d, "stl", "model/stl", bytes))
+    })
+    .await
 }
 
 async fn import(
