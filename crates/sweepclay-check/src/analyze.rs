@@ -37,8 +37,15 @@ impl Bead {
         };
         let (x, y) = (self.from[0] + t * dx, self.from[1] + t * dy);
         let z = self.from[2] + t * (self.to[2] - self.from[2]);
-        (t, (p[0] - x).hypot(p[1] - y), z, [x, y])
+        (t, len2(p[0] - x, p[1] - y), z, [x, y])
     }
+}
+
+/// Length of a plan vector. Not `f64::hypot`: that guards against
+/// overflow at a cost this hot loop cannot pay, and an overflow to
+/// infinity only makes a distance compare as far.
+fn len2(dx: f64, dy: f64) -> f64 {
+    (dx * dx + dy * dy).sqrt()
 }
 
 fn cell(v: f64, size: f64) -> i32 {
@@ -48,44 +55,91 @@ fn cell(v: f64, size: f64) -> i32 {
 #[derive(Default)]
 struct BeadGrid {
     cells: FxHashMap<(i32, i32, i32), Vec<u32>>,
+    /// Highest clay top in each plan column, every bead.
     column_max: FxHashMap<(i32, i32), f64>,
+    /// The same for settled beads only: those far enough back along the
+    /// path that the nozzle is no longer laying them (see `settle`).
+    settled_max: FxHashMap<(i32, i32), f64>,
+}
+
+/// Cell ranges of a bead: plan x, plan y, z (inclusive), and its top.
+type Span = ([i32; 2], [i32; 2], [i32; 2], f64);
+
+/// Which beads a query's column tops count.
+#[derive(Clone, Copy, PartialEq)]
+enum Tops {
+    All,
+    Settled,
 }
 
 impl BeadGrid {
-    fn insert(&mut self, b: &Bead, id: u32) {
-        let (x0, x1) = (
+    /// The cells a bead spans: plan x and y ranges, z range and top, or
+    /// `None` for a move so long (other slicers) that indexing it would
+    /// exhaust memory.
+    fn span(b: &Bead) -> Option<Span> {
+        let x = [
             cell(b.from[0].min(b.to[0]), CELL_XY),
             cell(b.from[0].max(b.to[0]), CELL_XY),
-        );
-        let (y0, y1) = (
+        ];
+        let y = [
             cell(b.from[1].min(b.to[1]), CELL_XY),
             cell(b.from[1].max(b.to[1]), CELL_XY),
-        );
+        ];
         let ztop = b.from[2].max(b.to[2]);
-        let (z0, z1) = (cell(b.from[2].min(b.to[2]), CELL_Z), cell(ztop, CELL_Z));
-        // Very long moves (other slicers) are bounded to keep memory sane.
-        if (x1 - x0 + 1) as i64 * (y1 - y0 + 1) as i64 * (z1 - z0 + 1) as i64 > 100_000 {
+        let z = [cell(b.from[2].min(b.to[2]), CELL_Z), cell(ztop, CELL_Z)];
+        let n = (x[1] - x[0] + 1) as i64 * (y[1] - y[0] + 1) as i64 * (z[1] - z[0] + 1) as i64;
+        (n <= 100_000).then_some((x, y, z, ztop))
+    }
+
+    fn insert(&mut self, b: &Bead, id: u32) {
+        let Some((xs, ys, zs, ztop)) = Self::span(b) else {
             return;
-        }
-        for x in x0..=x1 {
-            for y in y0..=y1 {
+        };
+        for x in xs[0]..=xs[1] {
+            for y in ys[0]..=ys[1] {
                 let m = self.column_max.entry((x, y)).or_insert(f64::MIN);
                 *m = m.max(ztop);
-                for z in z0..=z1 {
+                for z in zs[0]..=zs[1] {
                     self.cells.entry((x, y, z)).or_default().push(id);
                 }
             }
         }
     }
 
-    /// Ids in cells within `r` (plan) of `p` and heights `zlo..=zhi`.
-    fn for_each(&self, p: [f64; 3], r: f64, zlo: f64, zhi: f64, mut f: impl FnMut(u32)) {
+    /// Counts a bead in the settled column tops.
+    fn settle(&mut self, b: &Bead) {
+        let Some((xs, ys, _, ztop)) = Self::span(b) else {
+            return;
+        };
+        for x in xs[0]..=xs[1] {
+            for y in ys[0]..=ys[1] {
+                let m = self.settled_max.entry((x, y)).or_insert(f64::MIN);
+                *m = m.max(ztop);
+            }
+        }
+    }
+
+    /// Ids in cells within `r` (plan) of `p` and heights `zlo..=zhi`,
+    /// skipping plan columns whose `tops` are below `zlo`.
+    fn for_each(
+        &self,
+        p: [f64; 3],
+        r: f64,
+        zlo: f64,
+        zhi: f64,
+        tops: Tops,
+        mut f: impl FnMut(u32),
+    ) {
         let (x0, x1) = (cell(p[0] - r, CELL_XY), cell(p[0] + r, CELL_XY));
         let (y0, y1) = (cell(p[1] - r, CELL_XY), cell(p[1] + r, CELL_XY));
         let (z0, z1) = (cell(zlo, CELL_Z), cell(zhi, CELL_Z));
+        let tops = match tops {
+            Tops::All => &self.column_max,
+            Tops::Settled => &self.settled_max,
+        };
         for x in x0..=x1 {
             for y in y0..=y1 {
-                let Some(&top) = self.column_max.get(&(x, y)) else {
+                let Some(&top) = tops.get(&(x, y)) else {
                     continue;
                 };
                 if top < zlo {
@@ -135,8 +189,7 @@ fn pick_support(cands: &[Candidate], min_layer: f64, near_bed: bool) -> Option<C
             .iter()
             .filter(|c| {
                 let rise = c.z - best.z;
-                rise >= min_layer
-                    && rise >= 0.5 * (c.at[0] - best.at[0]).hypot(c.at[1] - best.at[1])
+                rise >= min_layer && rise >= 0.5 * len2(c.at[0] - best.at[0], c.at[1] - best.at[1])
             })
             .min_by(|a, b| a.d.total_cmp(&b.d));
         match next {
@@ -238,6 +291,7 @@ pub fn check(text: &str, cfg: &CheckConfig) -> Report {
     // Deposition replay: support and collisions.
     let mut beads: Vec<Bead> = Vec::new();
     let mut grid = BeadGrid::default();
+    let mut unsettled: std::collections::VecDeque<u32> = std::collections::VecDeque::new();
     let mut stamp: Vec<u32> = Vec::new();
     let mut s = 0.0f64;
     let mut top_z = f64::MIN;
@@ -269,22 +323,38 @@ pub fn check(text: &str, cfg: &CheckConfig) -> Report {
                 m.from[2] + t * (m.to[2] - m.from[2]),
             ];
             let sp = s_start + t * len;
+            // Beads the nozzle has left behind count for collisions.
+            while let Some(&j) = unsettled.front() {
+                let b = &beads[j as usize];
+                if b.s_end > sp - recent_nozzle {
+                    break;
+                }
+                grid.settle(b);
+                unsettled.pop_front();
+            }
             if top_z > p[2] + cfg.nozzle_height + cfg.collision_tolerance_mm {
                 r.carriage_collisions
                     .add(m.line, top_z - p[2] - cfg.nozzle_height);
             }
             let mut worst: f64 = 0.0;
             let zlo = p[2] + cfg.collision_tolerance_mm;
-            grid.for_each(p, reach, zlo, p[2] + cfg.nozzle_height, |id| {
-                let b = &beads[id as usize];
-                if b.s_end > sp - recent_nozzle {
-                    return;
-                }
-                let (_, d, z, _) = b.closest(p);
-                if z > zlo && d < cfg.nozzle_radius + b.width / 2.0 {
-                    worst = worst.max(z - p[2]);
-                }
-            });
+            grid.for_each(
+                p,
+                reach,
+                zlo,
+                p[2] + cfg.nozzle_height,
+                Tops::Settled,
+                |id| {
+                    let b = &beads[id as usize];
+                    if b.s_end > sp - recent_nozzle {
+                        return;
+                    }
+                    let (_, d, z, _) = b.closest(p);
+                    if z > zlo && d < cfg.nozzle_radius + b.width / 2.0 {
+                        worst = worst.max(z - p[2]);
+                    }
+                },
+            );
             if worst > 0.0 {
                 r.nozzle_collisions.add(m.line, worst);
             }
@@ -341,7 +411,7 @@ pub fn check(text: &str, cfg: &CheckConfig) -> Report {
                 // a turn or a step-up is approached (or passed alongside)
                 // and a layer down; a bead laid again right on top of an
                 // earlier one (d ≈ 0) is neither.
-                let from_end = (m.from[0] - at[0]).hypot(m.from[1] - at[1]);
+                let from_end = len2(m.from[0] - at[0], m.from[1] - at[1]);
                 if s_start - b.s_end <= 1.5 * d + 1e-6
                     && (d > from_end + 0.1 || m.from[2] - z < 0.5)
                 {
@@ -373,9 +443,16 @@ pub fn check(text: &str, cfg: &CheckConfig) -> Report {
             };
             // Beads covering the middle are within w/2; look wider only
             // when none is (to measure an overhang).
-            grid.for_each(mid, cfg.width_max / 2.0 + 0.5, zlo, zhi, &mut visit);
+            grid.for_each(
+                mid,
+                cfg.width_max / 2.0 + 0.5,
+                zlo,
+                zhi,
+                Tops::All,
+                &mut visit,
+            );
             if !covered.get() {
-                grid.for_each(mid, cfg.width_max, zlo, zhi, &mut visit);
+                grid.for_each(mid, cfg.width_max, zlo, zhi, Tops::All, &mut visit);
             }
             r.support.beads += 1;
             if double {
@@ -444,6 +521,7 @@ pub fn check(text: &str, cfg: &CheckConfig) -> Report {
             step,
         };
         grid.insert(&bead, id);
+        unsettled.push_back(id);
         top_z = top_z.max(bead.from[2].max(bead.to[2]));
         beads.push(bead);
     }

@@ -234,21 +234,35 @@ fn find_self_intersection(s: &Surface) -> Option<(u32, u32, [f64; 3])> {
         grid.insert(*p, id as u32);
     }
     let w2 = w * w;
+    // Ids are numbered column by column, so in every cell's list the
+    // owners never decrease and the curves near `mine` along Ψ form one
+    // run, skipped by two binary searches: each point looks only at far
+    // curves, and consecutive points in one cell share the cell lookups.
+    let mut lists: Vec<&[u32]> = Vec::new();
+    let mut last: Option<[f64; 3]> = None;
     for (id, p) in pos.iter().enumerate() {
+        if last.is_none_or(|q| !grid.same_cell(q, *p)) {
+            lists = grid.near_lists(*p);
+            last = Some(*p);
+        }
         let mine = owner[id] as i64;
-        let mut hit = None;
-        grid.for_each_near(*p, |other| {
-            if hit.is_some() || (owner[other as usize] as i64 - mine).abs() <= far {
-                return;
+        for ids in &lists {
+            let (first, last) = (
+                owner[ids[0] as usize] as i64,
+                owner[ids[ids.len() - 1] as usize] as i64,
+            );
+            if first >= mine - far && last <= mine + far {
+                continue; // only curves near this one along Ψ
             }
-            let q = pos[other as usize];
-            let d2 = (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2);
-            if d2 < w2 {
-                hit = Some(owner[other as usize]);
+            let lo = ids.partition_point(|&o| (owner[o as usize] as i64) < mine - far);
+            let hi = ids.partition_point(|&o| (owner[o as usize] as i64) <= mine + far);
+            for &other in ids[..lo].iter().chain(&ids[hi..]) {
+                let q = pos[other as usize];
+                let d2 = (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2);
+                if d2 < w2 {
+                    return Some((owner[id], owner[other as usize], *p));
+                }
             }
-        });
-        if let Some(b) = hit {
-            return Some((owner[id], b, *p));
         }
     }
     None

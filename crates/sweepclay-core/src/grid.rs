@@ -91,17 +91,26 @@ impl Grid3 {
 
     /// Calls `f` for every point in the 27 cells around `p` (all points
     /// within one cell side are among them).
-    pub fn for_each_near(&self, p: [f64; 3], mut f: impl FnMut(u32)) {
+    /// The id lists of the cell holding `p` and its 26 neighbours, in a
+    /// fixed order (ids in each list in insertion order).
+    pub fn near_lists(&self, p: [f64; 3]) -> Vec<&[u32]> {
         let (x, y, z) = self.key(p);
+        let mut out = Vec::with_capacity(27);
         for dx in -1..=1 {
             for dy in -1..=1 {
                 for dz in -1..=1 {
                     if let Some(v) = self.cells.get(&(x + dx, y + dy, z + dz)) {
-                        v.iter().for_each(|&id| f(id));
+                        out.push(v.as_slice());
                     }
                 }
             }
         }
+        out
+    }
+
+    /// Whether `a` and `b` fall in the same cell.
+    pub fn same_cell(&self, a: [f64; 3], b: [f64; 3]) -> bool {
+        self.key(a) == self.key(b)
     }
 }
 
@@ -115,8 +124,7 @@ mod tests {
         g.insert([0.2, 0.2, 0.2], 1);
         g.insert([1.1, 0.9, 0.0], 2);
         g.insert([5.0, 5.0, 5.0], 3);
-        let mut found = vec![];
-        g.for_each_near([0.5, 0.5, 0.5], |i| found.push(i));
+        let mut found: Vec<u32> = g.near_lists([0.5, 0.5, 0.5]).concat();
         found.sort();
         assert_eq!(found, vec![1, 2]);
     }
