@@ -85,11 +85,12 @@ pub fn emit<W: Write>(s: &Sliced, out: &mut W) -> io::Result<Vec<usize>> {
     if !pr.start_gcode.is_empty() && !pr.start_gcode.ends_with('\n') {
         writeln!(out)?;
     }
-    let points: Vec<[f64; 3]> = s.toolpath.points.iter().map(|p| p.pos).collect();
     let before = out.count;
+    let points = &s.toolpath.points;
     let lines = emit_moves(
-        out,
-        &points,
+        out.inner,
+        points.len(),
+        |i| points[i].pos,
         &s.extrusion,
         &MoveFormat {
             origin: o,
@@ -121,55 +122,108 @@ pub struct MoveFormat {
     pub travel_feed_mm_min: f64,
 }
 
+/// Appends `v` with `decimals` (≤ 8) digits after the point: the integer
+/// `round(v · 10^decimals)` split at the point, no `-0`. Equal to
+/// `format!("{v:.N}")` except where v·10^N lies within a rounding error of
+/// a tie (both are then correct to half a unit of the last digit).
+pub fn push_fixed(buf: &mut Vec<u8>, v: f64, decimals: usize) {
+    const POW: [f64; 9] = [1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8];
+    const IPOW: [i64; 9] = [
+        1,
+        10,
+        100,
+        1000,
+        10_000,
+        100_000,
+        1_000_000,
+        10_000_000,
+        100_000_000,
+    ];
+    let r = (v * POW[decimals]).round();
+    if !(r.abs() < 9.0e15) {
+        // Out of i64's exact range, or not a number: the slow, general way.
+        use std::io::Write as _;
+        let _ = write!(buf, "{v:.decimals$}");
+        return;
+    }
+    let mut n = r as i64;
+    if n < 0 {
+        buf.push(b'-');
+        n = -n;
+    }
+    let mut ib = itoa::Buffer::new();
+    buf.extend_from_slice(ib.format(n / IPOW[decimals]).as_bytes());
+    if decimals > 0 {
+        buf.push(b'.');
+        let mut frac = n % IPOW[decimals];
+        let mut digits = [b'0'; 8];
+        for d in digits[..decimals].iter_mut().rev() {
+            *d = b'0' + (frac % 10) as u8;
+            frac /= 10;
+        }
+        buf.extend_from_slice(&digits[..decimals]);
+    }
+}
+
 /// Writes the moves: a `G0` to the first point, then one `G1` per point
 /// with E for the bead volume, preceded by `;WIDTH:` / `;HEIGHT:` when the
 /// bead size (to 3 decimals) changes. Coordinates have 3 decimals, E 5;
-/// absolute E never repeats a value.
-#[allow(clippy::needless_range_loop)] // indexes points, widths, heights, volumes together
+/// absolute E never repeats a value. `n` points, the i-th at `pos(i)`.
+/// Returns the 1-based line (counted from the first line written here) of
+/// each point's move.
 pub fn emit_moves<W: Write>(
     out: &mut W,
-    points: &[[f64; 3]],
+    n: usize,
+    pos: impl Fn(usize) -> [f64; 3],
     ex: &Extrusion,
     f: &MoveFormat,
 ) -> io::Result<Vec<usize>> {
-    let mut out = Lines {
-        inner: out,
-        count: 0,
-    };
-    let out = &mut out;
+    const CHUNK: usize = 1 << 16;
     let o = f.origin;
-    let p0 = points[0];
-    writeln!(
-        out,
-        "G0 F{} X{:.3} Y{:.3} Z{:.3}",
-        f.travel_feed_mm_min,
-        p0[0] + o[0],
-        p0[1] + o[1],
-        p0[2]
-    )?;
-    let mut lines = Vec::with_capacity(points.len());
-    lines.push(out.count);
+    let mut buf: Vec<u8> = Vec::with_capacity(CHUNK + 256);
+    let mut line = 1;
+    let mut lines = Vec::with_capacity(n);
+    let xyz = |buf: &mut Vec<u8>, p: [f64; 3]| {
+        buf.extend_from_slice(b"X");
+        push_fixed(buf, p[0] + o[0], 3);
+        buf.extend_from_slice(b" Y");
+        push_fixed(buf, p[1] + o[1], 3);
+        buf.extend_from_slice(b" Z");
+        push_fixed(buf, p[2], 3);
+    };
+    let mut ib = itoa::Buffer::new();
+    buf.extend_from_slice(b"G0 F");
+    if f.travel_feed_mm_min.fract() == 0.0 && f.travel_feed_mm_min.abs() < 1e15 {
+        buf.extend_from_slice(ib.format(f.travel_feed_mm_min as i64).as_bytes());
+    } else {
+        buf.extend_from_slice(f.travel_feed_mm_min.to_string().as_bytes());
+    }
+    buf.push(b' ');
+    xyz(&mut buf, pos(0));
+    buf.push(b'\n');
+    lines.push(line);
     let mut e_total = 0.0f64;
     let mut e_printed = 0.0f64;
-    let (mut last_w, mut last_h) = (String::new(), String::new());
-    for i in 1..points.len() {
-        let w = format!("{:.3}", 0.5 * (ex.width[i] + ex.width[i - 1]));
-        let h = format!("{:.3}", 0.5 * (ex.layer_height[i] + ex.layer_height[i - 1]));
-        if w != last_w {
-            writeln!(out, ";WIDTH:{w}")?;
-            last_w = w;
+    let (mut last_w, mut last_h) = (i64::MIN, i64::MIN);
+    for i in 1..n {
+        let w = 0.5 * (ex.width[i] + ex.width[i - 1]);
+        let h = 0.5 * (ex.layer_height[i] + ex.layer_height[i - 1]);
+        let (wq, hq) = ((w * 1e3).round() as i64, (h * 1e3).round() as i64);
+        if wq != last_w {
+            buf.extend_from_slice(b";WIDTH:");
+            push_fixed(&mut buf, w, 3);
+            buf.push(b'\n');
+            line += 1;
+            last_w = wq;
         }
-        if h != last_h {
-            writeln!(out, ";HEIGHT:{h}")?;
-            last_h = h;
+        if hq != last_h {
+            buf.extend_from_slice(b";HEIGHT:");
+            push_fixed(&mut buf, h, 3);
+            buf.push(b'\n');
+            line += 1;
+            last_h = hq;
         }
         let de = ex.volume[i] * f.e_per_mm3;
-        let p = points[i];
-        let feed = if i == 1 {
-            format!("F{} ", f.feed_mm_min)
-        } else {
-            String::new()
-        };
         let e = if f.relative_e {
             de.max(1e-5)
         } else {
@@ -177,15 +231,24 @@ pub fn emit_moves<W: Write>(
             e_printed = (e_printed + 1e-5).max(e_total);
             e_printed
         };
-        writeln!(
-            out,
-            "G1 {feed}X{:.3} Y{:.3} Z{:.3} E{e:.5}",
-            p[0] + o[0],
-            p[1] + o[1],
-            p[2]
-        )?;
-        lines.push(out.count);
+        buf.extend_from_slice(b"G1 ");
+        if i == 1 {
+            buf.push(b'F');
+            buf.extend_from_slice(f.feed_mm_min.to_string().as_bytes());
+            buf.push(b' ');
+        }
+        xyz(&mut buf, pos(i));
+        buf.extend_from_slice(b" E");
+        push_fixed(&mut buf, e, 5);
+        buf.push(b'\n');
+        line += 1;
+        lines.push(line);
+        if buf.len() >= CHUNK {
+            out.write_all(&buf)?;
+            buf.clear();
+        }
     }
+    out.write_all(&buf)?;
     Ok(lines)
 }
 
@@ -245,7 +308,7 @@ mod tests {
             vec![0.0, 3.75, 3.75, 5.0],
         );
         let mut out = Vec::new();
-        let lines = emit_moves(&mut out, &pts, &e, &FMT).unwrap();
+        let lines = emit_moves(&mut out, pts.len(), |i| pts[i], &e, &FMT).unwrap();
         assert_eq!(lines, vec![1, 4, 5, 7]);
         assert_eq!(
             String::from_utf8(out).unwrap(),
@@ -257,6 +320,46 @@ mod tests {
              ;WIDTH:3.500\n\
              G1 X103.000 Y50.000 Z2.500 E1.25000\n"
         );
+    }
+
+    #[test]
+    fn fixed_point_matches_the_standard_formatter() {
+        let mut rng = 0x9e3779b97f4a7c15u64;
+        let mut mismatches = 0;
+        let cases = 200_000;
+        for k in 0..cases {
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            let mag = [1e-4, 1.0, 150.0, 1e4][k % 4];
+            let v = ((rng >> 11) as f64 / (1u64 << 53) as f64 - 0.3) * mag;
+            for d in [3, 5] {
+                let mut b = Vec::new();
+                push_fixed(&mut b, v, d);
+                let ours = String::from_utf8(b).unwrap();
+                let std = format!("{v:.d$}");
+                let std = if std.trim_start_matches(['-', '0', '.']).is_empty() {
+                    std.trim_start_matches('-').to_string()
+                } else {
+                    std
+                };
+                if ours != std {
+                    mismatches += 1;
+                    let (a, b): (f64, f64) = (ours.parse().unwrap(), std.parse().unwrap());
+                    assert!(
+                        (a - b).abs() <= 1.01 * 10f64.powi(-(d as i32)),
+                        "{v}: {ours} vs {std}"
+                    );
+                }
+            }
+        }
+        // Only near-ties may differ, by one unit of the last digit.
+        assert!(mismatches < cases / 1000, "{mismatches} mismatches");
+        let mut b = Vec::new();
+        push_fixed(&mut b, -0.0001, 3);
+        push_fixed(&mut b, f64::NAN, 3);
+        push_fixed(&mut b, 1e300, 1);
+        assert!(String::from_utf8(b).unwrap().starts_with("0.000NaN1000000"));
     }
 
     #[test]
@@ -286,7 +389,8 @@ mod tests {
         let mut out = Vec::new();
         emit_moves(
             &mut out,
-            &pts,
+            pts.len(),
+            |i| pts[i],
             &e,
             &MoveFormat {
                 relative_e: true,
@@ -301,7 +405,7 @@ mod tests {
         );
         // Absolute E never repeats a value, so every move extrudes.
         let mut out = Vec::new();
-        emit_moves(&mut out, &pts, &e, &FMT).unwrap();
+        emit_moves(&mut out, pts.len(), |i| pts[i], &e, &FMT).unwrap();
         assert!(String::from_utf8(out)
             .unwrap()
             .ends_with("E0.30000\nG1 X101.000 Y50.000 Z1.000 E0.30001\n"));
