@@ -140,7 +140,7 @@ pub fn push_fixed(buf: &mut Vec<u8>, v: f64, decimals: usize) {
         100_000_000,
     ];
     let r = (v * POW[decimals]).round();
-    if !(r.abs() < 9.0e15) {
+    if r.is_nan() || r.abs() >= 9.0e15 {
         // Out of i64's exact range, or not a number: the slow, general way.
         use std::io::Write as _;
         let _ = write!(buf, "{v:.decimals$}");
