@@ -3,8 +3,8 @@
 //! ("what clay is below this bead?", "is clay inside the nozzle cylinder?")
 //! looks at a few cells, not at every earlier bead.
 
-use crate::parse::{parse, Diagnostic};
-use crate::replay::{replay, Event, Move};
+use crate::parse::{Diagnostic, Line, LineParser};
+use crate::replay::{Event, Move, Replayer};
 use crate::report::{Count, Report};
 use crate::CheckConfig;
 use rustc_hash::FxHashMap;
@@ -223,96 +223,251 @@ fn minmax(slot: &mut Option<[(f64, usize); 2]>, v: f64, line: usize) {
 
 /// Checks a G-code text. Never panics, whatever the input.
 pub fn check(text: &str, cfg: &CheckConfig) -> Report {
-    let mut diags: Vec<Diagnostic> = Vec::new();
-    let lines = parse(text, &mut diags);
-    let events = replay(&lines, &mut diags);
-    let mut r = Report {
-        lines: text.lines().count(),
-        ..Report::default()
-    };
-    let is_extruding = |m: &Move| m.de > EPS_E;
-    let first = events
-        .iter()
-        .position(|e| matches!(e, Event::Move(m) if is_extruding(m)));
-    let last = events
-        .iter()
-        .rposition(|e| matches!(e, Event::Move(m) if is_extruding(m)));
+    let mut c = Checker::new(cfg);
+    text.lines().for_each(|l| c.line(l));
+    c.finish()
+}
 
-    // Continuity.
-    let mut in_run = false;
-    for (i, ev) in events.iter().enumerate() {
-        let inside = first.is_some_and(|f| i > f) && last.is_some_and(|l| i < l);
-        match ev {
-            Event::Pause(line) => {
-                if inside {
-                    r.pauses.add(*line, 0.0);
-                    in_run = false;
-                }
+/// Checks G-code read line by line from `input`, holding no more of the
+/// text than one line: for files too large to read into memory. Bytes that
+/// are not UTF-8 are replaced, as by `String::from_utf8_lossy`.
+pub fn check_reader<R: std::io::BufRead>(
+    mut input: R,
+    cfg: &CheckConfig,
+) -> std::io::Result<Report> {
+    let mut c = Checker::new(cfg);
+    let mut buf = Vec::new();
+    loop {
+        buf.clear();
+        if input.read_until(b'\n', &mut buf)? == 0 {
+            break;
+        }
+        if buf.last() == Some(&b'\n') {
+            buf.pop();
+            if buf.last() == Some(&b'\r') {
+                buf.pop();
             }
-            Event::Move(m) => {
-                r.moves += 1;
-                let len = m.length();
-                if m.de < -EPS_E {
-                    if first.is_some_and(|f| i > f) {
-                        r.retractions.add(m.line, -m.de);
-                    }
-                    in_run = false;
-                } else if is_extruding(m) {
-                    r.extruding_moves += 1;
-                    if len == 0.0 {
-                        r.extrusion_without_motion.add(m.line, m.de);
-                    }
-                    if !in_run {
-                        r.extrusion_runs += 1;
-                        if r.run_starts.len() < 20 {
-                            r.run_starts.push(m.line);
-                        }
-                    }
-                    in_run = true;
-                } else if len > 0.0 {
-                    if inside {
-                        r.travel_moves.add(m.line, len);
-                    }
-                    in_run = false;
-                }
-                // Bounds.
-                let bv = cfg.build_volume;
-                let out =
-                    m.to.iter()
-                        .zip(bv)
-                        .fold(0.0f64, |o, (&v, lim)| o.max(-v).max(v - lim));
-                if out > 1e-3 {
-                    r.out_of_bounds.add(m.line, out);
-                }
-            }
+        }
+        match std::str::from_utf8(&buf) {
+            Ok(l) => c.line(l),
+            Err(_) => c.line(&String::from_utf8_lossy(&buf)),
+        }
+    }
+    Ok(c.finish())
+}
+
+/// Checks G-code as it is written: an `io::Write` that feeds each complete
+/// line to the check, so a writer can verify its output in the same pass
+/// without keeping it. [`CheckWriter::finish`] gives the report.
+pub struct CheckWriter<'a> {
+    checker: Checker<'a>,
+    partial: Vec<u8>,
+}
+
+impl<'a> CheckWriter<'a> {
+    /// A check with `cfg`, fed by writing to it.
+    pub fn new(cfg: &'a CheckConfig) -> Self {
+        CheckWriter {
+            checker: Checker::new(cfg),
+            partial: Vec::new(),
         }
     }
 
-    // Deposition replay: support and collisions.
-    let mut beads: Vec<Bead> = Vec::new();
-    let mut grid = BeadGrid::default();
-    let mut unsettled: std::collections::VecDeque<u32> = std::collections::VecDeque::new();
-    let mut stamp: Vec<u32> = Vec::new();
-    let mut s = 0.0f64;
-    let mut top_z = f64::MIN;
-    let mut lo = [f64::MAX; 3];
-    let mut hi = [f64::MIN; 3];
-    let mut layer_heights = Vec::new();
-    let mut cands: Vec<Candidate> = Vec::new();
-    let recent_nozzle = cfg.nozzle_radius + cfg.width_max;
-    let reach = cfg.nozzle_radius + cfg.width_max / 2.0;
-    for (i, ev) in events.iter().enumerate() {
-        let Event::Move(m) = ev else { continue };
+    fn feed(&mut self, mut bytes: &[u8]) {
+        if bytes.last() == Some(&b'\r') {
+            bytes = &bytes[..bytes.len() - 1];
+        }
+        match std::str::from_utf8(bytes) {
+            Ok(l) => self.checker.line(l),
+            Err(_) => self.checker.line(&String::from_utf8_lossy(bytes)),
+        }
+    }
+
+    /// The report on everything written (a last line without a newline
+    /// included).
+    pub fn finish(mut self) -> Report {
+        if !self.partial.is_empty() {
+            let last = std::mem::take(&mut self.partial);
+            self.feed(&last);
+        }
+        self.checker.finish()
+    }
+}
+
+impl std::io::Write for CheckWriter<'_> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        let mut rest = buf;
+        while let Some(nl) = rest.iter().position(|&b| b == b'\n') {
+            if self.partial.is_empty() {
+                self.feed(&rest[..nl]);
+            } else {
+                self.partial.extend_from_slice(&rest[..nl]);
+                let line = std::mem::take(&mut self.partial);
+                self.feed(&line);
+                self.partial = line;
+                self.partial.clear();
+            }
+            rest = &rest[nl + 1..];
+        }
+        self.partial.extend_from_slice(rest);
+        Ok(buf.len())
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        Ok(())
+    }
+}
+
+/// A count whose occurrences only count if an extrusion follows them
+/// (travel, pauses and collisions between two beads, not after the last).
+#[derive(Clone, Copy)]
+enum Deferred {
+    Travel,
+    Pause,
+    Nozzle,
+    Carriage,
+}
+
+/// The check as a state machine fed one line at a time, in one pass: what
+/// happens after the first bead is held back until the next bead proves it
+/// was not after the last one.
+struct Checker<'a> {
+    cfg: &'a CheckConfig,
+    parser: LineParser,
+    line: Line,
+    replayer: Replayer,
+    diags: Vec<Diagnostic>,
+    r: Report,
+    /// An extruding move has been seen.
+    started: bool,
+    in_run: bool,
+    pending: Vec<(Deferred, usize, f64)>,
+    beads: Vec<Bead>,
+    grid: BeadGrid,
+    unsettled: std::collections::VecDeque<u32>,
+    stamp: Vec<u32>,
+    s: f64,
+    top_z: f64,
+    lo: [f64; 3],
+    hi: [f64; 3],
+    layer_heights: Vec<f64>,
+    cands: Vec<Candidate>,
+}
+
+impl<'a> Checker<'a> {
+    fn new(cfg: &'a CheckConfig) -> Self {
+        Checker {
+            cfg,
+            parser: LineParser::default(),
+            line: Line::empty(),
+            replayer: Replayer::default(),
+            diags: Vec::new(),
+            r: Report::default(),
+            started: false,
+            in_run: false,
+            pending: Vec::new(),
+            beads: Vec::new(),
+            grid: BeadGrid::default(),
+            unsettled: Default::default(),
+            stamp: Vec::new(),
+            s: 0.0,
+            top_z: f64::MIN,
+            lo: [f64::MAX; 3],
+            hi: [f64::MIN; 3],
+            layer_heights: Vec::new(),
+            cands: Vec::new(),
+        }
+    }
+
+    fn line(&mut self, raw: &str) {
+        self.r.lines += 1;
+        let n = self.r.lines;
+        if !self.parser.parse(raw, n, &mut self.diags, &mut self.line) {
+            return;
+        }
+        match self.replayer.feed(&self.line, &mut self.diags) {
+            Some(Event::Pause(line)) => {
+                if self.started {
+                    self.pending.push((Deferred::Pause, line, 0.0));
+                    self.in_run = false;
+                }
+            }
+            Some(Event::Move(m)) => self.step(&m),
+            None => {}
+        }
+    }
+
+    fn defer_or_add(&mut self, extruding: bool, kind: Deferred, line: usize, v: f64) {
+        if extruding {
+            self.count(kind).add(line, v);
+        } else {
+            self.pending.push((kind, line, v));
+        }
+    }
+
+    fn count(&mut self, kind: Deferred) -> &mut crate::report::Count {
+        match kind {
+            Deferred::Travel => &mut self.r.travel_moves,
+            Deferred::Pause => &mut self.r.pauses,
+            Deferred::Nozzle => &mut self.r.nozzle_collisions,
+            Deferred::Carriage => &mut self.r.carriage_collisions,
+        }
+    }
+
+    fn step(&mut self, m: &Move) {
+        let cfg = self.cfg;
+        let is_extruding = m.de > EPS_E;
         let len = m.length();
-        let s_start = s;
-        s += len;
+        // Continuity.
+        self.r.moves += 1;
+        if m.de < -EPS_E {
+            if self.started {
+                self.r.retractions.add(m.line, -m.de);
+            }
+            self.in_run = false;
+        } else if is_extruding {
+            self.started = true;
+            // Whatever happened since the last bead was between beads.
+            for (kind, line, v) in std::mem::take(&mut self.pending) {
+                self.count(kind).add(line, v);
+            }
+            self.r.extruding_moves += 1;
+            if len == 0.0 {
+                self.r.extrusion_without_motion.add(m.line, m.de);
+            }
+            if !self.in_run {
+                self.r.extrusion_runs += 1;
+                if self.r.run_starts.len() < 20 {
+                    self.r.run_starts.push(m.line);
+                }
+            }
+            self.in_run = true;
+        } else if len > 0.0 {
+            if self.started {
+                self.pending.push((Deferred::Travel, m.line, len));
+            }
+            self.in_run = false;
+        }
+        // Bounds.
+        let out =
+            m.to.iter()
+                .zip(cfg.build_volume)
+                .fold(0.0f64, |o, (&v, lim)| o.max(-v).max(v - lim));
+        if out > 1e-3 {
+            self.r.out_of_bounds.add(m.line, out);
+        }
+
+        // Deposition replay: support and collisions.
+        let s_start = self.s;
+        self.s += len;
         if m.feed > 0.0 {
-            r.time_min += len / m.feed;
+            self.r.time_min += len / m.feed;
         }
-        let active = first.is_some_and(|f| i >= f) && last.is_some_and(|l| i <= l);
-        if !active {
-            continue;
+        if !self.started {
+            return;
         }
+        let recent_nozzle = cfg.nozzle_radius + cfg.width_max;
+        let reach = cfg.nozzle_radius + cfg.width_max / 2.0;
         // Collisions at points along the move (every r/2 mm, end included).
         let samples = ((len / (cfg.nozzle_radius / 2.0).max(0.5)).ceil() as usize).clamp(1, 200);
         for k in 1..=samples {
@@ -324,21 +479,22 @@ pub fn check(text: &str, cfg: &CheckConfig) -> Report {
             ];
             let sp = s_start + t * len;
             // Beads the nozzle has left behind count for collisions.
-            while let Some(&j) = unsettled.front() {
-                let b = &beads[j as usize];
+            while let Some(&j) = self.unsettled.front() {
+                let b = &self.beads[j as usize];
                 if b.s_end > sp - recent_nozzle {
                     break;
                 }
-                grid.settle(b);
-                unsettled.pop_front();
+                self.grid.settle(b);
+                self.unsettled.pop_front();
             }
-            if top_z > p[2] + cfg.nozzle_height + cfg.collision_tolerance_mm {
-                r.carriage_collisions
-                    .add(m.line, top_z - p[2] - cfg.nozzle_height);
+            if self.top_z > p[2] + cfg.nozzle_height + cfg.collision_tolerance_mm {
+                let v = self.top_z - p[2] - cfg.nozzle_height;
+                self.defer_or_add(is_extruding, Deferred::Carriage, m.line, v);
             }
             let mut worst: f64 = 0.0;
             let zlo = p[2] + cfg.collision_tolerance_mm;
-            grid.for_each(
+            let beads = &self.beads;
+            self.grid.for_each(
                 p,
                 reach,
                 zlo,
@@ -356,12 +512,32 @@ pub fn check(text: &str, cfg: &CheckConfig) -> Report {
                 },
             );
             if worst > 0.0 {
-                r.nozzle_collisions.add(m.line, worst);
+                self.defer_or_add(is_extruding, Deferred::Nozzle, m.line, worst);
             }
         }
-        if !is_extruding(m) || len == 0.0 {
-            continue;
+        if !is_extruding || len == 0.0 {
+            return;
         }
+        self.bead(m, len, s_start);
+    }
+
+    /// Support analysis of an extruding move, then its bead joins the clay.
+    fn bead(&mut self, m: &Move, len: f64, s_start: f64) {
+        let cfg = self.cfg;
+        let s = self.s;
+        let Checker {
+            r,
+            beads,
+            grid,
+            unsettled,
+            stamp,
+            top_z,
+            lo,
+            hi,
+            layer_heights,
+            cands,
+            ..
+        } = self;
         r.path_length_mm += len;
         let volume = m.de / cfg.e_per_mm3;
         r.volume_ml += volume / 1000.0;
@@ -522,24 +698,29 @@ pub fn check(text: &str, cfg: &CheckConfig) -> Report {
         };
         grid.insert(&bead, id);
         unsettled.push_back(id);
-        top_z = top_z.max(bead.from[2].max(bead.to[2]));
+        *top_z = top_z.max(bead.from[2].max(bead.to[2]));
         beads.push(bead);
     }
-    if r.extruding_moves > 0 {
-        r.size_mm = [hi[0] - lo[0], hi[1] - lo[1], hi[2].max(0.0)];
-    }
-    if !layer_heights.is_empty() {
-        layer_heights.sort_by(f64::total_cmp);
-        let median = layer_heights[layer_heights.len() / 2];
-        if median > 0.0 {
-            r.layers = (hi[2] / median).round() as usize;
+
+    fn finish(mut self) -> Report {
+        let r = &mut self.r;
+        let (lo, hi) = (self.lo, self.hi);
+        if r.extruding_moves > 0 {
+            r.size_mm = [hi[0] - lo[0], hi[1] - lo[1], hi[2].max(0.0)];
         }
+        if !self.layer_heights.is_empty() {
+            self.layer_heights.sort_by(f64::total_cmp);
+            let median = self.layer_heights[self.layer_heights.len() / 2];
+            if median > 0.0 {
+                r.layers = (hi[2] / median).round() as usize;
+            }
+        }
+        self.diags.sort_by_key(|d| d.line);
+        self.diags.truncate(50);
+        r.diagnostics = self.diags;
+        verdict(r, self.cfg);
+        self.r
     }
-    diags.sort_by_key(|d| d.line);
-    diags.truncate(50);
-    r.diagnostics = diags;
-    verdict(&mut r, cfg);
-    r
 }
 
 fn verdict(r: &mut Report, cfg: &CheckConfig) {

@@ -39,7 +39,7 @@ pub mod parse;
 pub mod replay;
 mod report;
 
-pub use analyze::check;
+pub use analyze::{check, check_reader, CheckWriter};
 pub use parse::Diagnostic;
 pub use report::{Count, Report, SupportStats};
 

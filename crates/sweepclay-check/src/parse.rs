@@ -40,122 +40,181 @@ pub struct Diagnostic {
 /// Parses a whole file. Lines that cannot be read produce diagnostics and
 /// are skipped.
 pub fn parse(text: &str, diags: &mut Vec<Diagnostic>) -> Vec<Line> {
+    let mut parser = LineParser::default();
+    let mut line = Line::empty();
     let mut out = Vec::new();
     for (i, raw) in text.lines().enumerate() {
-        let n = i + 1;
-        if let Some(l) = parse_line(raw, n, diags) {
-            out.push(l);
+        if parser.parse(raw, i + 1, diags, &mut line) {
+            out.push(line.clone());
         }
     }
     out
 }
 
-fn parse_line(raw: &str, n: usize, diags: &mut Vec<Diagnostic>) -> Option<Line> {
-    // Checksum: XOR of every byte before '*'.
-    let mut body = raw;
-    if let Some(star) = raw.find('*') {
-        let before = &raw[..star];
-        if !before.contains(';') {
-            let want: u8 = before.bytes().fold(0, |a, b| a ^ b);
-            let digits: String = raw[star + 1..]
-                .chars()
-                .take_while(|c| c.is_ascii_digit())
-                .collect();
-            match digits.parse::<u16>() {
-                Ok(got) if got == want as u16 => {}
-                _ => diags.push(Diagnostic {
-                    line: n,
-                    message: format!("checksum mismatch (expected {want})"),
-                }),
-            }
-            body = before;
+impl Line {
+    /// A line with no command, for [`LineParser::parse`] to fill.
+    pub fn empty() -> Line {
+        Line {
+            line: 0,
+            letter: None,
+            code: 0.0,
+            params: Vec::new(),
         }
     }
-    // Strip comments.
-    let mut clean = String::with_capacity(body.len());
-    let mut in_paren = false;
-    for c in body.chars() {
-        match c {
-            ';' if !in_paren => break,
-            '(' => in_paren = true,
-            ')' if in_paren => in_paren = false,
-            _ if !in_paren => clean.push(c),
-            _ => {}
-        }
+}
+
+/// Reads lines one at a time into a [`Line`] it reuses, so reading a file
+/// allocates nothing per line once its buffers have grown.
+#[derive(Debug, Default)]
+pub struct LineParser {
+    clean: String,
+}
+
+/// The char at byte `i` of `s` and its length.
+fn char_at(s: &str, i: usize) -> (char, usize) {
+    let b = s.as_bytes()[i];
+    if b < 0x80 {
+        (b as char, 1)
+    } else {
+        let c = s[i..].chars().next().unwrap_or('\u{fffd}');
+        (c, c.len_utf8())
     }
-    let bytes: Vec<char> = clean.chars().collect();
-    let mut words = Vec::new();
-    let mut i = 0;
-    while i < bytes.len() {
-        let c = bytes[i];
-        if c.is_whitespace() {
-            i += 1;
-            continue;
-        }
-        if !c.is_ascii_alphabetic() {
-            diags.push(Diagnostic {
-                line: n,
-                message: format!("unexpected character `{c}`"),
-            });
-            return None;
-        }
-        let letter = c.to_ascii_uppercase();
-        i += 1;
-        let start = i;
-        while i < bytes.len() && !bytes[i].is_ascii_alphabetic() && !bytes[i].is_whitespace() {
-            i += 1;
-        }
-        // Allow "X 10" (space between letter and number).
-        let mut num: String = bytes[start..i].iter().collect();
-        if num.is_empty() {
-            let mut j = i;
-            while j < bytes.len() && bytes[j].is_whitespace() {
-                j += 1;
-            }
-            let s2 = j;
-            while j < bytes.len() && !bytes[j].is_ascii_alphabetic() && !bytes[j].is_whitespace() {
-                j += 1;
-            }
-            if j > s2 && (bytes[s2].is_ascii_digit() || matches!(bytes[s2], '-' | '+' | '.')) {
-                num = bytes[s2..j].iter().collect();
-                i = j;
-            }
-        }
-        let value = if num.is_empty() {
-            0.0
-        } else {
-            match num.parse::<f64>() {
-                Ok(v) if v.is_finite() => v,
-                _ => {
-                    diags.push(Diagnostic {
+}
+
+fn ends_word(c: char) -> bool {
+    c.is_ascii_alphabetic() || c.is_whitespace()
+}
+
+impl LineParser {
+    /// Parses line `n` (1-based) of a file into `out`. Returns false, with
+    /// a diagnostic when it is not just empty, when the line holds no
+    /// command.
+    pub fn parse(
+        &mut self,
+        raw: &str,
+        n: usize,
+        diags: &mut Vec<Diagnostic>,
+        out: &mut Line,
+    ) -> bool {
+        // Checksum: XOR of every byte before '*'.
+        let mut body = raw;
+        if let Some(star) = raw.find('*') {
+            let before = &raw[..star];
+            if !before.contains(';') {
+                let want: u8 = before.bytes().fold(0, |a, b| a ^ b);
+                let rest = &raw[star + 1..];
+                let end = rest
+                    .find(|c: char| !c.is_ascii_digit())
+                    .unwrap_or(rest.len());
+                match rest[..end].parse::<u16>() {
+                    Ok(got) if got == want as u16 => {}
+                    _ => diags.push(Diagnostic {
                         line: n,
-                        message: format!("`{letter}{num}` is not a number"),
-                    });
-                    return None;
+                        message: format!("checksum mismatch (expected {want})"),
+                    }),
+                }
+                body = before;
+            }
+        }
+        // Strip comments.
+        self.clean.clear();
+        let mut in_paren = false;
+        for c in body.chars() {
+            match c {
+                ';' if !in_paren => break,
+                '(' => in_paren = true,
+                ')' if in_paren => in_paren = false,
+                _ if !in_paren => self.clean.push(c),
+                _ => {}
+            }
+        }
+        let s = self.clean.as_str();
+        let len = s.len();
+        out.params.clear();
+        let mut i = 0;
+        while i < len {
+            let (c, cl) = char_at(s, i);
+            if c.is_whitespace() {
+                i += cl;
+                continue;
+            }
+            if !c.is_ascii_alphabetic() {
+                diags.push(Diagnostic {
+                    line: n,
+                    message: format!("unexpected character `{c}`"),
+                });
+                return false;
+            }
+            let letter = c.to_ascii_uppercase();
+            i += 1;
+            let start = i;
+            while i < len {
+                let (c, cl) = char_at(s, i);
+                if ends_word(c) {
+                    break;
+                }
+                i += cl;
+            }
+            // Allow "X 10" (space between letter and number).
+            let mut num = &s[start..i];
+            if num.is_empty() {
+                let mut j = i;
+                while j < len {
+                    let (c, cl) = char_at(s, j);
+                    if !c.is_whitespace() {
+                        break;
+                    }
+                    j += cl;
+                }
+                let s2 = j;
+                while j < len {
+                    let (c, cl) = char_at(s, j);
+                    if ends_word(c) {
+                        break;
+                    }
+                    j += cl;
+                }
+                let first = s.as_bytes().get(s2).copied().unwrap_or(b' ');
+                if j > s2 && (first.is_ascii_digit() || matches!(first, b'-' | b'+' | b'.')) {
+                    num = &s[s2..j];
+                    i = j;
                 }
             }
-        };
-        words.push((letter, value));
-    }
-    if words.first().is_some_and(|(c, _)| *c == 'N') {
-        words.remove(0);
-    }
-    if words.is_empty() {
-        return None;
-    }
-    let (letter, code) = match words[0] {
-        (c @ ('G' | 'M' | 'T'), v) => {
-            words.remove(0);
-            (Some(c), v)
+            let value = if num.is_empty() {
+                0.0
+            } else {
+                match num.parse::<f64>() {
+                    Ok(v) if v.is_finite() => v,
+                    _ => {
+                        diags.push(Diagnostic {
+                            line: n,
+                            message: format!("`{letter}{num}` is not a number"),
+                        });
+                        return false;
+                    }
+                }
+            };
+            out.params.push((letter, value));
         }
-        _ => (None, 0.0),
-    };
-    Some(Line {
-        line: n,
-        letter,
-        code,
-        params: words,
-    })
+        let words = &mut out.params;
+        if words.first().is_some_and(|(c, _)| *c == 'N') {
+            words.remove(0);
+        }
+        if words.is_empty() {
+            return false;
+        }
+        let (letter, code) = match words[0] {
+            (c @ ('G' | 'M' | 'T'), v) => {
+                words.remove(0);
+                (Some(c), v)
+            }
+            _ => (None, 0.0),
+        };
+        out.line = n;
+        out.letter = letter;
+        out.code = code;
+        true
+    }
 }
 
 #[cfg(test)]

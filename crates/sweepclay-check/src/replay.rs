@@ -48,100 +48,135 @@ pub enum Event {
 
 /// Replays the lines. Returns the events; diagnostics are appended.
 pub fn replay(lines: &[Line], diags: &mut Vec<Diagnostic>) -> Vec<Event> {
-    let mut pos = [0.0f64; 3];
-    let mut e = 0.0f64;
-    let mut abs_xyz = true;
-    let mut abs_e = true;
-    let mut scale = 1.0;
-    let mut feed = 0.0;
+    let mut r = Replayer::default();
     let mut out = Vec::new();
-    let mut unknown_reported = std::collections::BTreeSet::new();
     for l in lines {
+        if let Some(ev) = r.feed(l, diags) {
+            out.push(ev);
+        }
+    }
+    out
+}
+
+/// The machine state of a replay, fed one line at a time.
+#[derive(Debug)]
+pub struct Replayer {
+    pos: [f64; 3],
+    e: f64,
+    abs_xyz: bool,
+    abs_e: bool,
+    scale: f64,
+    feed: f64,
+    unknown_reported: std::collections::BTreeSet<String>,
+}
+
+impl Default for Replayer {
+    fn default() -> Self {
+        Replayer {
+            pos: [0.0; 3],
+            e: 0.0,
+            abs_xyz: true,
+            abs_e: true,
+            scale: 1.0,
+            feed: 0.0,
+            unknown_reported: Default::default(),
+        }
+    }
+}
+
+impl Replayer {
+    /// Applies one line; returns the move or pause it makes, if any.
+    pub fn feed(&mut self, l: &Line, diags: &mut Vec<Diagnostic>) -> Option<Event> {
         let Some(letter) = l.letter else {
             diags.push(Diagnostic {
                 line: l.line,
                 message: "parameters without a command".into(),
             });
-            continue;
+            return None;
         };
+        let scale = self.scale;
         match (letter, l.code) {
             ('G', c) if c == 0.0 || c == 1.0 => {
-                let mut to = pos;
+                let mut to = self.pos;
                 for (a, k) in ['X', 'Y', 'Z'].into_iter().enumerate() {
                     if let Some(v) = l.get(k) {
-                        to[a] = if abs_xyz {
+                        to[a] = if self.abs_xyz {
                             v * scale
                         } else {
-                            pos[a] + v * scale
+                            self.pos[a] + v * scale
                         };
                     }
                 }
                 let mut de = 0.0;
                 if let Some(v) = l.get('E') {
                     let v = v * scale;
-                    de = if abs_e { v - e } else { v };
-                    e += de;
+                    de = if self.abs_e { v - self.e } else { v };
+                    self.e += de;
                 }
                 if let Some(f) = l.get('F') {
-                    feed = f * scale;
+                    self.feed = f * scale;
                 }
-                out.push(Event::Move(Move {
+                let m = Move {
                     line: l.line,
-                    from: pos,
+                    from: self.pos,
                     to,
                     de,
-                    feed,
-                }));
-                pos = to;
+                    feed: self.feed,
+                };
+                self.pos = to;
+                return Some(Event::Move(m));
             }
             ('G', 2.0) | ('G', 3.0) => diags.push(Diagnostic {
                 line: l.line,
                 message: "arc moves (G2/G3) are not replayed".into(),
             }),
-            ('G', 4.0) | ('M', 0.0) | ('M', 1.0) | ('M', 600.0) => out.push(Event::Pause(l.line)),
-            ('G', 20.0) => scale = 25.4,
-            ('G', 21.0) => scale = 1.0,
+            ('G', 4.0) | ('M', 0.0) | ('M', 1.0) | ('M', 600.0) => {
+                return Some(Event::Pause(l.line))
+            }
+            ('G', 20.0) => self.scale = 25.4,
+            ('G', 21.0) => self.scale = 1.0,
             ('G', 28.0) => {
                 let any = ['X', 'Y', 'Z'].iter().any(|k| l.get(*k).is_some());
-                let mut to = pos;
+                let mut to = self.pos;
                 for (a, k) in ['X', 'Y', 'Z'].into_iter().enumerate() {
                     if !any || l.get(k).is_some() {
                         to[a] = 0.0;
                     }
                 }
-                out.push(Event::Move(Move {
+                let m = Move {
                     line: l.line,
-                    from: pos,
+                    from: self.pos,
                     to,
                     de: 0.0,
-                    feed,
-                }));
-                pos = to;
+                    feed: self.feed,
+                };
+                self.pos = to;
+                return Some(Event::Move(m));
             }
             ('G', 90.0) => {
-                abs_xyz = true;
-                abs_e = true;
+                self.abs_xyz = true;
+                self.abs_e = true;
             }
             ('G', 91.0) => {
-                abs_xyz = false;
-                abs_e = false;
+                self.abs_xyz = false;
+                self.abs_e = false;
             }
             ('G', 92.0) => {
                 if l.params.is_empty() {
-                    pos = [0.0; 3];
-                    e = 0.0;
+                    self.pos = [0.0; 3];
+                    self.e = 0.0;
                 }
                 for (a, k) in ['X', 'Y', 'Z'].into_iter().enumerate() {
                     if let Some(v) = l.get(k) {
-                        pos[a] = v * scale;
+                        self.pos[a] = v * scale;
                     }
                 }
                 if let Some(v) = l.get('E') {
-                    e = v * scale;
+                    self.e = v * scale;
                 }
             }
-            ('M', 82.0) => abs_e = true,
-            ('M', 83.0) => abs_e = false,
+            ('M', 82.0) => self.abs_e = true,
+            ('M', 83.0) => self.abs_e = false,
             // Known commands with no effect on the deposition.
             ('M', c)
                 if [
@@ -153,7 +188,7 @@ pub fn replay(lines: &[Line], diags: &mut Vec<Diagnostic>) -> Vec<Event> {
             ('G', c) if [29.0, 17.0, 80.0].contains(&c) => {}
             ('T', _) => {}
             (k, c) => {
-                if unknown_reported.insert(format!("{k}{c}")) {
+                if self.unknown_reported.insert(format!("{k}{c}")) {
                     diags.push(Diagnostic {
                         line: l.line,
                         message: format!("unknown command {k}{c} ignored"),
@@ -161,8 +196,8 @@ pub fn replay(lines: &[Line], diags: &mut Vec<Diagnostic>) -> Vec<Event> {
                 }
             }
         }
+        None
     }
-    out
 }
 
 #[cfg(test)]

@@ -357,3 +357,49 @@ proptest! {
         let _ = check(&text, &CheckConfig::default());
     }
 }
+
+#[test]
+fn reading_line_by_line_gives_the_same_report() {
+    use sweepclay_check::check_reader;
+    let cfg = CheckConfig::default();
+    let mut travel = wall(6);
+    travel.line("G1 Z20");
+    travel.line("G1 X50 Y70");
+    travel.line("G1 Z1.2");
+    travel.at = [50.0, 70.0, 1.2];
+    travel.run([90.0, 70.0, 1.2], W, LAYER);
+    let mut tail = wall(5);
+    // Moves and a pause after the last bead are not failures.
+    tail.line("G1 Z40");
+    tail.line("M0");
+    tail.line("G1 X0 Y0");
+    for text in [
+        wall(8).out,
+        travel.out,
+        tail.out.clone(),
+        "G1 X1 Y1 Z1 E1\r\nG1 X2 Y1 Z1 E2\r\n".to_string(),
+    ] {
+        let streamed = check_reader(text.as_bytes(), &cfg).unwrap();
+        // As JSON: a degenerate bead's NaN angle is not equal to itself.
+        let json = |r: &Report| serde_json::to_string(r).unwrap();
+        assert_eq!(json(&streamed), json(&check(&text, &cfg)));
+        // Written in odd-sized pieces, as a writer would.
+        let mut w = sweepclay_check::CheckWriter::new(&cfg);
+        for piece in text.as_bytes().chunks(7) {
+            std::io::Write::write_all(&mut w, piece).unwrap();
+        }
+        assert_eq!(json(&w.finish()), json(&streamed));
+    }
+    assert!(
+        verdict(&tail.out).printable,
+        "{}",
+        verdict(&tail.out).render()
+    );
+    // Bytes that are not UTF-8 are replaced, not fatal.
+    let mut bytes = b"G21\nG1 X1 Y1 Z1 E1 ; caf".to_vec();
+    bytes.extend_from_slice(&[0xe9, b'\n']);
+    let r = check_reader(&bytes[..], &cfg).unwrap();
+    assert_eq!(r.lines, 2);
+    assert_eq!(r, check(&String::from_utf8_lossy(&bytes), &cfg));
+    assert_eq!(r.extruding_moves, 1);
+}

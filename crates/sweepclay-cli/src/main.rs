@@ -5,9 +5,9 @@ use anyhow::{bail, Context, Result};
 use clap::{Args, Parser, Subcommand};
 use std::io::Write;
 use std::path::{Path, PathBuf};
-use sweepclay_check::{check, CheckConfig};
+use sweepclay_check::{check_reader, CheckConfig};
 use sweepclay_core::{examples, printer::PRESETS, Design, Printer, PrinterRef};
-use sweepclay_web::verify::{printer_check, verify, Verified};
+use sweepclay_web::verify::{printer_check, verify_into};
 
 /// Clay 3D printing of sweeping surfaces: design file → one continuous,
 /// collision-free, self-supporting G-code path, and a checker that says
@@ -184,12 +184,6 @@ fn slice(a: SliceArgs) -> Result<i32> {
         design.params.set(k, v)?;
     }
     let sliced = sweepclay_core::slice(&design).with_context(|| source.clone())?;
-    let Verified {
-        gcode: text,
-        report,
-        locations,
-    } = verify(&sliced, a.min_overlap);
-    let printer = &sliced.corrected.surface.printer;
     let out = a.output.clone().unwrap_or_else(|| {
         let stem = Path::new(&a.design)
             .file_stem()
@@ -197,6 +191,17 @@ fn slice(a: SliceArgs) -> Result<i32> {
             .unwrap_or_else(|| "out".into());
         PathBuf::from(stem).with_extension("gcode")
     });
+    // The G-code streams into a temporary file beside the output and
+    // through the checker in one pass; it becomes the output only if it
+    // passes (or with --force).
+    let tmp = temp_beside(&out)?;
+    let (report, locations) = verify_into(
+        &sliced,
+        a.min_overlap,
+        std::io::BufWriter::with_capacity(1 << 16, tmp.as_file()),
+    )
+    .with_context(|| format!("writing {}", tmp.path().display()))?;
+    let printer = &sliced.corrected.surface.printer;
     if let Some(p) = &a.preview {
         write_atomic(p, sweepclay_core::preview::svg(&sliced).as_bytes())?;
     }
@@ -259,7 +264,7 @@ fn slice(a: SliceArgs) -> Result<i32> {
     if !report.printable {
         eprintln!("warning: writing G-code that FAILS the printability check (--force)");
     }
-    write_atomic(&out, text.as_bytes())?;
+    persist(tmp, &out)?;
     Ok(if report.printable { 0 } else { 1 })
 }
 
@@ -288,8 +293,8 @@ fn serve(a: ServeArgs) -> Result<i32> {
 }
 
 fn check_cmd(a: CheckArgs) -> Result<i32> {
-    let text = std::fs::read(&a.file).with_context(|| format!("reading {}", a.file.display()))?;
-    let text = String::from_utf8_lossy(&text);
+    let file =
+        std::fs::File::open(&a.file).with_context(|| format!("reading {}", a.file.display()))?;
     let p = load_printer(&a.printer)?;
     let cfg = CheckConfig {
         nozzle_height: a.nozzle_height,
@@ -301,7 +306,8 @@ fn check_cmd(a: CheckArgs) -> Result<i32> {
         first_layer_max_mm: a.first_layer_max,
         ..printer_check(&p)
     };
-    let report = check(&text, &cfg);
+    let report = check_reader(std::io::BufReader::with_capacity(1 << 16, file), &cfg)
+        .with_context(|| format!("reading {}", a.file.display()))?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&report)?);
     } else {
@@ -310,17 +316,21 @@ fn check_cmd(a: CheckArgs) -> Result<i32> {
     Ok(if report.printable { 0 } else { 1 })
 }
 
-/// Writes through a temporary file in the same directory and renames it,
-/// so a crash never leaves a half-written file.
-fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+/// An empty temporary file in the directory of `path`, to be renamed over
+/// it by [`persist`] (deleted if dropped).
+fn temp_beside(path: &Path) -> Result<tempfile::NamedTempFile> {
     let dir = path
         .parent()
         .filter(|d| !d.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
-    let mut tmp = tempfile::NamedTempFile::new_in(dir)
-        .with_context(|| format!("creating a temporary file in {}", dir.display()))?;
-    tmp.write_all(bytes)?;
-    // Temporary files are private (0600); the result is an ordinary file.
+    tempfile::NamedTempFile::new_in(dir)
+        .with_context(|| format!("creating a temporary file in {}", dir.display()))
+}
+
+/// Makes a finished temporary file `path`: an ordinary file (temporary
+/// files are private, 0600), synced, then renamed, so a crash never leaves
+/// a half-written file.
+fn persist(tmp: tempfile::NamedTempFile, path: &Path) -> Result<()> {
     #[cfg(unix)]
     {
         use std::os::unix::fs::PermissionsExt;
@@ -331,4 +341,11 @@ fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     tmp.persist(path)
         .with_context(|| format!("writing {}", path.display()))?;
     Ok(())
+}
+
+/// Writes through a temporary file in the same directory and renames it.
+fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
+    let mut tmp = temp_beside(path)?;
+    tmp.write_all(bytes)?;
+    persist(tmp, path)
 }

@@ -2,7 +2,8 @@
 //! and the modeler's download both run before they hand out a file, and the
 //! way back from a failing G-code line to the place in the design.
 
-use sweepclay_check::{check, CheckConfig, Report};
+use std::io::{self, Write};
+use sweepclay_check::{CheckConfig, CheckWriter, Report};
 use sweepclay_core::toolpath::PointKind;
 use sweepclay_core::{gcode, Params, Printer, Sliced};
 
@@ -43,23 +44,55 @@ pub struct Verified {
     pub locations: Vec<String>,
 }
 
-/// Emits the G-code of `s` and checks it, refusing beads that overlap the
-/// bead below by less than `min_overlap` of their width.
-pub fn verify(s: &Sliced, min_overlap: f64) -> Verified {
-    let (text, point_lines) = gcode::to_string_with_lines(s);
+/// Writes to two writers.
+struct Tee<A, B>(A, B);
+
+impl<A: Write, B: Write> Write for Tee<A, B> {
+    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
+        self.0.write_all(buf)?;
+        self.1.write_all(buf)?;
+        Ok(buf.len())
+    }
+    fn flush(&mut self) -> io::Result<()> {
+        self.0.flush()?;
+        self.1.flush()
+    }
+}
+
+/// Writes the G-code of `s` to `out` and checks it in the same pass,
+/// refusing beads that overlap the bead below by less than `min_overlap`
+/// of their width. Nothing of the text is kept: `out` may be a file of any
+/// size. Returns the report and where in the design its failures are.
+pub fn verify_into<W: Write>(
+    s: &Sliced,
+    min_overlap: f64,
+    out: W,
+) -> io::Result<(Report, Vec<String>)> {
     let surface = &s.corrected.surface;
     let cfg = CheckConfig {
         overlap_min: min_overlap,
         ..check_config(&surface.printer, &surface.params)
     };
-    let report = check(&text, &cfg);
+    let mut tee = Tee(out, CheckWriter::new(&cfg));
+    let point_lines = gcode::emit(s, &mut tee)?;
+    tee.flush()?;
+    let Tee(_, checker) = tee;
+    let report = checker.finish();
     let locations = failure_lines(&report)
         .into_iter()
         .take(5)
         .filter_map(|l| locate(s, &point_lines, l))
         .collect();
+    Ok((report, locations))
+}
+
+/// [`verify_into`] a string.
+pub fn verify(s: &Sliced, min_overlap: f64) -> Verified {
+    let mut text = Vec::with_capacity(s.toolpath.points.len() * 48 + 2048);
+    let (report, locations) =
+        verify_into(s, min_overlap, &mut text).expect("writing to memory cannot fail");
     Verified {
-        gcode: text,
+        gcode: String::from_utf8(text).expect("G-code is UTF-8"),
         report,
         locations,
     }
