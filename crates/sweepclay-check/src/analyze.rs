@@ -386,14 +386,12 @@ impl<'a> Checker<'a> {
             return;
         }
         match self.replayer.feed(&self.line, &mut self.diags) {
-            Some(Event::Pause(line)) => {
-                if self.started {
-                    self.pending.push((Deferred::Pause, line, 0.0));
-                    self.in_run = false;
-                }
+            Some(Event::Pause(line)) if self.started => {
+                self.pending.push((Deferred::Pause, line, 0.0));
+                self.in_run = false;
             }
             Some(Event::Move(m)) => self.step(&m),
-            None => {}
+            Some(Event::Pause(_)) | None => {}
         }
     }
 
@@ -634,7 +632,7 @@ impl<'a> Checker<'a> {
             if double {
                 r.support.double_deposition.add(m.line, 0.0);
             }
-            let support = pick_support(&cands, cfg.min_layer_mm, mid[2] <= cfg.first_layer_max_mm);
+            let support = pick_support(cands, cfg.min_layer_mm, mid[2] <= cfg.first_layer_max_mm);
             let (dz, overlap, offset) = match support {
                 Some(c) => {
                     let dz = mid[2] - c.z;
