@@ -20,6 +20,54 @@ pub fn example(name: &str) -> Option<&'static str> {
         .map(|(_, t)| *t)
 }
 
+/// The benchmark design: t1 enlarged 2.5× in plan, both profiles stretched
+/// to 240 mm (a wall on a 400 mm printer), sampled at the layer height and
+/// spacing that give about `samples` surface samples (layer height from
+/// 1.25 mm down to 0.5 mm first, then the spacing). Every size is the same
+/// shape, only finer: the scaling series of the benchmarks.
+pub fn scaled(samples: usize) -> crate::Design {
+    use crate::printer::{Printer, PrinterRef};
+    let mut d = crate::Design::from_json(example("t1").expect("t1 is bundled")).expect("t1 parses");
+    d.name = format!("t1 x2.5, 240 mm, {samples} samples");
+    if let Some(p) = d.trajectory.points.as_mut() {
+        p.iter_mut().for_each(|q| *q = q.map(|v| 2.5 * v));
+    }
+    // Both ends 240 mm tall: one stage at every resolution, so the sample
+    // count follows spacing and layer height smoothly.
+    for c in [&mut d.profile_start, &mut d.profile_end] {
+        let top = c.control_points.last().expect("a profile has points")[1];
+        c.control_points
+            .iter_mut()
+            .for_each(|q| q[1] *= 240.0 / top);
+    }
+    d.printer = PrinterRef::Inline(Printer {
+        name: "bench-400".into(),
+        build_volume: [400.0, 400.0, 400.0],
+        origin: [200.0, 200.0],
+        ..Printer::preset("generic").expect("generic is a preset")
+    });
+    // About 110,000 samples at 1.1 mm × 1.25 mm; samples ∝ 1 / (spacing ·
+    // layer height).
+    let base = 110_000.0 * 1.1 * 1.25;
+    let lh = (1.25 * (110_000.0 / samples as f64).sqrt()).clamp(0.5, 1.25);
+    d.params.layer_height = lh;
+    d.params.max_layer_height = 2.0 * lh;
+    d.params.spacing = (base / (lh * samples as f64)).clamp(0.01, 50.0);
+    // Corrections from real counts (sampling is cheap next to the rest of
+    // the pipeline); the layering itself depends a little on the spacing.
+    for _ in 0..6 {
+        let Ok(s) = crate::surface::sample_surface(&d) else {
+            break;
+        };
+        let ratio = s.samples.len() as f64 / samples as f64;
+        if (ratio - 1.0).abs() < 0.03 {
+            break;
+        }
+        d.params.spacing = (d.params.spacing * ratio).clamp(0.01, 50.0);
+    }
+    d
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -31,6 +79,16 @@ mod tests {
             let d = Design::from_json(text).unwrap_or_else(|e| panic!("{name}: {e}"));
             let s = crate::slice(&d).unwrap_or_else(|e| panic!("{name}: {e}"));
             assert!(s.stats.sample_points > 1000, "{name}: {:?}", s.stats);
+        }
+    }
+
+    #[test]
+    fn scaled_design_has_about_the_samples_asked_for() {
+        for n in [10_000, 100_000] {
+            let d = scaled(n);
+            let s = crate::surface::sample_surface(&d).unwrap();
+            let got = s.samples.len() as f64;
+            assert!((got / n as f64 - 1.0).abs() < 0.1, "{n}: {got}");
         }
     }
 

@@ -1,0 +1,144 @@
+//! The pipeline's stages, each on its own (paper §4–5; DESIGN.md §10):
+//! on the six bundled examples, and on a scaling series of one design
+//! (`examples::scaled`) from 10 thousand to 10 million samples; and the
+//! G-code writer next to a bare fixed-point formatting loop over the same
+//! numbers (its floor).
+//!
+//! `cargo bench -p sweepclay-core` (all), or with a filter:
+//! `cargo bench -p sweepclay-core -- stages/t1`, `-- scaling`, `-- gcode_floor`.
+//! `SWEEPCLAY_BENCH_MAX=1000000` stops the scaling series at 1 million.
+
+use criterion::{criterion_group, criterion_main, BatchSize, BenchmarkId, Criterion, Throughput};
+use std::hint::black_box;
+use sweepclay_core::{correct, examples, extrude, finish, gcode, surface, toolpath, Design};
+
+/// The scaling series: 10k, 30k, 100k, … up to 10M (or `SWEEPCLAY_BENCH_MAX`).
+pub fn sizes() -> Vec<usize> {
+    let max: usize = std::env::var("SWEEPCLAY_BENCH_MAX")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(10_000_000);
+    [
+        10_000, 30_000, 100_000, 300_000, 1_000_000, 3_000_000, 10_000_000,
+    ]
+    .into_iter()
+    .filter(|&n| n <= max)
+    .collect()
+}
+
+fn stages(c: &mut Criterion, group: &str, name: &str, d: &Design, samples: u64) {
+    let mut g = c.benchmark_group(group);
+    g.throughput(Throughput::Elements(samples));
+    if samples > 200_000 {
+        g.sample_size(10);
+    }
+    let surf = surface::sample_surface(d).unwrap();
+    let corrected = correct::correct(&surf).unwrap();
+    let path = toolpath::plan_path(&corrected);
+    let sliced = finish(corrected.clone()).unwrap();
+    let mut out = Vec::with_capacity(sliced.toolpath.points.len() * 48);
+    g.bench_function(BenchmarkId::new("sample", name), |b| {
+        b.iter(|| surface::sample_surface(black_box(d)).unwrap())
+    });
+    g.bench_function(BenchmarkId::new("correct", name), |b| {
+        b.iter(|| correct::correct(black_box(&surf)).unwrap())
+    });
+    g.bench_function(BenchmarkId::new("path", name), |b| {
+        b.iter(|| toolpath::plan_path(black_box(&corrected)))
+    });
+    g.bench_function(BenchmarkId::new("extrusion", name), |b| {
+        b.iter(|| extrude::plan_extrusion(black_box(&path), &corrected.surface.params))
+    });
+    g.bench_function(BenchmarkId::new("gcode", name), |b| {
+        b.iter(|| {
+            out.clear();
+            gcode::emit(black_box(&sliced), &mut out).unwrap()
+        })
+    });
+    g.bench_function(BenchmarkId::new("slice", name), |b| {
+        b.iter(|| sweepclay_core::slice(black_box(d)).unwrap())
+    });
+    g.finish();
+}
+
+fn examples_bench(c: &mut Criterion) {
+    for (file, text) in examples::EXAMPLES {
+        let d = Design::from_json(text).unwrap();
+        let n = sweepclay_core::slice(&d).unwrap().stats.sample_points as u64;
+        stages(c, "stages", file.trim_end_matches(".json"), &d, n);
+    }
+}
+
+fn scaling_bench(c: &mut Criterion) {
+    for n in sizes() {
+        let d = examples::scaled(n);
+        stages(c, "scaling", &n.to_string(), &d, n as u64);
+    }
+}
+
+/// The floor: the same numbers (x, y, z with 3 decimals, E with 5) written
+/// as `G1 X… Y… Z… E…` lines by a bare loop over precomputed values, with
+/// the same fixed-point writer; and the standard formatter for contrast.
+fn gcode_floor(c: &mut Criterion) {
+    let d = Design::from_json(examples::example("t1").unwrap()).unwrap();
+    let s = sweepclay_core::slice(&d).unwrap();
+    let o = s.corrected.surface.printer.origin;
+    let e_per = s.corrected.surface.printer.e_per_mm3;
+    let mut e = 0.0;
+    let nums: Vec<[f64; 4]> = s
+        .toolpath
+        .points
+        .iter()
+        .zip(&s.extrusion.volume)
+        .map(|(p, v)| {
+            e += v * e_per;
+            [p.pos[0] + o[0], p.pos[1] + o[1], p.pos[2], e]
+        })
+        .collect();
+    let mut g = c.benchmark_group("gcode_floor");
+    g.throughput(Throughput::Elements(nums.len() as u64));
+    let mut out: Vec<u8> = Vec::with_capacity(nums.len() * 48);
+    g.bench_function("emit_t1", |b| {
+        b.iter_batched_ref(
+            Vec::new,
+            |v: &mut Vec<u8>| gcode::emit(black_box(&s), v).unwrap(),
+            BatchSize::LargeInput,
+        )
+    });
+    g.bench_function("fixed_point_loop_t1", |b| {
+        b.iter(|| {
+            out.clear();
+            for n in black_box(&nums) {
+                out.extend_from_slice(b"G1 X");
+                gcode::push_fixed(&mut out, n[0], 3);
+                out.extend_from_slice(b" Y");
+                gcode::push_fixed(&mut out, n[1], 3);
+                out.extend_from_slice(b" Z");
+                gcode::push_fixed(&mut out, n[2], 3);
+                out.extend_from_slice(b" E");
+                gcode::push_fixed(&mut out, n[3], 5);
+                out.push(b'\n');
+            }
+            out.len()
+        })
+    });
+    g.bench_function("std_format_loop_t1", |b| {
+        use std::io::Write;
+        b.iter(|| {
+            out.clear();
+            for n in black_box(&nums) {
+                writeln!(
+                    out,
+                    "G1 X{:.3} Y{:.3} Z{:.3} E{:.5}",
+                    n[0], n[1], n[2], n[3]
+                )
+                .unwrap();
+            }
+            out.len()
+        })
+    });
+    g.finish();
+}
+
+criterion_group!(benches, examples_bench, gcode_floor, scaling_bench);
+criterion_main!(benches);

@@ -1,0 +1,53 @@
+//! The whole job, design → verified G-code (DESIGN.md §10): slice, write
+//! the G-code and check it in the same pass (`verify_into`, output
+//! discarded), on the six examples and on the scaling series of
+//! `examples::scaled` (10 thousand to 10 million samples).
+//!
+//! `cargo bench -p sweepclay-web` (all), `-- verified/t1`, `-- verified_scaling`.
+//! `SWEEPCLAY_BENCH_MAX=1000000` stops the scaling series at 1 million.
+
+use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
+use std::hint::black_box;
+use sweepclay_core::{examples, Design};
+use sweepclay_web::verify::verify_into;
+
+fn verified(d: &Design) -> bool {
+    let s = sweepclay_core::slice(d).unwrap();
+    verify_into(&s, 0.5, std::io::sink()).unwrap().0.printable
+}
+
+fn bench(c: &mut Criterion) {
+    let mut g = c.benchmark_group("verified");
+    for (file, text) in examples::EXAMPLES {
+        let d = Design::from_json(text).unwrap();
+        assert!(verified(&d), "{file} must verify");
+        let n = sweepclay_core::slice(&d).unwrap().stats.sample_points;
+        g.throughput(Throughput::Elements(n as u64));
+        g.bench_function(file.trim_end_matches(".json"), |b| {
+            b.iter(|| verified(black_box(&d)))
+        });
+    }
+    g.finish();
+    let max: usize = std::env::var("SWEEPCLAY_BENCH_MAX")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(10_000_000);
+    let mut g = c.benchmark_group("verified_scaling");
+    g.sample_size(10);
+    for n in [
+        10_000, 30_000, 100_000, 300_000, 1_000_000, 3_000_000, 10_000_000,
+    ] {
+        if n > max {
+            break;
+        }
+        let d = examples::scaled(n);
+        g.throughput(Throughput::Elements(n as u64));
+        g.bench_function(BenchmarkId::from_parameter(n), |b| {
+            b.iter(|| verified(black_box(&d)))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(benches, bench);
+criterion_main!(benches);
