@@ -13,11 +13,13 @@ const EPS_E: f64 = 1e-7;
 const CELL_XY: f64 = 4.0;
 const CELL_Z: f64 = 2.0;
 
-/// A deposited move.
+/// A deposited move. Ends and width are kept in single precision (40
+/// bytes a bead instead of 72): 15 µm at 400 mm, far below the 1 µm…1 mm
+/// of the G-code's own numbers' last digits and the checker's tolerances.
 struct Bead {
-    from: [f64; 3],
-    to: [f64; 3],
-    width: f64,
+    from32: [f32; 3],
+    to32: [f32; 3],
+    width32: f32,
     /// Path distance at the end of the move.
     s_end: f64,
     /// Turnaround step (steeper than 1:2): clay, but no support for others.
@@ -25,18 +27,41 @@ struct Bead {
 }
 
 impl Bead {
+    fn new(from: [f64; 3], to: [f64; 3], width: f64, s_end: f64, step: bool) -> Bead {
+        Bead {
+            from32: from.map(|v| v as f32),
+            to32: to.map(|v| v as f32),
+            width32: width as f32,
+            s_end,
+            step,
+        }
+    }
+
+    fn from(&self) -> [f64; 3] {
+        self.from32.map(f64::from)
+    }
+
+    fn to(&self) -> [f64; 3] {
+        self.to32.map(f64::from)
+    }
+
+    fn width(&self) -> f64 {
+        f64::from(self.width32)
+    }
+
     /// Closest point of the bead's centreline (in plan) to `p`:
     /// `(parameter, horizontal distance, height there, the point)`.
     fn closest(&self, p: [f64; 3]) -> (f64, f64, f64, [f64; 2]) {
-        let (dx, dy) = (self.to[0] - self.from[0], self.to[1] - self.from[1]);
+        let (from, to) = (self.from(), self.to());
+        let (dx, dy) = (to[0] - from[0], to[1] - from[1]);
         let l2 = dx * dx + dy * dy;
         let t = if l2 > 0.0 {
-            (((p[0] - self.from[0]) * dx + (p[1] - self.from[1]) * dy) / l2).clamp(0.0, 1.0)
+            (((p[0] - from[0]) * dx + (p[1] - from[1]) * dy) / l2).clamp(0.0, 1.0)
         } else {
             0.0
         };
-        let (x, y) = (self.from[0] + t * dx, self.from[1] + t * dy);
-        let z = self.from[2] + t * (self.to[2] - self.from[2]);
+        let (x, y) = (from[0] + t * dx, from[1] + t * dy);
+        let z = from[2] + t * (to[2] - from[2]);
         (t, len2(p[0] - x, p[1] - y), z, [x, y])
     }
 }
@@ -77,16 +102,17 @@ impl BeadGrid {
     /// `None` for a move so long (other slicers) that indexing it would
     /// exhaust memory.
     fn span(b: &Bead) -> Option<Span> {
+        let (from, to) = (b.from(), b.to());
         let x = [
-            cell(b.from[0].min(b.to[0]), CELL_XY),
-            cell(b.from[0].max(b.to[0]), CELL_XY),
+            cell(from[0].min(to[0]), CELL_XY),
+            cell(from[0].max(to[0]), CELL_XY),
         ];
         let y = [
-            cell(b.from[1].min(b.to[1]), CELL_XY),
-            cell(b.from[1].max(b.to[1]), CELL_XY),
+            cell(from[1].min(to[1]), CELL_XY),
+            cell(from[1].max(to[1]), CELL_XY),
         ];
-        let ztop = b.from[2].max(b.to[2]);
-        let z = [cell(b.from[2].min(b.to[2]), CELL_Z), cell(ztop, CELL_Z)];
+        let ztop = from[2].max(to[2]);
+        let z = [cell(from[2].min(to[2]), CELL_Z), cell(ztop, CELL_Z)];
         let n = (x[1] - x[0] + 1) as i64 * (y[1] - y[0] + 1) as i64 * (z[1] - z[0] + 1) as i64;
         (n <= 100_000).then_some((x, y, z, ztop))
     }
@@ -504,7 +530,7 @@ impl<'a> Checker<'a> {
                         return;
                     }
                     let (_, d, z, _) = b.closest(p);
-                    if z > zlo && d < cfg.nozzle_radius + b.width / 2.0 {
+                    if z > zlo && d < cfg.nozzle_radius + b.width() / 2.0 {
                         worst = worst.max(z - p[2]);
                     }
                 },
@@ -595,19 +621,19 @@ impl<'a> Checker<'a> {
                     if mid[2] - z > cfg.max_gap_mm {
                         return;
                     }
-                    if d <= cfg.width_max.max(b.width / 2.0) {
-                        let covers = d <= b.width / 2.0;
+                    if d <= cfg.width_max.max(b.width() / 2.0) {
+                        let covers = d <= b.width() / 2.0;
                         covered.set(covered.get() || covers);
                         cands.push(Candidate {
                             z,
                             at,
                             d,
-                            width: b.width,
+                            width: b.width(),
                             covers,
                         });
                     }
                 } else if (z - mid[2]).abs() < cfg.min_layer_mm
-                    && d < 0.5 * b.width.min(cfg.width_min)
+                    && d < 0.5 * b.width().min(cfg.width_min)
                     // Clay laid in the last 2 w_max of path is the run's own
                     // fresh clay (a corner piles up, it is not laid twice).
                     && s_start - b.s_end > 2.0 * cfg.width_max
@@ -683,20 +709,20 @@ impl<'a> Checker<'a> {
                 }
             }
         }
-        let bead = Bead {
-            from: m.from,
-            to: m.to,
-            width: if width.is_finite() {
+        let bead = Bead::new(
+            m.from,
+            m.to,
+            if width.is_finite() {
                 width.clamp(0.0, 1e3)
             } else {
                 cfg.width_min
             },
-            s_end: s,
+            s,
             step,
-        };
+        );
         grid.insert(&bead, id);
         unsettled.push_back(id);
-        *top_z = top_z.max(bead.from[2].max(bead.to[2]));
+        *top_z = top_z.max(m.from[2].max(m.to[2]));
         beads.push(bead);
     }
 
