@@ -359,3 +359,25 @@ fn serve_prints_its_url_and_answers() {
             "listening on 127.0.0.1:{port}"
         )));
 }
+
+#[test]
+fn streamed_output_is_the_gcode_the_library_writes() {
+    // `slice` streams the G-code through a buffered temporary file and the
+    // checker in one pass; the file is byte for byte the library's text.
+    let tmp = tempfile::tempdir().unwrap();
+    sweepclay(tmp.path())
+        .args(["slice", "t5", "-o", "t5.gcode"])
+        .assert()
+        .success();
+    let written = std::fs::read_to_string(tmp.path().join("t5.gcode")).unwrap();
+    let d = sweepclay_core::Design::from_json(sweepclay_core::examples::example("t5").unwrap())
+        .unwrap();
+    let text = sweepclay_core::gcode::to_string(&sweepclay_core::slice(&d).unwrap());
+    assert_eq!(written, text);
+    // Nothing else is left in the directory (the temporary file was renamed).
+    let names: Vec<_> = std::fs::read_dir(tmp.path())
+        .unwrap()
+        .map(|e| e.unwrap().file_name())
+        .collect();
+    assert_eq!(names, vec![std::ffi::OsString::from("t5.gcode")]);
+}

@@ -6,12 +6,14 @@
 //!   point above moves with it.
 //! - Self-intersection: surface points of transition curves more than 1.6
 //!   bead widths apart along Ψ that come closer than the widest bead are
-//!   found with a 3D grid (linear time). As in the paper, C_s and C_t are
+//!   found through a plan grid of each curve's radial segment (one query
+//!   per curve), comparing samples only for curves whose segments come
+//!   within a bead width. As in the paper, C_s and C_t are
 //!   then compressed along x (all radial offsets scaled by c = 0.9, 0.81, …)
 //!   until none remains.
 
 use crate::error::{Error, Result};
-use crate::grid::Grid3;
+use crate::grid::Grid2;
 use crate::surface::Surface;
 use serde::Serialize;
 
@@ -216,56 +218,98 @@ fn support_free(s: &mut Surface) -> Vec<SupportFix> {
 
 /// The first pair of surface points from transition curves far apart along
 /// Ψ that are closer than the widest bead: `(curve a, curve b, position)`.
+///
+/// Every sample of a transition curve lies on one radial segment in plan
+/// (p_i + ξ·d_i over the curve's range of ξ), and two points are at least
+/// as far apart in 3D as in plan. So a grid of those segments first finds
+/// the pairs of curves, far apart along Ψ, whose segments come within
+/// w_max in plan; only their samples are compared, each with the samples
+/// of the other curve within w_max in height (both curves are sorted by
+/// height). A surface that does not meet itself has no such pairs: the
+/// cost is one segment query per curve, whatever the sampling density.
 fn find_self_intersection(s: &Surface) -> Option<(u32, u32, [f64; 3])> {
     let w = s.params.width_max;
     // A U-turn of radius w/2 is the tightest curve whose sides do not touch:
     // its opposite points are π·w/2 ≈ 1.57 w apart along Ψ.
-    let far = ((1.6 * w) / s.spacing).ceil() as i64;
-    let mut grid = Grid3::new(w);
-    let mut owner = Vec::with_capacity(s.samples.len());
-    let mut pos = Vec::with_capacity(s.samples.len());
-    for (c, col) in s.columns.iter().enumerate() {
-        for i in col.samples() {
-            owner.push(c as u32);
-            pos.push(s.position(c, i));
-        }
-    }
-    for (id, p) in pos.iter().enumerate() {
-        grid.insert(*p, id as u32);
+    let far = ((1.6 * w) / s.spacing).ceil() as usize;
+    let segs: Vec<[[f64; 2]; 2]> = s
+        .columns
+        .iter()
+        .map(|col| {
+            let (lo, hi) = s.samples[col.samples()]
+                .iter()
+                .fold((f64::MAX, f64::MIN), |(lo, hi), smp| {
+                    (lo.min(smp.xi), hi.max(smp.xi))
+                });
+            let a = col.point(lo, 0.0);
+            let b = col.point(hi, 0.0);
+            [[a[0], a[1]], [b[0], b[1]]]
+        })
+        .collect();
+    let mut grid = Grid2::new(w.max(s.spacing));
+    for (c, seg) in segs.iter().enumerate() {
+        grid.insert_segment(seg[0], seg[1], c as u32);
     }
     let w2 = w * w;
-    // Ids are numbered column by column, so in every cell's list the
-    // owners never decrease and the curves near `mine` along Ψ form one
-    // run, skipped by two binary searches: each point looks only at far
-    // curves, and consecutive points in one cell share the cell lookups.
-    let mut lists: Vec<&[u32]> = Vec::new();
-    let mut last: Option<[f64; 3]> = None;
-    for (id, p) in pos.iter().enumerate() {
-        if last.is_none_or(|q| !grid.same_cell(q, *p)) {
-            lists = grid.near_lists(*p);
-            last = Some(*p);
-        }
-        let mine = owner[id] as i64;
-        for ids in &lists {
-            let (first, last) = (
-                owner[ids[0] as usize] as i64,
-                owner[ids[ids.len() - 1] as usize] as i64,
-            );
-            if first >= mine - far && last <= mine + far {
-                continue; // only curves near this one along Ψ
+    let mut near: Vec<u32> = Vec::new();
+    for (a, seg) in segs.iter().enumerate() {
+        near.clear();
+        grid.for_each_near_segment(seg[0], seg[1], w, |b| {
+            if (b as usize) > a + far && segment_distance(*seg, segs[b as usize]) < w {
+                near.push(b);
             }
-            let lo = ids.partition_point(|&o| (owner[o as usize] as i64) < mine - far);
-            let hi = ids.partition_point(|&o| (owner[o as usize] as i64) <= mine + far);
-            for &other in ids[..lo].iter().chain(&ids[hi..]) {
-                let q = pos[other as usize];
-                let d2 = (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2);
-                if d2 < w2 {
-                    return Some((owner[id], owner[other as usize], *p));
+        });
+        near.sort_unstable();
+        near.dedup();
+        for &b in &near {
+            let (ca, cb) = (&s.columns[a], &s.columns[b as usize]);
+            let rb = cb.samples();
+            let mut start = rb.start;
+            for i in ca.samples() {
+                let p = s.position(a, i);
+                while start < rb.end && s.samples[start].z < p[2] - w {
+                    start += 1;
+                }
+                for j in start..rb.end {
+                    if s.samples[j].z > p[2] + w {
+                        break;
+                    }
+                    let q = s.position(b as usize, j);
+                    let d2 = (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2);
+                    if d2 < w2 {
+                        return Some((a as u32, b, p));
+                    }
                 }
             }
         }
     }
     None
+}
+
+/// Distance between two segments in the plane.
+fn segment_distance(a: [[f64; 2]; 2], b: [[f64; 2]; 2]) -> f64 {
+    fn point_seg(p: [f64; 2], s: [[f64; 2]; 2]) -> f64 {
+        let (dx, dy) = (s[1][0] - s[0][0], s[1][1] - s[0][1]);
+        let l2 = dx * dx + dy * dy;
+        let t = if l2 > 0.0 {
+            (((p[0] - s[0][0]) * dx + (p[1] - s[0][1]) * dy) / l2).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        (p[0] - s[0][0] - t * dx).hypot(p[1] - s[0][1] - t * dy)
+    }
+    let cross = |o: [f64; 2], p: [f64; 2], q: [f64; 2]| {
+        (p[0] - o[0]) * (q[1] - o[1]) - (p[1] - o[1]) * (q[0] - o[0])
+    };
+    let (d1, d2) = (cross(a[0], a[1], b[0]), cross(a[0], a[1], b[1]));
+    let (d3, d4) = (cross(b[0], b[1], a[0]), cross(b[0], b[1], a[1]));
+    if d1 * d2 < 0.0 && d3 * d4 < 0.0 {
+        return 0.0; // they cross
+    }
+    point_seg(a[0], b)
+        .min(point_seg(a[1], b))
+        .min(point_seg(b[0], a))
+        .min(point_seg(b[1], a))
 }
 
 #[cfg(test)]
@@ -344,6 +388,51 @@ mod tests {
             .expect("intersection reported");
         assert!(x.compression < 1.0 && x.iterations >= 1);
         assert!(find_self_intersection(&c.surface).is_none());
+    }
+
+    /// The plain definition: every pair of points, far apart along Ψ.
+    fn brute_force(s: &Surface) -> bool {
+        let w = s.params.width_max;
+        let far = ((1.6 * w) / s.spacing).ceil() as usize;
+        let pts: Vec<(usize, [f64; 3])> = s
+            .columns
+            .iter()
+            .enumerate()
+            .flat_map(|(c, col)| col.samples().map(move |i| (c, i)))
+            .map(|(c, i)| (c, s.position(c, i)))
+            .collect();
+        pts.iter().any(|(a, p)| {
+            pts.iter().any(|(b, q)| {
+                *b > a + far
+                    && (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2) < w * w
+            })
+        })
+    }
+
+    #[test]
+    fn segment_filter_agrees_with_every_pair() {
+        // Half circles of shrinking radius with profiles leaning in: from
+        // far apart to meeting themselves.
+        for (r, lean) in [
+            (30.0, 5.0),
+            (20.0, 10.0),
+            (20.0, 15.0),
+            (12.0, 4.0),
+            (9.0, 0.0),
+            (40.0, 35.0),
+        ] {
+            let d = design(
+                &format!("[[0,0],[{},10],[{},20]]", -lean / 2.0, -lean),
+                &format!("[[0,0],[{},10],[{},20]]", -lean / 2.0, -lean),
+                &format!(r#"{{"control_points":[[{r},0],[{r},{r}],[-{r},{r}],[-{r},0]]}}"#),
+            );
+            let Ok(s) = sample_surface(&d) else { continue };
+            assert_eq!(
+                find_self_intersection(&s).is_some(),
+                brute_force(&s),
+                "radius {r}, lean {lean}"
+            );
+        }
     }
 
     #[test]

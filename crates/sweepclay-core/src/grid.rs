@@ -62,72 +62,9 @@ impl Grid2 {
     }
 }
 
-/// A 3D grid of points.
-#[derive(Debug)]
-pub struct Grid3 {
-    cell: f64,
-    cells: FxHashMap<(i32, i32, i32), Vec<u32>>,
-}
-
-impl Grid3 {
-    /// An empty grid with cubic cells of side `cell` (mm).
-    pub fn new(cell: f64) -> Self {
-        Grid3 {
-            cell,
-            cells: FxHashMap::default(),
-        }
-    }
-
-    fn key(&self, p: [f64; 3]) -> (i32, i32, i32) {
-        let k = |v: f64| (v / self.cell).floor().clamp(-1e9, 1e9) as i32;
-        (k(p[0]), k(p[1]), k(p[2]))
-    }
-
-    /// Stores point `id` at `p`.
-    pub fn insert(&mut self, p: [f64; 3], id: u32) {
-        let k = self.key(p);
-        self.cells.entry(k).or_default().push(id);
-    }
-
-    /// Calls `f` for every point in the 27 cells around `p` (all points
-    /// within one cell side are among them).
-    /// The id lists of the cell holding `p` and its 26 neighbours, in a
-    /// fixed order (ids in each list in insertion order).
-    pub fn near_lists(&self, p: [f64; 3]) -> Vec<&[u32]> {
-        let (x, y, z) = self.key(p);
-        let mut out = Vec::with_capacity(27);
-        for dx in -1..=1 {
-            for dy in -1..=1 {
-                for dz in -1..=1 {
-                    if let Some(v) = self.cells.get(&(x + dx, y + dy, z + dz)) {
-                        out.push(v.as_slice());
-                    }
-                }
-            }
-        }
-        out
-    }
-
-    /// Whether `a` and `b` fall in the same cell.
-    pub fn same_cell(&self, a: [f64; 3], b: [f64; 3]) -> bool {
-        self.key(a) == self.key(b)
-    }
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    #[test]
-    fn finds_neighbours_and_not_far_points() {
-        let mut g = Grid3::new(1.0);
-        g.insert([0.2, 0.2, 0.2], 1);
-        g.insert([1.1, 0.9, 0.0], 2);
-        g.insert([5.0, 5.0, 5.0], 3);
-        let mut found: Vec<u32> = g.near_lists([0.5, 0.5, 0.5]).concat();
-        found.sort();
-        assert_eq!(found, vec![1, 2]);
-    }
 
     #[test]
     fn segments_are_found_along_their_length() {

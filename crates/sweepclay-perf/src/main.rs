@@ -3,8 +3,9 @@
 //! peak heap of slicing and of design → verified G-code with a counting
 //! allocator, reads the criterion medians of the same runs from
 //! `target/criterion` (run the benchmarks first; `scripts/perf.sh` does
-//! both), writes `docs/perf/scaling.csv` and plots time and memory against
-//! samples into `docs/img/scaling.png`.
+//! both), writes `docs/perf/scaling.csv` and every benchmark's median to
+//! `docs/perf/medians.csv`, and plots time and memory against samples into
+//! `docs/img/scaling.png`.
 //!
 //! `cargo run --release -p sweepclay-perf -- [MAX_SAMPLES]`
 
@@ -109,9 +110,52 @@ fn main() -> Result<()> {
     let dir = root.join("docs/perf");
     std::fs::create_dir_all(&dir)?;
     std::fs::write(dir.join("scaling.csv"), csv)?;
+    std::fs::write(dir.join("medians.csv"), all_medians(&crit)?)?;
     plot(&rows, &root.join("docs/img/scaling.png"))?;
     eprintln!("wrote docs/perf/scaling.csv and docs/img/scaling.png");
     Ok(())
+}
+
+/// Every criterion benchmark under `root` with its median: `id,median_ms`,
+/// sorted by id.
+fn all_medians(root: &Path) -> Result<String> {
+    fn walk(dir: &Path, out: &mut Vec<PathBuf>) -> std::io::Result<()> {
+        for e in std::fs::read_dir(dir)? {
+            let p = e?.path();
+            if p.is_dir() {
+                if p.file_name().is_some_and(|n| n == "new") {
+                    if p.join("estimates.json").exists() {
+                        out.push(p);
+                    }
+                } else if p.file_name().is_none_or(|n| n != "base" && n != "report") {
+                    walk(&p, out)?;
+                }
+            }
+        }
+        Ok(())
+    }
+    let mut found = Vec::new();
+    if root.exists() {
+        walk(root, &mut found).context("reading target/criterion")?;
+    }
+    let mut rows: Vec<(String, f64)> = found
+        .iter()
+        .filter_map(|p| {
+            let id = p
+                .parent()?
+                .strip_prefix(root)
+                .ok()?
+                .to_string_lossy()
+                .into_owned();
+            Some((id.clone(), criterion_median(root, &id)?))
+        })
+        .collect();
+    rows.sort_by(|a, b| a.0.cmp(&b.0));
+    let mut out = String::from("id,median_ms\n");
+    for (id, ms) in rows {
+        writeln!(out, "{id},{ms:.4}")?;
+    }
+    Ok(out)
 }
 
 const FONT: &str = "/usr/share/fonts/truetype/dejavu/DejaVuSans.ttf";
@@ -209,7 +253,11 @@ fn plot(rows: &[Row], out: &Path) -> Result<()> {
         .x_label_formatter(&|v| human(*v))
         .draw()?;
     for (name, f, colour) in [
-        ("design → G-code", (|r: &Row| r.slice_peak) as fn(&Row) -> usize, BLUE),
+        (
+            "design → G-code",
+            (|r: &Row| r.slice_peak) as fn(&Row) -> usize,
+            BLUE,
+        ),
         ("design → verified G-code", |r: &Row| r.verified_peak, RED),
     ] {
         let pts: Vec<(f64, f64)> = rows.iter().map(|r| (xs(r), per(r, f(r)))).collect();

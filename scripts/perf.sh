@@ -1,0 +1,14 @@
+#!/usr/bin/env bash
+# Regenerates the figures of docs/PERFORMANCE.md: the criterion benchmarks
+# of every stage and of design -> verified G-code (examples and the scaling
+# series), then peak memory per sample, docs/perf/scaling.csv and the plot
+# docs/img/scaling.png. Takes about half an hour on a 2-core machine.
+#   scripts/perf.sh            # scaling series to 10M samples (verified to 3M)
+#   MAX=1000000 scripts/perf.sh  # quicker: everything to 1M
+set -euo pipefail
+cd "$(dirname "$0")/.."
+max="${MAX:-10000000}"
+vmax=$(( max < 3000000 ? max : 3000000 ))
+SWEEPCLAY_BENCH_MAX="$max" cargo bench -p sweepclay-core --bench pipeline
+SWEEPCLAY_BENCH_MAX="$vmax" cargo bench -p sweepclay-web --bench verified
+cargo run --release -p sweepclay-perf -- "$max"
