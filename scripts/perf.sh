@@ -11,4 +11,5 @@ max="${MAX:-10000000}"
 vmax=$(( max < 3000000 ? max : 3000000 ))
 SWEEPCLAY_BENCH_MAX="$max" cargo bench -p sweepclay-core --bench pipeline
 SWEEPCLAY_BENCH_MAX="$vmax" cargo bench -p sweepclay-web --bench verified
+cargo bench -p sweepclay-check --bench check
 cargo run --release -p sweepclay-perf -- "$max"

@@ -67,6 +67,10 @@ fn examples_bench(c: &mut Criterion) {
         let n = sweepclay_core::slice(&d).unwrap().stats.sample_points as u64;
         stages(c, "stages", file.trim_end_matches(".json"), &d, n);
     }
+    // The size of the paper's largest model (43,724 samples).
+    let d = examples::scaled(43_724);
+    let n = sweepclay_core::slice(&d).unwrap().stats.sample_points as u64;
+    stages(c, "stages", "44k", &d, n);
 }
 
 fn scaling_bench(c: &mut Criterion) {

@@ -26,6 +26,7 @@ const SIZES: [usize; 7] = [
 /// One size of the series.
 struct Row {
     samples: usize,
+    /// Design → G-code: criterion medians of `slice` plus `gcode`.
     slice_ms: Option<f64>,
     verified_ms: Option<f64>,
     slice_peak: usize,
@@ -76,13 +77,16 @@ fn main() -> Result<()> {
         anyhow::ensure!(printable, "the {n}-sample design must verify");
         let row = Row {
             samples,
-            slice_ms: criterion_median(&crit, &format!("scaling/slice/{n}")),
+            // Design → G-code: the pipeline, then the writer.
+            slice_ms: criterion_median(&crit, &format!("scaling/slice/{n}"))
+                .zip(criterion_median(&crit, &format!("scaling/gcode/{n}")))
+                .map(|(a, b)| a + b),
             verified_ms: criterion_median(&crit, &format!("verified_scaling/{n}")),
             slice_peak,
             verified_peak,
         };
         eprintln!(
-            "{samples:>9} samples: slice {} ms, verified {} ms; peak {:.0} B/sample sliced, {:.0} B/sample verified",
+            "{samples:>9} samples: design → G-code {} ms, verified {} ms; peak {:.0} B/sample sliced, {:.0} B/sample verified",
             row.slice_ms.map_or("-".into(), |v| format!("{v:.1}")),
             row.verified_ms.map_or("-".into(), |v| format!("{v:.1}")),
             slice_peak as f64 / samples as f64,
@@ -91,7 +95,7 @@ fn main() -> Result<()> {
         rows.push(row);
     }
     let mut csv = String::from(
-        "samples,slice_median_ms,verified_median_ms,slice_peak_bytes,verified_peak_bytes,slice_bytes_per_sample,verified_bytes_per_sample\n",
+        "samples,gcode_median_ms,verified_median_ms,slice_peak_bytes,verified_peak_bytes,slice_bytes_per_sample,verified_bytes_per_sample\n",
     );
     let opt = |v: Option<f64>| v.map_or(String::new(), |v| format!("{v:.3}"));
     for r in &rows {
@@ -254,7 +258,7 @@ fn plot(rows: &[Row], out: &Path) -> Result<()> {
         .draw()?;
     for (name, f, colour) in [
         (
-            "design → G-code",
+            "slice (no G-code text)",
             (|r: &Row| r.slice_peak) as fn(&Row) -> usize,
             BLUE,
         ),

@@ -27,6 +27,11 @@ fn bench(c: &mut Criterion) {
             b.iter(|| verified(black_box(&d)))
         });
     }
+    // The size of the paper's largest model (43,724 samples).
+    let d = examples::scaled(43_724);
+    assert!(verified(&d));
+    g.throughput(Throughput::Elements(43_724));
+    g.bench_function("44k", |b| b.iter(|| verified(black_box(&d))));
     g.finish();
     let max: usize = std::env::var("SWEEPCLAY_BENCH_MAX")
         .ok()
