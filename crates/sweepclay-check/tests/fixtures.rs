@@ -177,16 +177,21 @@ fn spiral_vase_is_printable() {
     );
 }
 
-#[test]
-fn travel_move_fails() {
-    // Lift, move to a second wall 20 mm away, lower: three travel moves.
+/// A wall, then lift, move to a second wall 20 mm away, lower: three
+/// travel moves.
+fn two_walls() -> G {
     let mut g = wall(6);
     g.line("G1 Z20");
     g.line("G1 X50 Y70");
     g.line("G1 Z1.2");
     g.at = [50.0, 70.0, 1.2];
     g.run([90.0, 70.0, 1.2], W, LAYER);
-    let r = verdict(&g.out);
+    g
+}
+
+#[test]
+fn travel_move_fails() {
+    let r = verdict(&two_walls().out);
     fails_for(&r, "travel move", &["extrusion runs"]);
     assert_eq!(r.travel_moves.count, 3);
     assert_eq!(r.extrusion_runs, 2);
@@ -362,12 +367,7 @@ proptest! {
 fn reading_line_by_line_gives_the_same_report() {
     use sweepclay_check::check_reader;
     let cfg = CheckConfig::default();
-    let mut travel = wall(6);
-    travel.line("G1 Z20");
-    travel.line("G1 X50 Y70");
-    travel.line("G1 Z1.2");
-    travel.at = [50.0, 70.0, 1.2];
-    travel.run([90.0, 70.0, 1.2], W, LAYER);
+    let travel = two_walls();
     let mut tail = wall(5);
     // Moves and a pause after the last bead are not failures.
     tail.line("G1 Z40");

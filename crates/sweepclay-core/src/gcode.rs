@@ -209,19 +209,17 @@ pub fn emit_moves<W: Write>(
         let w = 0.5 * (ex.width[i] + ex.width[i - 1]);
         let h = 0.5 * (ex.layer_height[i] + ex.layer_height[i - 1]);
         let (wq, hq) = ((w * 1e3).round() as i64, (h * 1e3).round() as i64);
-        if wq != last_w {
-            buf.extend_from_slice(b";WIDTH:");
-            push_fixed(&mut buf, w, 3);
-            buf.push(b'\n');
-            line += 1;
-            last_w = wq;
-        }
-        if hq != last_h {
-            buf.extend_from_slice(b";HEIGHT:");
-            push_fixed(&mut buf, h, 3);
-            buf.push(b'\n');
-            line += 1;
-            last_h = hq;
+        for (tag, v, q, last) in [
+            (&b";WIDTH:"[..], w, wq, &mut last_w),
+            (&b";HEIGHT:"[..], h, hq, &mut last_h),
+        ] {
+            if q != *last {
+                buf.extend_from_slice(tag);
+                push_fixed(&mut buf, v, 3);
+                buf.push(b'\n');
+                line += 1;
+                *last = q;
+            }
         }
         let de = ex.volume[i] * f.e_per_mm3;
         let e = if f.relative_e {
