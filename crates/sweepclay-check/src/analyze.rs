@@ -261,25 +261,9 @@ pub fn check_reader<R: std::io::BufRead>(
     mut input: R,
     cfg: &CheckConfig,
 ) -> std::io::Result<Report> {
-    let mut c = Checker::new(cfg);
-    let mut buf = Vec::new();
-    loop {
-        buf.clear();
-        if input.read_until(b'\n', &mut buf)? == 0 {
-            break;
-        }
-        if buf.last() == Some(&b'\n') {
-            buf.pop();
-            if buf.last() == Some(&b'\r') {
-                buf.pop();
-            }
-        }
-        match std::str::from_utf8(&buf) {
-            Ok(l) => c.line(l),
-            Err(_) => c.line(&String::from_utf8_lossy(&buf)),
-        }
-    }
-    Ok(c.finish())
+    let mut w = CheckWriter::new(cfg);
+    std::io::copy(&mut input, &mut w)?;
+    Ok(w.finish())
 }
 
 /// Checks G-code as it is written: an `io::Write` that feeds each complete
@@ -299,22 +283,11 @@ impl<'a> CheckWriter<'a> {
         }
     }
 
-    fn feed(&mut self, mut bytes: &[u8]) {
-        if bytes.last() == Some(&b'\r') {
-            bytes = &bytes[..bytes.len() - 1];
-        }
-        match std::str::from_utf8(bytes) {
-            Ok(l) => self.checker.line(l),
-            Err(_) => self.checker.line(&String::from_utf8_lossy(bytes)),
-        }
-    }
-
     /// The report on everything written (a last line without a newline
     /// included).
     pub fn finish(mut self) -> Report {
         if !self.partial.is_empty() {
-            let last = std::mem::take(&mut self.partial);
-            self.feed(&last);
+            self.checker.bytes(&self.partial);
         }
         self.checker.finish()
     }
@@ -325,12 +298,10 @@ impl std::io::Write for CheckWriter<'_> {
         let mut rest = buf;
         while let Some(nl) = rest.iter().position(|&b| b == b'\n') {
             if self.partial.is_empty() {
-                self.feed(&rest[..nl]);
+                self.checker.bytes(&rest[..nl]);
             } else {
                 self.partial.extend_from_slice(&rest[..nl]);
-                let line = std::mem::take(&mut self.partial);
-                self.feed(&line);
-                self.partial = line;
+                self.checker.bytes(&self.partial);
                 self.partial.clear();
             }
             rest = &rest[nl + 1..];
@@ -402,6 +373,18 @@ impl<'a> Checker<'a> {
             hi: [f64::MIN; 3],
             layer_heights: Vec::new(),
             cands: Vec::new(),
+        }
+    }
+
+    /// A line as bytes, without its `\n`: a `\r` before it is dropped,
+    /// bytes that are not UTF-8 are replaced.
+    fn bytes(&mut self, mut line: &[u8]) {
+        if line.last() == Some(&b'\r') {
+            line = &line[..line.len() - 1];
+        }
+        match std::str::from_utf8(line) {
+            Ok(l) => self.line(l),
+            Err(_) => self.line(&String::from_utf8_lossy(line)),
         }
     }
 

@@ -81,6 +81,18 @@ fn char_at(s: &str, i: usize) -> (char, usize) {
     }
 }
 
+/// The first byte index from `i` on whose char is not `keep` (or the end).
+fn skip_while(s: &str, mut i: usize, keep: impl Fn(char) -> bool) -> usize {
+    while i < s.len() {
+        let (c, cl) = char_at(s, i);
+        if !keep(c) {
+            break;
+        }
+        i += cl;
+    }
+    i
+}
+
 fn ends_word(c: char) -> bool {
     c.is_ascii_alphabetic() || c.is_whitespace()
 }
@@ -148,32 +160,12 @@ impl LineParser {
             let letter = c.to_ascii_uppercase();
             i += 1;
             let start = i;
-            while i < len {
-                let (c, cl) = char_at(s, i);
-                if ends_word(c) {
-                    break;
-                }
-                i += cl;
-            }
+            i = skip_while(s, start, |c| !ends_word(c));
             // Allow "X 10" (space between letter and number).
             let mut num = &s[start..i];
             if num.is_empty() {
-                let mut j = i;
-                while j < len {
-                    let (c, cl) = char_at(s, j);
-                    if !c.is_whitespace() {
-                        break;
-                    }
-                    j += cl;
-                }
-                let s2 = j;
-                while j < len {
-                    let (c, cl) = char_at(s, j);
-                    if ends_word(c) {
-                        break;
-                    }
-                    j += cl;
-                }
+                let s2 = skip_while(s, i, char::is_whitespace);
+                let j = skip_while(s, s2, |c| !ends_word(c));
                 let first = s.as_bytes().get(s2).copied().unwrap_or(b' ');
                 if j > s2 && (first.is_ascii_digit() || matches!(first, b'-' | b'+' | b'.')) {
                     num = &s[s2..j];

@@ -13,17 +13,15 @@ use std::hint::black_box;
 use sweepclay_core::{correct, examples, extrude, finish, gcode, surface, toolpath, Design};
 
 /// The scaling series: 10k, 30k, 100k, … up to 10M (or `SWEEPCLAY_BENCH_MAX`).
-pub fn sizes() -> Vec<usize> {
+fn sizes() -> Vec<usize> {
     let max: usize = std::env::var("SWEEPCLAY_BENCH_MAX")
         .ok()
         .and_then(|v| v.parse().ok())
         .unwrap_or(10_000_000);
-    [
-        10_000, 30_000, 100_000, 300_000, 1_000_000, 3_000_000, 10_000_000,
-    ]
-    .into_iter()
-    .filter(|&n| n <= max)
-    .collect()
+    examples::SCALING_SIZES
+        .into_iter()
+        .filter(|&n| n <= max)
+        .collect()
 }
 
 fn stages(c: &mut Criterion, group: &str, name: &str, d: &Design, samples: u64) {
@@ -36,7 +34,7 @@ fn stages(c: &mut Criterion, group: &str, name: &str, d: &Design, samples: u64) 
     let corrected = correct::correct(&surf).unwrap();
     let path = toolpath::plan_path(&corrected);
     let sliced = finish(corrected.clone()).unwrap();
-    let mut out = Vec::with_capacity(sliced.toolpath.points.len() * 48);
+    let mut out = Vec::with_capacity(gcode::size_hint(&sliced));
     g.bench_function(BenchmarkId::new("sample", name), |b| {
         b.iter(|| surface::sample_surface(black_box(d)).unwrap())
     });

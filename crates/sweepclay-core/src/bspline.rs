@@ -93,8 +93,13 @@ impl BSpline {
 
     /// Length of the control polygon, an upper bound of the curve's length.
     pub fn polygon_length(&self) -> f64 {
-        self.ctrl.windows(2).map(|w| dist(w[0], w[1])).sum()
+        polyline_length(&self.ctrl)
     }
+}
+
+/// Length of a polyline (0 for fewer than two points).
+pub fn polyline_length(pts: &[[f64; 2]]) -> f64 {
+    pts.windows(2).map(|w| dist(w[0], w[1])).sum()
 }
 
 /// Euclidean distance of two plane points.

@@ -298,13 +298,8 @@ fn segment_distance(a: [[f64; 2]; 2], b: [[f64; 2]; 2]) -> f64 {
         };
         (p[0] - s[0][0] - t * dx).hypot(p[1] - s[0][1] - t * dy)
     }
-    let cross = |o: [f64; 2], p: [f64; 2], q: [f64; 2]| {
-        (p[0] - o[0]) * (q[1] - o[1]) - (p[1] - o[1]) * (q[0] - o[0])
-    };
-    let (d1, d2) = (cross(a[0], a[1], b[0]), cross(a[0], a[1], b[1]));
-    let (d3, d4) = (cross(b[0], b[1], a[0]), cross(b[0], b[1], a[1]));
-    if d1 * d2 < 0.0 && d3 * d4 < 0.0 {
-        return 0.0; // they cross
+    if crate::curves::segments_cross(a[0], a[1], b[0], b[1]) {
+        return 0.0;
     }
     point_seg(a[0], b)
         .min(point_seg(a[1], b))

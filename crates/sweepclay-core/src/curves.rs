@@ -334,7 +334,7 @@ impl Trajectory {
 }
 
 /// Whether two closed segments intersect (touching counts).
-fn segments_cross(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> bool {
+pub(crate) fn segments_cross(a: [f64; 2], b: [f64; 2], c: [f64; 2], d: [f64; 2]) -> bool {
     fn orient(p: [f64; 2], q: [f64; 2], r: [f64; 2]) -> f64 {
         (q[0] - p[0]) * (r[1] - p[1]) - (q[1] - p[1]) * (r[0] - p[0])
     }

@@ -229,11 +229,7 @@ impl Design {
     /// refuse a design before it allocates anything for it. NaN when a
     /// coordinate is not a number (slicing then names it).
     pub fn estimated_samples(&self) -> f64 {
-        let poly = |pts: &[[f64; 2]]| -> f64 {
-            pts.windows(2)
-                .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
-                .sum()
-        };
+        use crate::bspline::polyline_length as poly;
         let t = &self.trajectory;
         let length = poly(t.control_points.as_deref().unwrap_or(&[]))
             + poly(t.points.as_deref().unwrap_or(&[]));

@@ -20,6 +20,11 @@ pub fn example(name: &str) -> Option<&'static str> {
         .map(|(_, t)| *t)
 }
 
+/// The sample counts of the benchmarks' scaling series of [`scaled`].
+pub const SCALING_SIZES: [usize; 7] = [
+    10_000, 30_000, 100_000, 300_000, 1_000_000, 3_000_000, 10_000_000,
+];
+
 /// The benchmark design: t1 enlarged 2.5× in plan, both profiles stretched
 /// to 240 mm (a wall on a 400 mm printer), sampled at the layer height and
 /// spacing that give about `samples` surface samples (layer height from

@@ -255,9 +255,14 @@ pub fn to_string(s: &Sliced) -> String {
     to_string_with_lines(s).0
 }
 
+/// About how many bytes [`emit`] writes for `s` (a capacity to reserve).
+pub fn size_hint(s: &Sliced) -> usize {
+    s.toolpath.points.len() * 48 + 2048
+}
+
 /// [`emit`] into a string, with the line of each toolpath point.
 pub fn to_string_with_lines(s: &Sliced) -> (String, Vec<usize>) {
-    let mut v = Vec::with_capacity(s.toolpath.points.len() * 48 + 2048);
+    let mut v = Vec::with_capacity(size_hint(s));
     let lines = emit(s, &mut v).expect("writing to memory cannot fail");
     (
         String::from_utf8(v).expect("G-code is ASCII or the design name's UTF-8"),

@@ -305,10 +305,7 @@ fn flatten_path(d: &str, step: f64) -> Result<Vec<[f64; 2]>> {
 /// Segments for a Bézier curve so each is at most `step` long (the control
 /// polygon bounds the curve's length), capped for absurd inputs.
 fn pieces(ctrl: &[[f64; 2]], step: f64) -> usize {
-    let poly: f64 = ctrl
-        .windows(2)
-        .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
-        .sum();
+    let poly = crate::bspline::polyline_length(ctrl);
     ((poly / step).ceil() as usize).clamp(1, 10_000)
 }
 
@@ -316,11 +313,7 @@ fn pieces(ctrl: &[[f64; 2]], step: f64) -> usize {
 mod tests {
     use super::*;
 
-    fn length(p: &[[f64; 2]]) -> f64 {
-        p.windows(2)
-            .map(|w| (w[1][0] - w[0][0]).hypot(w[1][1] - w[0][1]))
-            .sum()
-    }
+    use crate::bspline::polyline_length as length;
 
     #[test]
     fn svg_arc_in_mm_is_flattened_and_flipped() {

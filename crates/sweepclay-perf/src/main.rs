@@ -19,10 +19,6 @@ use sweepclay_core::examples;
 #[global_allocator]
 static ALLOC: PeakAlloc = PeakAlloc;
 
-const SIZES: [usize; 7] = [
-    10_000, 30_000, 100_000, 300_000, 1_000_000, 3_000_000, 10_000_000,
-];
-
 /// One size of the series.
 struct Row {
     samples: usize,
@@ -61,7 +57,7 @@ fn main() -> Result<()> {
     let root = workspace();
     let crit = root.join("target/criterion");
     let mut rows = Vec::new();
-    for &n in SIZES.iter().filter(|&&n| n <= max) {
+    for n in examples::SCALING_SIZES.into_iter().filter(|&n| n <= max) {
         let d = examples::scaled(n);
         let (sliced, slice_peak) = peak_of(|| sweepclay_core::slice(&d));
         let sliced = sliced.context("the benchmark design slices")?;

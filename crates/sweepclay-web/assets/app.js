@@ -41,6 +41,11 @@ window.sweepclayErrors = [];
 window.addEventListener('error', (e) => window.sweepclayErrors.push(String(e.message)));
 window.addEventListener('unhandledrejection', (e) => window.sweepclayErrors.push(String(e.reason)));
 
+/** POSTs a design (JSON text) to an API route. */
+function postDesign(route, json) {
+  return fetch(route, { method: 'POST', headers: { 'content-type': 'application/json' }, body: json });
+}
+
 // ---------------------------------------------------------------- design
 
 function clone(d) {
@@ -195,7 +200,7 @@ async function sendSlice() {
   const t0 = performance.now();
   setBusy(true);
   try {
-    const r = await fetch('/api/slice?format=binary', { method: 'POST', headers: { 'content-type': 'application/json' }, body: job.design });
+    const r = await postDesign('/api/slice?format=binary', job.design);
     const body = r.ok ? decode(await r.arrayBuffer()) : await r.json();
     if (!r.ok) {
       showError(body.error, body.key);
@@ -296,7 +301,7 @@ function scheduleVerify(design) {
   setVerdict('checking');
   state.verifyTimer = setTimeout(async () => {
     try {
-      const r = await fetch('/api/verify', { method: 'POST', headers: { 'content-type': 'application/json' }, body: design });
+      const r = await postDesign('/api/verify', design);
       const body = await r.json();
       if (seq !== state.verifySeq) return;
       setVerdict(r.ok ? body : { printable: false, failures: [body.error], locations: [] });
@@ -423,7 +428,7 @@ async function downloadFrom(route, ext, button) {
   const label = button.textContent;
   button.textContent = 'working…';
   try {
-    const r = await fetch(route, { method: 'POST', headers: { 'content-type': 'application/json' }, body: JSON.stringify(state.design) });
+    const r = await postDesign(route, JSON.stringify(state.design));
     if (!r.ok) {
       const body = await r.json();
       if (body.failures) setVerdict({ printable: false, failures: body.failures, locations: body.locations || [] });

@@ -26,7 +26,6 @@ export class CurveEditor {
   constructor(canvas, o) {
     this.canvas = canvas;
     this.o = o;
-    this.scale = 1;
     this.ox = 0;
     this.oy = 0;
     this.selected = -1;
@@ -75,9 +74,10 @@ export class CurveEditor {
     const m = 28;
     const sx = (this.w - 2 * m) / Math.max(x1 - x0, 1e-6);
     const sy = (this.h - 2 * m) / Math.max(y1 - y0, 1e-6);
-    this.scale = this.o.fixed ? null : Math.min(sx, sy);
-    this.sx = this.o.fixed ? sx : this.scale;
-    this.sy = this.o.fixed ? sy : this.scale;
+    // A fixed view fills the canvas; a free one keeps x and y at one scale.
+    const k = Math.min(sx, sy);
+    this.sx = this.o.fixed ? sx : k;
+    this.sy = this.o.fixed ? sy : k;
     this.ox = m + (this.w - 2 * m - (x1 - x0) * this.sx) / 2 - x0 * this.sx;
     this.oy = this.h - m - (this.h - 2 * m - (y1 - y0) * this.sy) / 2 + y0 * this.sy;
     this.fitted = true;
@@ -159,7 +159,7 @@ export class CurveEditor {
       if (!p) return;
       this.points[d.i] = p;
       d.moved = true;
-      this.o.set(this.points.map((q) => q.slice()), false);
+      this.changed(false);
       this.draw();
     } else if (d.kind === 'centre') {
       // Moving o moves the curve the other way: o stays the origin.
@@ -172,7 +172,7 @@ export class CurveEditor {
       this.ox += dx * this.sx;
       this.oy -= dy * this.sy;
       d.moved = true;
-      this.o.set(this.points.map((q) => q.slice()), false);
+      this.changed(false);
       this.draw();
     }
   }
@@ -181,7 +181,7 @@ export class CurveEditor {
     const d = this.drag;
     this.drag = null;
     if (this.canvas.hasPointerCapture(e.pointerId)) this.canvas.releasePointerCapture(e.pointerId);
-    if (d && d.moved) this.o.set(this.points.map((q) => q.slice()), true);
+    if (d && d.moved) this.changed(true);
   }
 
   dbl(e) {
@@ -209,8 +209,13 @@ export class CurveEditor {
     pts[best + 1] = p;
     this.points = pts;
     this.selected = best + 1;
-    this.o.set(pts.map((q) => q.slice()), true);
+    this.changed(true);
     this.draw();
+  }
+
+  /** Hands a copy of the points to the model; `final` ends a gesture. */
+  changed(final) {
+    this.o.set(this.points.map((q) => q.slice()), final);
   }
 
   remove(i) {
@@ -218,7 +223,7 @@ export class CurveEditor {
     if (this.o.pinned && this.o.pinned(i, this.points)) return;
     this.points.splice(i, 1);
     this.selected = -1;
-    this.o.set(this.points.map((q) => q.slice()), true);
+    this.changed(true);
     this.draw();
   }
 

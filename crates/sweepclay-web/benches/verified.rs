@@ -39,12 +39,7 @@ fn bench(c: &mut Criterion) {
         .unwrap_or(10_000_000);
     let mut g = c.benchmark_group("verified_scaling");
     g.sample_size(10);
-    for n in [
-        10_000, 30_000, 100_000, 300_000, 1_000_000, 3_000_000, 10_000_000,
-    ] {
-        if n > max {
-            break;
-        }
+    for n in examples::SCALING_SIZES.into_iter().filter(|&n| n <= max) {
         let d = examples::scaled(n);
         g.throughput(Throughput::Elements(n as u64));
         g.bench_function(BenchmarkId::from_parameter(n), |b| {

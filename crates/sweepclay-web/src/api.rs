@@ -42,6 +42,16 @@ impl ApiError {
     }
 }
 
+impl ApiError {
+    /// The same error, naming the offending key.
+    pub fn with_key(self, key: impl Into<String>) -> Self {
+        ApiError {
+            key: Some(key.into()),
+            ..self
+        }
+    }
+}
+
 impl From<Error> for ApiError {
     fn from(e: Error) -> Self {
         let (status, key) = match &e {
@@ -74,17 +84,15 @@ pub fn parse_design(text: &str, limits: &Limits) -> Result<Design, ApiError> {
     let d = Design::from_json(text)?;
     let est = d.estimated_samples();
     if est > limits.max_samples {
-        return Err(ApiError {
-            key: Some("params.spacing".into()),
-            ..ApiError::new(
-                413,
-                format!(
-                    "params.spacing / params.layer_height: the design would have about {:.1} million samples, over this server's limit of {:.1} million; raise the spacing or the layer height",
-                    est / 1e6,
-                    limits.max_samples / 1e6
-                ),
-            )
-        });
+        return Err(ApiError::new(
+            413,
+            format!(
+                "params.spacing / params.layer_height: the design would have about {:.1} million samples, over this server's limit of {:.1} million; raise the spacing or the layer height",
+                est / 1e6,
+                limits.max_samples / 1e6
+            ),
+        )
+        .with_key("params.spacing"));
     }
     Ok(d)
 }
@@ -319,10 +327,8 @@ pub struct Verdict {
 }
 
 /// Slices, emits and checks a design.
-pub fn verified(design: &Design) -> Result<(Sliced, Verified), ApiError> {
-    let s = sweepclay_core::slice(design)?;
-    let v = verify(&s, 0.5);
-    Ok((s, v))
+pub fn verified(design: &Design) -> Result<Verified, ApiError> {
+    Ok(verify(&sweepclay_core::slice(design)?, 0.5))
 }
 
 /// The verdict of [`verified`].
@@ -339,17 +345,19 @@ pub fn verdict(v: &Verified) -> Verdict {
 /// The G-code of a design, only if it passes the check; otherwise a 422
 /// that says why and where.
 pub fn gcode(design: &Design) -> Result<String, ApiError> {
-    let (_, v) = verified(design)?;
-    if v.report.printable {
-        Ok(v.gcode)
+    let Verified {
+        gcode,
+        report,
+        locations,
+    } = verified(design)?;
+    if report.printable {
+        Ok(gcode)
     } else {
+        let error = format!("not printable: {}", report.failures.join("; "));
         Err(ApiError {
-            failures: v.report.failures.clone(),
-            locations: v.locations.clone(),
-            ..ApiError::new(
-                422,
-                format!("not printable: {}", v.report.failures.join("; ")),
-            )
+            failures: report.failures,
+            locations,
+            ..ApiError::new(422, error)
         })
     }
 }
@@ -377,21 +385,17 @@ pub fn import(format: &str, text: &str) -> Result<Imported, ApiError> {
         "svg" => sweepclay_core::import::svg_trajectory(text)?,
         "csv" => sweepclay_core::import::csv_trajectory(text)?,
         other => {
-            return Err(ApiError {
-                key: Some("format".into()),
-                ..ApiError::new(
-                    400,
-                    format!("format: `{other}` is not an import format (svg, csv)"),
-                )
-            })
+            return Err(ApiError::new(
+                400,
+                format!("format: `{other}` is not an import format (svg, csv)"),
+            )
+            .with_key("format"))
         }
     };
     for p in &mut points {
         *p = p.map(|x| (x * 1000.0).round() / 1000.0);
     }
-    let length_mm = *sweepclay_core::curves::arc_lengths(&points)
-        .last()
-        .expect("an import has at least two points");
+    let length_mm = sweepclay_core::bspline::polyline_length(&points);
     Ok(Imported { points, length_mm })
 }
 

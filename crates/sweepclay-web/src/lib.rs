@@ -192,10 +192,10 @@ async fn slice(
         None | Some("json") => false,
         Some("binary") => true,
         Some(other) => {
-            return Err(ApiError {
-                key: Some("format".into()),
-                ..ApiError::new(400, format!("format: `{other}` is not json or binary"))
-            })
+            return Err(
+                ApiError::new(400, format!("format: `{other}` is not json or binary"))
+                    .with_key("format"),
+            )
         }
     };
     let view = with_design(limits, body, |d| api::slice_view(&d)).await?;
@@ -214,7 +214,7 @@ async fn verify_design(
     State(limits): State<Shared>,
     body: Result<Bytes, BytesRejection>,
 ) -> Result<Json<api::Verdict>, ApiError> {
-    with_design(limits, body, |d| Ok(api::verdict(&api::verified(&d)?.1)))
+    with_design(limits, body, |d| Ok(api::verdict(&api::verified(&d)?)))
         .await
         .map(Json)
 }
@@ -304,12 +304,12 @@ async fn check(
         ));
     }
     let name = q.printer.unwrap_or_else(|| "generic".into());
-    let printer = Printer::preset(&name).ok_or_else(|| ApiError {
-        key: Some("printer".into()),
-        ..ApiError::new(
+    let printer = Printer::preset(&name).ok_or_else(|| {
+        ApiError::new(
             422,
             format!("printer: `{name}` is not a preset ({})", PRESETS.join(", ")),
         )
+        .with_key("printer")
     })?;
     let text = text(body)?;
     blocking(move || {

@@ -88,7 +88,7 @@ pub fn verify_into<W: Write>(
 
 /// [`verify_into`] a string.
 pub fn verify(s: &Sliced, min_overlap: f64) -> Verified {
-    let mut text = Vec::with_capacity(s.toolpath.points.len() * 48 + 2048);
+    let mut text = Vec::with_capacity(gcode::size_hint(s));
     let (report, locations) =
         verify_into(s, min_overlap, &mut text).expect("writing to memory cannot fail");
     Verified {
