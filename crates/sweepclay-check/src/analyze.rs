@@ -77,14 +77,13 @@ fn cell(v: f64, size: f64) -> i32 {
     (v / size).floor().clamp(-1e8, 1e8) as i32
 }
 
-#[derive(Default)]
 struct BeadGrid {
     cells: FxHashMap<(i32, i32, i32), Vec<u32>>,
     /// Highest clay top in each plan column, every bead.
-    column_max: FxHashMap<(i32, i32), f64>,
+    column_max: TopGrid,
     /// The same for settled beads only: those far enough back along the
     /// path that the nozzle is no longer laying them (see `settle`).
-    settled_max: FxHashMap<(i32, i32), f64>,
+    settled_max: TopGrid,
 }
 
 /// Cell ranges of a bead: plan x, plan y, z (inclusive), and its top.
@@ -98,6 +97,15 @@ enum Tops {
 }
 
 impl BeadGrid {
+    fn new(cfg: &CheckConfig) -> BeadGrid {
+        let plate = [cfg.build_volume[0], cfg.build_volume[1]];
+        BeadGrid {
+            cells: FxHashMap::default(),
+            column_max: TopGrid::new(plate, CELL_XY),
+            settled_max: TopGrid::new(plate, CELL_XY),
+        }
+    }
+
     /// The cells a bead spans: plan x and y ranges, z range and top, or
     /// `None` for a move so long (other slicers) that indexing it would
     /// exhaust memory.
@@ -118,13 +126,12 @@ impl BeadGrid {
     }
 
     fn insert(&mut self, b: &Bead, id: u32) {
-        let Some((xs, ys, zs, ztop)) = Self::span(b) else {
+        self.column_max.raise(b);
+        let Some((xs, ys, zs, _)) = Self::span(b) else {
             return;
         };
         for x in xs[0]..=xs[1] {
             for y in ys[0]..=ys[1] {
-                let m = self.column_max.entry((x, y)).or_insert(f64::MIN);
-                *m = m.max(ztop);
                 for z in zs[0]..=zs[1] {
                     self.cells.entry((x, y, z)).or_default().push(id);
                 }
@@ -134,15 +141,7 @@ impl BeadGrid {
 
     /// Counts a bead in the settled column tops.
     fn settle(&mut self, b: &Bead) {
-        let Some((xs, ys, _, ztop)) = Self::span(b) else {
-            return;
-        };
-        for x in xs[0]..=xs[1] {
-            for y in ys[0]..=ys[1] {
-                let m = self.settled_max.entry((x, y)).or_insert(f64::MIN);
-                *m = m.max(ztop);
-            }
-        }
+        self.settled_max.raise(b);
     }
 
     /// Ids in cells within `r` (plan) of `p` and heights `zlo..=zhi`,
@@ -165,9 +164,7 @@ impl BeadGrid {
         };
         for x in x0..=x1 {
             for y in y0..=y1 {
-                let Some(&top) = tops.get(&(x, y)) else {
-                    continue;
-                };
+                let top = tops.at_cell(x, y, CELL_XY);
                 if top < zlo {
                     continue;
                 }
@@ -181,16 +178,140 @@ impl BeadGrid {
     }
 }
 
+/// Highest clay top in each plan cell of a fixed rectangle (the bed with
+/// a margin): a dense array, so a question about a neighbourhood is a few
+/// loads. Clay outside the rectangle is counted in its border cells, which
+/// keeps every cell's value an upper bound.
+struct TopGrid {
+    cell: f64,
+    /// Plan coordinates of the rectangle's low corner.
+    origin: [f64; 2],
+    n: [usize; 2],
+    top: Vec<f32>,
+    /// The widest bead raised.
+    widest: f32,
+}
+
+impl TopGrid {
+    /// A grid over `0..extent` in x and y plus a margin of 8 cells, with
+    /// cells a whole multiple of `base` mm (so each cell of a `base` grid
+    /// lies in one of them) and at most 1024 a side.
+    fn new(extent: [f64; 2], base: f64) -> TopGrid {
+        let extent = extent.map(|v| {
+            if v.is_finite() {
+                v.clamp(1.0, 1e6)
+            } else {
+                1.0
+            }
+        });
+        let cell = base * (extent[0].max(extent[1]) / (1000.0 * base)).ceil().max(1.0);
+        let margin = 8.0 * cell;
+        let n = extent.map(|v| ((v + 2.0 * margin) / cell).ceil() as usize);
+        TopGrid {
+            cell,
+            origin: [-margin, -margin],
+            n,
+            top: vec![f32::NEG_INFINITY; n[0] * n[1]],
+            widest: 0.0,
+        }
+    }
+
+    /// The top of the cell holding cell `(x, y)` of a grid of `base` mm
+    /// aligned at 0 (an upper bound of its clay).
+    fn at_cell(&self, x: i32, y: i32, base: f64) -> f64 {
+        let (px, py) = ((f64::from(x) + 0.5) * base, (f64::from(y) + 0.5) * base);
+        f64::from(self.top[self.index(py, 1) * self.n[0] + self.index(px, 0)])
+    }
+
+    /// Cell index along axis `a`, clamped into the rectangle.
+    fn index(&self, v: f64, a: usize) -> usize {
+        let i = ((v - self.origin[a]) / self.cell).floor();
+        if i >= 0.0 {
+            (i as usize).min(self.n[a] - 1)
+        } else {
+            0
+        }
+    }
+
+    /// Cell ranges `[x0, x1], [y0, y1]` (inclusive) of a plan box.
+    fn range(&self, lo: [f64; 2], hi: [f64; 2]) -> ([usize; 2], [usize; 2]) {
+        (
+            [self.index(lo[0], 0), self.index(hi[0], 0)],
+            [self.index(lo[1], 1), self.index(hi[1], 1)],
+        )
+    }
+
+    fn raise_box(&mut self, (xs, ys): ([usize; 2], [usize; 2]), top: f32) {
+        for y in ys[0]..=ys[1] {
+            let row = &mut self.top[y * self.n[0]..(y + 1) * self.n[0]];
+            for v in &mut row[xs[0]..=xs[1]] {
+                *v = v.max(top);
+            }
+        }
+    }
+
+    /// Raises the cells a bead's centreline passes through to its top:
+    /// the cells of its plan bounding box, or for a long slanting move
+    /// (other slicers) the cells around points every half cell along it.
+    fn raise(&mut self, b: &Bead) {
+        let (f, t) = (b.from(), b.to());
+        let top = b.from32[2].max(b.to32[2]);
+        self.widest = self.widest.max(b.width32);
+        let (xs, ys) = self.range(
+            [f[0].min(t[0]), f[1].min(t[1])],
+            [f[0].max(t[0]), f[1].max(t[1])],
+        );
+        if (xs[1] - xs[0] + 1) * (ys[1] - ys[0] + 1) <= 16 {
+            return self.raise_box((xs, ys), top);
+        }
+        let len = len2(t[0] - f[0], t[1] - f[1]);
+        let steps = ((2.0 * len / self.cell).ceil() as usize).min(1 << 20);
+        for k in 0..=steps {
+            let u = k as f64 / steps as f64;
+            let p = [f[0] + u * (t[0] - f[0]), f[1] + u * (t[1] - f[1])];
+            // Every point of the centreline is within half a cell of one
+            // of these, so in its cell or a neighbour.
+            let r = 0.5 * self.cell;
+            let cells = self.range([p[0] - r, p[1] - r], [p[0] + r, p[1] + r]);
+            self.raise_box(cells, top);
+        }
+    }
+
+    /// The cell's plan rectangle `[x0, y0, x1, y1]`.
+    fn rect(&self, x: usize, y: usize) -> [f64; 4] {
+        let x0 = self.origin[0] + x as f64 * self.cell;
+        let y0 = self.origin[1] + y as f64 * self.cell;
+        [x0, y0, x0 + self.cell, y0 + self.cell]
+    }
+}
+
+/// Plan distance from `p` to a rectangle `[x0, y0, x1, y1]` (0 inside).
+fn rect_distance(r: [f64; 4], p: [f64; 2]) -> f64 {
+    let dx = (r[0] - p[0]).max(p[0] - r[2]).max(0.0);
+    let dy = (r[1] - p[1]).max(p[1] - r[3]).max(0.0);
+    len2(dx, dy)
+}
+
 /// A bead below a new bead: height at its point nearest to the new bead's
 /// middle, that point, the horizontal distance to it, its width, and
 /// whether its footprint (a capsule: centreline ± w/2) covers the middle.
 #[derive(Clone, Copy, Debug)]
 struct Candidate {
+    /// The bead's index.
+    id: u32,
     z: f64,
     at: [f64; 2],
     d: f64,
     width: f64,
     covers: bool,
+}
+
+impl Candidate {
+    /// Order by distance, ties (the shared end of two beads) to the
+    /// earlier bead.
+    fn nearer(&self, o: &Candidate) -> std::cmp::Ordering {
+        self.d.total_cmp(&o.d).then(self.id.cmp(&o.id))
+    }
 }
 
 /// The bead a new bead rests on. Under a bead, earlier passes form a stack
@@ -209,7 +330,7 @@ fn pick_support(cands: &[Candidate], min_layer: f64, near_bed: bool) -> Option<C
         return None;
     }
     let group: Vec<&Candidate> = cands.iter().filter(|c| c.covers == covering).collect();
-    let mut best = **group.iter().min_by(|a, b| a.d.total_cmp(&b.d))?;
+    let mut best = **group.iter().min_by(|a, b| a.nearer(b))?;
     loop {
         let next = group
             .iter()
@@ -217,12 +338,224 @@ fn pick_support(cands: &[Candidate], min_layer: f64, near_bed: bool) -> Option<C
                 let rise = c.z - best.z;
                 rise >= min_layer && rise >= 0.5 * len2(c.at[0] - best.at[0], c.at[1] - best.at[1])
             })
-            .min_by(|a, b| a.d.total_cmp(&b.d));
+            .min_by(|a, b| a.nearer(b));
         match next {
             Some(c) => best = **c,
             None => return Some(best),
         }
     }
+}
+
+/// What an earlier bead is to a new one.
+enum Class {
+    /// Clay below that may support it.
+    Below(Candidate),
+    /// Clay already at its height under its middle.
+    Double,
+    /// Neither: too far, too deep, above it, a step, or behind the nozzle.
+    Neither,
+}
+
+/// Judges earlier bead `b` (index `j`) against the new bead `m`, whose
+/// middle is `mid` and which starts at path distance `s_start`.
+fn classify(b: &Bead, j: u32, m: &Move, mid: [f64; 3], s_start: f64, cfg: &CheckConfig) -> Class {
+    if b.step || b.s_end >= s_start - 1e-9 {
+        return Class::Neither;
+    }
+    let (_, d, z, at) = b.closest(mid);
+    // A bead laid earlier in this run lies behind the nozzle, not below
+    // it: little more path than the distance lies between them, and the
+    // new bead clearly moves away from it (its middle ≥ 0.1 mm farther
+    // from it than its start) or starts less than 0.5 mm above it (round
+    // a sharp corner it may turn back toward it). A bead below that the
+    // path returns over after a turn or a step-up is approached (or
+    // passed alongside) and a layer down; a bead laid again right on top
+    // of an earlier one (d ≈ 0) is neither.
+    let from_end = len2(m.from[0] - at[0], m.from[1] - at[1]);
+    if s_start - b.s_end <= 1.5 * d + 1e-6 && (d > from_end + 0.1 || m.from[2] - z < 0.5) {
+        return Class::Neither;
+    }
+    if z <= mid[2] - cfg.min_layer_mm {
+        if mid[2] - z <= cfg.max_gap_mm && d <= cfg.width_max.max(b.width() / 2.0) {
+            return Class::Below(Candidate {
+                id: j,
+                z,
+                at,
+                d,
+                width: b.width(),
+                covers: d <= b.width() / 2.0,
+            });
+        }
+    } else if (z - mid[2]).abs() < cfg.min_layer_mm
+        && d < 0.5 * b.width().min(cfg.width_min)
+        // Clay laid in the last 2 w_max of path is the run's own fresh
+        // clay (a corner piles up, it is not laid twice).
+        && s_start - b.s_end > 2.0 * cfg.width_max
+    {
+        return Class::Double;
+    }
+    Class::Neither
+}
+
+/// The beads laid in the last stretch of path, not yet in the settled
+/// tops: their lowest point (a sliding-window minimum: ids and heights both
+/// increasing) and how much the path turns among them (in plan, radians; a
+/// turnaround or a jump counts π).
+#[derive(Default)]
+struct Recent {
+    low: std::collections::VecDeque<(u32, f32)>,
+    turns: std::collections::VecDeque<(u32, f32)>,
+    turning: f64,
+    /// Plan direction of the last bead and its path end, if it had one.
+    last: Option<([f64; 2], f64)>,
+}
+
+impl Recent {
+    /// The turn from the last bead into the move `m` starting at path
+    /// distance `s_start`.
+    fn turn(&self, m: &Move, s_start: f64) -> f64 {
+        let (dx, dy) = (m.to[0] - m.from[0], m.to[1] - m.from[1]);
+        let l = len2(dx, dy);
+        match self.last {
+            Some((u, s)) if l > 1e-9 && (s - s_start).abs() < 1e-9 => {
+                let c = ((u[0] * dx + u[1] * dy) / l).clamp(-1.0, 1.0);
+                c.acos()
+            }
+            _ => std::f64::consts::PI,
+        }
+    }
+
+    fn push(&mut self, id: u32, m: &Move, s_start: f64, s_end: f64, step: bool, low: f32) {
+        let turn = if step {
+            std::f64::consts::PI
+        } else {
+            self.turn(m, s_start)
+        };
+        self.turning += turn;
+        self.turns.push_back((id, turn as f32));
+        while self.low.back().is_some_and(|r| r.1 >= low) {
+            self.low.pop_back();
+        }
+        self.low.push_back((id, low));
+        let (dx, dy) = (m.to[0] - m.from[0], m.to[1] - m.from[1]);
+        let l = len2(dx, dy);
+        self.last = (l > 1e-9 && !step).then(|| ([dx / l, dy / l], s_end));
+    }
+
+    /// Bead `id` leaves the window.
+    fn settle(&mut self, id: u32) {
+        if self.low.front().is_some_and(|r| r.0 == id) {
+            self.low.pop_front();
+        }
+        if self.turns.front().is_some_and(|r| r.0 == id) {
+            let (_, t) = self.turns.pop_front().unwrap_or_default();
+            self.turning -= f64::from(t);
+        }
+        if self.turns.is_empty() {
+            self.turning = 0.0;
+        }
+    }
+
+    fn low(&self) -> f64 {
+        self.low.front().map_or(f64::INFINITY, |r| f64::from(r.1))
+    }
+
+    /// Whether none of these beads can be clay below the new bead `m`
+    /// (middle `mid`) for `classify`. Either all are less than `min_layer`
+    /// below the middle, or the path turns less than 60° in plan through
+    /// them and into `m`. Then each is farther from the middle than
+    /// cos 30° ≈ 0.87 × the path between (more than the 1/1.5 `classify`
+    /// asks), and `m` runs away from each by more than a quarter of its
+    /// length. So, if `m` is longer than 0.45 mm in plan (or all are less
+    /// than 0.5 mm below its start), `classify` puts each behind the
+    /// nozzle.
+    fn clear_of(&self, m: &Move, mid: [f64; 3], s_start: f64, min_layer: f64) -> bool {
+        let low = self.low();
+        low > mid[2] - min_layer
+            || ((low > m.from[2] - 0.5 || m.xy_length() > 0.45)
+                && self.turning + self.turn(m, s_start) < std::f64::consts::FRAC_PI_3)
+    }
+}
+
+/// The support of a new bead found without a search, or `None` when
+/// anything about its surroundings is unusual (then the full search of
+/// [`pick_support`] decides). Beads rest on the pass below, which runs
+/// along under them: from `start`, the support of the bead before, walk
+/// along the beads laid around it while they come nearer the middle. The
+/// bead found is the answer only if it covers the middle and nothing
+/// else could change the full search's answer:
+/// - no settled clay near the middle is high enough above it to be
+///   climbed to (see `pick_support`) or at the new bead's own height;
+/// - none of the clay laid in the last 2 w_max of path can be clay below
+///   (`recent_clear`, from [`Recent::clear_of`]).
+///
+/// The cost does not depend on how finely the path is sampled.
+#[allow(clippy::too_many_arguments)]
+fn follow_support(
+    beads: &[Bead],
+    settled: usize,
+    tops: &TopGrid,
+    recent_clear: bool,
+    start: u32,
+    m: &Move,
+    mid: [f64; 3],
+    s_start: f64,
+    cfg: &CheckConfig,
+) -> Option<Candidate> {
+    if !recent_clear {
+        return None;
+    }
+    let eval = |k: usize| match beads.get(k) {
+        Some(b) if k < settled => match classify(b, k as u32, m, mid, s_start, cfg) {
+            Class::Below(c) => Some(c),
+            _ => None,
+        },
+        _ => None,
+    };
+    let mut best = eval(start as usize)?;
+    for dir in [1isize, -1] {
+        let mut k = start as isize;
+        let mut moved = false;
+        for _ in 0..64 {
+            k += dir;
+            match usize::try_from(k).ok().and_then(eval) {
+                Some(c) if c.nearer(&best).is_lt() => {
+                    best = c;
+                    moved = true;
+                }
+                _ => break,
+            }
+        }
+        if moved {
+            break;
+        }
+    }
+    if !best.covers {
+        return None;
+    }
+    // The full search's square; wider if a settled bead is so wide that it
+    // could cover the middle from farther (other slicers' files).
+    let r = (cfg.width_max / 2.0 + 0.5).max(f64::from(tops.widest) / 2.0);
+    if r > 2.0 * cfg.width_max {
+        return None;
+    }
+    let (xs, ys) = tops.range([mid[0] - r, mid[1] - r], [mid[0] + r, mid[1] + r]);
+    for y in ys[0]..=ys[1] {
+        for x in xs[0]..=xs[1] {
+            let top = f64::from(tops.top[y * tops.n[0] + x]);
+            if top == f64::NEG_INFINITY {
+                continue;
+            }
+            let rect = tops.rect(x, y);
+            let climb = best.z + cfg.min_layer_mm.max(0.5 * rect_distance(rect, best.at));
+            let own = rect_distance(rect, [mid[0], mid[1]]) < 0.5 * cfg.width_min
+                && top > mid[2] - cfg.min_layer_mm;
+            if top >= climb || own {
+                return None;
+            }
+        }
+    }
+    Some(best)
 }
 
 /// Overlap of a bead of width `wa` with one of width `wb` whose centre is
@@ -250,6 +583,17 @@ fn minmax(slot: &mut Option<[(f64, usize); 2]>, v: f64, line: usize) {
 /// Checks a G-code text. Never panics, whatever the input.
 pub fn check(text: &str, cfg: &CheckConfig) -> Report {
     let mut c = Checker::new(cfg);
+    text.lines().for_each(|l| c.line(l));
+    c.finish()
+}
+
+/// [`check`] with the support always found by the full search, never by
+/// following the bead below (`follow_support`): the reference the tests
+/// hold the fast path to. The two give the same report.
+#[doc(hidden)]
+pub fn check_exhaustive(text: &str, cfg: &CheckConfig) -> Report {
+    let mut c = Checker::new(cfg);
+    c.exhaustive = true;
     text.lines().for_each(|l| c.line(l));
     c.finish()
 }
@@ -349,6 +693,18 @@ struct Checker<'a> {
     hi: [f64; 3],
     layer_heights: Vec<f64>,
     cands: Vec<Candidate>,
+    /// Clay tops of the beads laid more than 2 w_max of path back, in
+    /// finer cells, for the support's fast path (`follow_support`).
+    support_tops: TopGrid,
+    /// Beads `..support_settled` are in `support_tops`.
+    support_settled: usize,
+    /// The lowest point of the beads laid since: a sliding-window minimum
+    /// (ids and heights, both increasing).
+    recent: Recent,
+    /// The bead the last bead rests on.
+    prev_support: Option<u32>,
+    /// Always search (tests compare the fast path against this).
+    exhaustive: bool,
 }
 
 impl<'a> Checker<'a> {
@@ -364,7 +720,7 @@ impl<'a> Checker<'a> {
             in_run: false,
             pending: Vec::new(),
             beads: Vec::new(),
-            grid: BeadGrid::default(),
+            grid: BeadGrid::new(cfg),
             unsettled: Default::default(),
             stamp: Vec::new(),
             s: 0.0,
@@ -373,6 +729,11 @@ impl<'a> Checker<'a> {
             hi: [f64::MIN; 3],
             layer_heights: Vec::new(),
             cands: Vec::new(),
+            support_tops: TopGrid::new([cfg.build_volume[0], cfg.build_volume[1]], 2.0),
+            support_settled: 0,
+            recent: Recent::default(),
+            prev_support: None,
+            exhaustive: false,
         }
     }
 
@@ -543,6 +904,11 @@ impl<'a> Checker<'a> {
             hi,
             layer_heights,
             cands,
+            support_tops,
+            support_settled,
+            recent,
+            prev_support,
+            exhaustive,
             ..
         } = self;
         r.path_length_mm += len;
@@ -561,6 +927,12 @@ impl<'a> Checker<'a> {
         let step = m.xy_length() <= 2.0 * rise;
         let id = beads.len() as u32;
         let mut width = cfg.width_min;
+        let horizon = s_start - 2.0 * cfg.width_max;
+        while let Some(b) = beads.get(*support_settled).filter(|b| b.s_end < horizon) {
+            support_tops.raise(b);
+            recent.settle(*support_settled as u32);
+            *support_settled += 1;
+        }
         if step {
             r.support.steps += 1;
         } else {
@@ -569,79 +941,63 @@ impl<'a> Checker<'a> {
                 0.5 * (m.from[1] + m.to[1]),
                 0.5 * (m.from[2] + m.to[2]),
             ];
-            stamp.resize(beads.len(), u32::MAX);
-            cands.clear();
-            let mut double = false;
-            let covered = std::cell::Cell::new(false);
-            let (zlo, zhi) = (mid[2] - cfg.max_gap_mm, mid[2] + cfg.min_layer_mm);
-            let mut visit = |j: u32| {
-                let ju = j as usize;
-                if stamp[ju] == id {
-                    return;
-                }
-                stamp[ju] = id;
-                let b = &beads[ju];
-                if b.step || b.s_end >= s_start - 1e-9 {
-                    return;
-                }
-                let (_, d, z, at) = b.closest(mid);
-                // A bead laid earlier in this run lies behind the nozzle,
-                // not below it: little more path than the distance lies
-                // between them, and the new bead clearly moves away from it
-                // (its middle ≥ 0.1 mm farther from it than its start) or
-                // starts less than 0.5 mm above it (round a sharp corner it
-                // may turn back toward it). A bead below that the path returns over after
-                // a turn or a step-up is approached (or passed alongside)
-                // and a layer down; a bead laid again right on top of an
-                // earlier one (d ≈ 0) is neither.
-                let from_end = len2(m.from[0] - at[0], m.from[1] - at[1]);
-                if s_start - b.s_end <= 1.5 * d + 1e-6
-                    && (d > from_end + 0.1 || m.from[2] - z < 0.5)
-                {
-                    return;
-                }
-                if z <= mid[2] - cfg.min_layer_mm {
-                    if mid[2] - z > cfg.max_gap_mm {
+            let clear = recent.clear_of(m, mid, s_start, cfg.min_layer_mm);
+            let fast = prev_support.filter(|_| !*exhaustive).and_then(|j| {
+                follow_support(
+                    beads,
+                    *support_settled,
+                    support_tops,
+                    clear,
+                    j,
+                    m,
+                    mid,
+                    s_start,
+                    cfg,
+                )
+            });
+            r.support.beads += 1;
+            let support = if fast.is_some() {
+                fast
+            } else {
+                stamp.resize(beads.len(), u32::MAX);
+                cands.clear();
+                let mut double = false;
+                let covered = std::cell::Cell::new(false);
+                let (zlo, zhi) = (mid[2] - cfg.max_gap_mm, mid[2] + cfg.min_layer_mm);
+                let mut visit = |j: u32| {
+                    let ju = j as usize;
+                    if stamp[ju] == id {
                         return;
                     }
-                    if d <= cfg.width_max.max(b.width() / 2.0) {
-                        let covers = d <= b.width() / 2.0;
-                        covered.set(covered.get() || covers);
-                        cands.push(Candidate {
-                            z,
-                            at,
-                            d,
-                            width: b.width(),
-                            covers,
-                        });
+                    stamp[ju] = id;
+                    match classify(&beads[ju], j, m, mid, s_start, cfg) {
+                        Class::Below(c) => {
+                            covered.set(covered.get() || c.covers);
+                            cands.push(c);
+                        }
+                        Class::Double => double = true,
+                        Class::Neither => {}
                     }
-                } else if (z - mid[2]).abs() < cfg.min_layer_mm
-                    && d < 0.5 * b.width().min(cfg.width_min)
-                    // Clay laid in the last 2 w_max of path is the run's own
-                    // fresh clay (a corner piles up, it is not laid twice).
-                    && s_start - b.s_end > 2.0 * cfg.width_max
-                {
-                    double = true;
+                };
+                // Beads covering the middle are within w/2; look wider only
+                // when none is (to measure an overhang).
+                grid.for_each(
+                    mid,
+                    cfg.width_max / 2.0 + 0.5,
+                    zlo,
+                    zhi,
+                    Tops::All,
+                    &mut visit,
+                );
+                if !covered.get() {
+                    grid.for_each(mid, cfg.width_max, zlo, zhi, Tops::All, &mut visit);
                 }
+                if double {
+                    r.support.double_deposition.add(m.line, 0.0);
+                }
+                pick_support(cands, cfg.min_layer_mm, mid[2] <= cfg.first_layer_max_mm)
             };
-            // Beads covering the middle are within w/2; look wider only
-            // when none is (to measure an overhang).
-            grid.for_each(
-                mid,
-                cfg.width_max / 2.0 + 0.5,
-                zlo,
-                zhi,
-                Tops::All,
-                &mut visit,
-            );
-            if !covered.get() {
-                grid.for_each(mid, cfg.width_max, zlo, zhi, Tops::All, &mut visit);
-            }
-            r.support.beads += 1;
-            if double {
-                r.support.double_deposition.add(m.line, 0.0);
-            }
-            let support = pick_support(cands, cfg.min_layer_mm, mid[2] <= cfg.first_layer_max_mm);
+            *prev_support = support.map(|c| c.id);
             let (dz, overlap, offset) = match support {
                 Some(c) => {
                     let dz = mid[2] - c.z;
@@ -705,6 +1061,8 @@ impl<'a> Checker<'a> {
         );
         grid.insert(&bead, id);
         unsettled.push_back(id);
+        let low = bead.from32[2].min(bead.to32[2]);
+        recent.push(id, m, s_start, s, step, low);
         *top_z = top_z.max(m.from[2].max(m.to[2]));
         beads.push(bead);
     }
@@ -793,6 +1151,7 @@ mod tests {
 
     fn cand(z: f64, x: f64, d: f64) -> Candidate {
         Candidate {
+            id: 0,
             z,
             at: [x, 0.0],
             d,

@@ -39,6 +39,8 @@ pub mod parse;
 pub mod replay;
 mod report;
 
+#[doc(hidden)]
+pub use analyze::check_exhaustive;
 pub use analyze::{check, check_reader, CheckWriter};
 pub use parse::Diagnostic;
 pub use report::{Count, Report, SupportStats};

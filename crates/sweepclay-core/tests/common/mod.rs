@@ -1,10 +1,11 @@
 //! Helpers shared by the integration tests of the pipeline.
 
-use sweepclay_check::{check, CheckConfig, Report};
+use sweepclay_check::{check, check_exhaustive, CheckConfig, Report};
 use sweepclay_core::{gcode, Sliced};
 
 /// The checker configured from the design's printer and parameters, as
-/// `sweepclay slice` configures it.
+/// `sweepclay slice` configures it. Also holds the checker's fast support
+/// path to its full search: both must give the same report.
 pub fn check_sliced(s: &Sliced) -> Report {
     let p = &s.corrected.surface.params;
     let pr = &s.corrected.surface.printer;
@@ -20,5 +21,12 @@ pub fn check_sliced(s: &Sliced) -> Report {
         first_layer_max_mm: p.max_layer_height + 0.05,
         ..CheckConfig::default()
     };
-    check(&gcode::to_string(s), &cfg)
+    let text = gcode::to_string(s);
+    let report = check(&text, &cfg);
+    assert_eq!(
+        report,
+        check_exhaustive(&text, &cfg),
+        "the checker's fast support path and its full search disagree"
+    );
+    report
 }
