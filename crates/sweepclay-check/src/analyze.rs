@@ -73,12 +73,25 @@ fn len2(dx: f64, dy: f64) -> f64 {
     (dx * dx + dy * dy).sqrt()
 }
 
+/// `floor(v / size)`, clamped to ±10⁸ (NaN to 0). Not `f64::floor`, which
+/// without SSE 4.1 is a library call this hot path cannot pay.
 fn cell(v: f64, size: f64) -> i32 {
-    (v / size).floor().clamp(-1e8, 1e8) as i32
+    let q = (v / size).clamp(-1e8, 1e8);
+    let t = q as i32;
+    if f64::from(t) > q {
+        t - 1
+    } else {
+        t
+    }
 }
 
 struct BeadGrid {
-    cells: FxHashMap<(i32, i32, i32), Vec<u32>>,
+    /// Each cell's list of beads, newest first: the index of its first
+    /// entry in `links`.
+    cells: FxHashMap<(i32, i32, i32), u32>,
+    /// List entries: a bead and the index of the next entry (`u32::MAX`
+    /// ends the list). One array instead of a vector per cell.
+    links: Vec<(u32, u32)>,
     /// Highest clay top in each plan column, every bead.
     column_max: TopGrid,
     /// The same for settled beads only: those far enough back along the
@@ -101,6 +114,7 @@ impl BeadGrid {
         let plate = [cfg.build_volume[0], cfg.build_volume[1]];
         BeadGrid {
             cells: FxHashMap::default(),
+            links: Vec::new(),
             column_max: TopGrid::new(plate, CELL_XY),
             settled_max: TopGrid::new(plate, CELL_XY),
         }
@@ -133,7 +147,9 @@ impl BeadGrid {
         for x in xs[0]..=xs[1] {
             for y in ys[0]..=ys[1] {
                 for z in zs[0]..=zs[1] {
-                    self.cells.entry((x, y, z)).or_default().push(id);
+                    let entry = self.links.len() as u32;
+                    let next = self.cells.insert((x, y, z), entry).unwrap_or(u32::MAX);
+                    self.links.push((id, next));
                 }
             }
         }
@@ -145,7 +161,7 @@ impl BeadGrid {
     }
 
     /// Ids in cells within `r` (plan) of `p` and heights `zlo..=zhi`,
-    /// skipping plan columns whose `tops` are below `zlo`.
+    /// newest first, skipping plan columns whose `tops` are below `zlo`.
     fn for_each(
         &self,
         p: [f64; 3],
@@ -162,15 +178,23 @@ impl BeadGrid {
             Tops::All => &self.column_max,
             Tops::Settled => &self.settled_max,
         };
+        // Plan distance from p to the cells' edges, one axis at a time.
+        let gap = |c: i32, v: f64| {
+            let lo = f64::from(c) * CELL_XY;
+            (lo - v).max(v - lo - CELL_XY).max(0.0)
+        };
         for x in x0..=x1 {
+            let gx = gap(x, p[0]);
             for y in y0..=y1 {
                 let top = tops.at_cell(x, y, CELL_XY);
-                if top < zlo {
+                if top < zlo || len2(gx, gap(y, p[1])) > r {
                     continue;
                 }
                 for z in z0..=z1.min(cell(top, CELL_Z)) {
-                    if let Some(v) = self.cells.get(&(x, y, z)) {
-                        v.iter().for_each(|&id| f(id));
+                    let mut e = self.cells.get(&(x, y, z)).copied().unwrap_or(u32::MAX);
+                    while let Some(&(id, next)) = self.links.get(e as usize) {
+                        f(id);
+                        e = next;
                     }
                 }
             }
@@ -225,12 +249,9 @@ impl TopGrid {
 
     /// Cell index along axis `a`, clamped into the rectangle.
     fn index(&self, v: f64, a: usize) -> usize {
-        let i = ((v - self.origin[a]) / self.cell).floor();
-        if i >= 0.0 {
-            (i as usize).min(self.n[a] - 1)
-        } else {
-            0
-        }
+        // `as` truncates toward zero and saturates (negative and NaN to 0),
+        // which is the floor for every cell index but the first.
+        (((v - self.origin[a]) / self.cell) as usize).min(self.n[a] - 1)
     }
 
     /// Cell ranges `[x0, x1], [y0, y1]` (inclusive) of a plan box.
@@ -836,10 +857,16 @@ impl<'a> Checker<'a> {
         }
         let recent_nozzle = cfg.nozzle_radius + cfg.width_max;
         let reach = cfg.nozzle_radius + cfg.width_max / 2.0;
-        // Collisions at points along the move (every r/2 mm, end included).
-        let samples = ((len / (cfg.nozzle_radius / 2.0).max(0.5)).ceil() as usize).clamp(1, 200);
-        for k in 1..=samples {
-            let t = k as f64 / samples as f64;
+        // Collisions at points every r/2 mm of path (at most 200 a move).
+        let every = (cfg.nozzle_radius / 2.0).max(0.5);
+        let (first, last) = ((s_start / every).floor() + 1.0, (self.s / every).floor());
+        let probes = (last - first + 1.0).clamp(0.0, 200.0) as usize;
+        for k in 0..probes {
+            let t = if probes < 200 {
+                ((first + k as f64) * every - s_start) / len
+            } else {
+                (k + 1) as f64 / probes as f64
+            };
             let p = [
                 m.from[0] + t * (m.to[0] - m.from[0]),
                 m.from[1] + t * (m.to[1] - m.from[1]),

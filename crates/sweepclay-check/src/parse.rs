@@ -93,6 +93,42 @@ fn skip_while(s: &str, mut i: usize, keep: impl Fn(char) -> bool) -> usize {
     i
 }
 
+/// A plain decimal (`-12.345`, `7`, `.5`) of at most 15 significant
+/// digits, read exactly: the digits as an integer divided by a power of
+/// ten, both exact in `f64`, so the one rounding gives the same value as
+/// `str::parse`. `None` for anything else (exponents, more digits), which
+/// `str::parse` then reads.
+fn decimal(s: &[u8]) -> Option<f64> {
+    const POW10: [f64; 16] = [
+        1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+    ];
+    let (neg, digits) = match s.first()? {
+        b'-' => (true, &s[1..]),
+        b'+' => (false, &s[1..]),
+        _ => (false, s),
+    };
+    let (mut m, mut n, mut frac, mut dot) = (0u64, 0usize, 0usize, false);
+    for &b in digits {
+        match b {
+            b'0'..=b'9' => {
+                m = m * 10 + u64::from(b - b'0');
+                n += 1;
+                frac += usize::from(dot);
+            }
+            b'.' if !dot => dot = true,
+            _ => return None,
+        }
+        if n > 15 {
+            return None;
+        }
+    }
+    if n == 0 {
+        return None;
+    }
+    let v = m as f64 / POW10[frac];
+    Some(if neg { -v } else { v })
+}
+
 fn ends_word(c: char) -> bool {
     c.is_ascii_alphabetic() || c.is_whitespace()
 }
@@ -128,19 +164,23 @@ impl LineParser {
                 body = before;
             }
         }
-        // Strip comments.
-        self.clean.clear();
-        let mut in_paren = false;
-        for c in body.chars() {
-            match c {
-                ';' if !in_paren => break,
-                '(' => in_paren = true,
-                ')' if in_paren => in_paren = false,
-                _ if !in_paren => self.clean.push(c),
-                _ => {}
+        // Strip comments: a `;` comment is a cut, `( )` ones need a copy.
+        let s = if body.contains('(') {
+            self.clean.clear();
+            let mut in_paren = false;
+            for c in body.chars() {
+                match c {
+                    ';' if !in_paren => break,
+                    '(' => in_paren = true,
+                    ')' if in_paren => in_paren = false,
+                    _ if !in_paren => self.clean.push(c),
+                    _ => {}
+                }
             }
-        }
-        let s = self.clean.as_str();
+            self.clean.as_str()
+        } else {
+            body.split_once(';').map_or(body, |(code, _)| code)
+        };
         let len = s.len();
         out.params.clear();
         let mut i = 0;
@@ -174,6 +214,8 @@ impl LineParser {
             }
             let value = if num.is_empty() {
                 0.0
+            } else if let Some(v) = decimal(num.as_bytes()) {
+                v
             } else {
                 match num.parse::<f64>() {
                     Ok(v) if v.is_finite() => v,
@@ -189,19 +231,21 @@ impl LineParser {
             out.params.push((letter, value));
         }
         let words = &mut out.params;
-        if words.first().is_some_and(|(c, _)| *c == 'N') {
-            words.remove(0);
-        }
-        if words.is_empty() {
+        let mut first = usize::from(words.first().is_some_and(|(c, _)| *c == 'N'));
+        let Some(&head) = words.get(first) else {
+            words.clear();
             return false;
-        }
-        let (letter, code) = match words[0] {
+        };
+        let (letter, code) = match head {
             (c @ ('G' | 'M' | 'T'), v) => {
-                words.remove(0);
+                first += 1;
                 (Some(c), v)
             }
             _ => (None, 0.0),
         };
+        if first > 0 {
+            words.drain(..first);
+        }
         out.line = n;
         out.letter = letter;
         out.code = code;
@@ -227,6 +271,55 @@ mod tests {
         assert!(l[3].is('M', 82.0));
         // "N3 T0" XOR = 57.
         assert!(d.is_empty(), "{d:?}");
+    }
+
+    #[test]
+    fn decimals_read_as_str_parse_reads_them() {
+        for t in [
+            "0",
+            "-0",
+            "7",
+            "+7",
+            ".5",
+            "5.",
+            "-12.345",
+            "123.45678",
+            "0.1",
+            "0.30000",
+            "199.999",
+            "-0.00001",
+            "999999999999999",
+            "1234567.89012345",
+        ] {
+            let want: f64 = t.parse().unwrap();
+            assert_eq!(
+                decimal(t.as_bytes()).map(f64::to_bits),
+                Some(want.to_bits()),
+                "{t}"
+            );
+        }
+        for t in [
+            "",
+            "-",
+            ".",
+            "1e5",
+            "1.2.3",
+            "12a",
+            "1234567890123456",
+            "--1",
+        ] {
+            assert_eq!(decimal(t.as_bytes()), None, "{t}");
+        }
+        // Every value the G-code writer prints (3 and 5 decimals) agrees.
+        for k in (0..2_000_000u64).step_by(7) {
+            for t in [
+                format!("{:.3}", k as f64 / 1000.0),
+                format!("{:.5}", k as f64 / 1e5),
+            ] {
+                let want: f64 = t.parse().unwrap();
+                assert_eq!(decimal(t.as_bytes()), Some(want), "{t}");
+            }
+        }
     }
 
     #[test]

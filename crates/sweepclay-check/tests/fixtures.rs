@@ -260,7 +260,8 @@ fn carriage_over_a_tall_wall_fails() {
     g.run([90.0, 70.0, LAYER], W, LAYER);
     let r = verdict(&g.out);
     fails_for(&r, "carriage collision", &["nozzle collision"]);
-    assert!(r.carriage_collisions.count >= 40, "{}", r.render());
+    // Probed every r/2 = 2.5 mm along the 40 mm run.
+    assert!(r.carriage_collisions.count >= 15, "{}", r.render());
 }
 
 #[test]
