@@ -171,30 +171,56 @@ impl BeadGrid {
         tops: Tops,
         mut f: impl FnMut(u32),
     ) {
-        let (x0, x1) = (cell(p[0] - r, CELL_XY), cell(p[0] + r, CELL_XY));
-        let (y0, y1) = (cell(p[1] - r, CELL_XY), cell(p[1] + r, CELL_XY));
         let (z0, z1) = (cell(zlo, CELL_Z), cell(zhi, CELL_Z));
         let tops = match tops {
             Tops::All => &self.column_max,
             Tops::Settled => &self.settled_max,
         };
-        // Plan distance from p to the cells' edges, one axis at a time.
-        let gap = |c: i32, v: f64| {
-            let lo = f64::from(c) * CELL_XY;
-            (lo - v).max(v - lo - CELL_XY).max(0.0)
-        };
-        for x in x0..=x1 {
-            let gx = gap(x, p[0]);
-            for y in y0..=y1 {
-                let top = tops.at_cell(x, y, CELL_XY);
-                if top < zlo || len2(gx, gap(y, p[1])) > r {
+        // The column tops first (a load each); the bead lists of a column
+        // only when its clay reaches `zlo`.
+        let (gxs, gys) = tops.range([p[0] - r, p[1] - r], [p[0] + r, p[1] + r]);
+        for gy in gys[0]..=gys[1] {
+            for gx in gxs[0]..=gxs[1] {
+                let top = f64::from(tops.top[gy * tops.n[0] + gx]);
+                if top < zlo {
                     continue;
                 }
-                for z in z0..=z1.min(cell(top, CELL_Z)) {
-                    let mut e = self.cells.get(&(x, y, z)).copied().unwrap_or(u32::MAX);
-                    while let Some(&(id, next)) = self.links.get(e as usize) {
-                        f(id);
-                        e = next;
+                // The `CELL_XY` columns of this one inside the query box;
+                // border cells also hold the clay beyond the border.
+                let c = tops.rect(gx, gy);
+                let lo = [
+                    if gx == 0 {
+                        p[0] - r
+                    } else {
+                        c[0].max(p[0] - r)
+                    },
+                    if gy == 0 {
+                        p[1] - r
+                    } else {
+                        c[1].max(p[1] - r)
+                    },
+                ];
+                let hi = [
+                    if gx + 1 == tops.n[0] {
+                        p[0] + r
+                    } else {
+                        (c[2] - 1e-9).min(p[0] + r)
+                    },
+                    if gy + 1 == tops.n[1] {
+                        p[1] + r
+                    } else {
+                        (c[3] - 1e-9).min(p[1] + r)
+                    },
+                ];
+                for x in cell(lo[0], CELL_XY)..=cell(hi[0], CELL_XY) {
+                    for y in cell(lo[1], CELL_XY)..=cell(hi[1], CELL_XY) {
+                        for z in z0..=z1.min(cell(top, CELL_Z)) {
+                            let mut e = self.cells.get(&(x, y, z)).copied().unwrap_or(u32::MAX);
+                            while let Some(&(id, next)) = self.links.get(e as usize) {
+                                f(id);
+                                e = next;
+                            }
+                        }
                     }
                 }
             }
@@ -238,13 +264,6 @@ impl TopGrid {
             top: vec![f32::NEG_INFINITY; n[0] * n[1]],
             widest: 0.0,
         }
-    }
-
-    /// The top of the cell holding cell `(x, y)` of a grid of `base` mm
-    /// aligned at 0 (an upper bound of its clay).
-    fn at_cell(&self, x: i32, y: i32, base: f64) -> f64 {
-        let (px, py) = ((f64::from(x) + 0.5) * base, (f64::from(y) + 0.5) * base);
-        f64::from(self.top[self.index(py, 1) * self.n[0] + self.index(px, 0)])
     }
 
     /// Cell index along axis `a`, clamped into the rectangle.
@@ -564,7 +583,8 @@ fn follow_support(
     for y in ys[0]..=ys[1] {
         for x in xs[0]..=xs[1] {
             let top = f64::from(tops.top[y * tops.n[0] + x]);
-            if top == f64::NEG_INFINITY {
+            // Most cells: clay lower than both tests' thresholds (or none).
+            if top < best.z + cfg.min_layer_mm && top <= mid[2] - cfg.min_layer_mm {
                 continue;
             }
             let rect = tops.rect(x, y);
@@ -724,6 +744,10 @@ struct Checker<'a> {
     recent: Recent,
     /// The bead the last bead rests on.
     prev_support: Option<u32>,
+    /// Offset / layer height of the steepest overhang so far, and a ratio
+    /// just under the overhang limit's.
+    steepest: f64,
+    overhang_near: f64,
     /// Always search (tests compare the fast path against this).
     exhaustive: bool,
 }
@@ -754,6 +778,11 @@ impl<'a> Checker<'a> {
             support_settled: 0,
             recent: Recent::default(),
             prev_support: None,
+            steepest: f64::NEG_INFINITY,
+            overhang_near: 0.999
+                * (cfg.max_overhang_deg + cfg.overhang_tolerance_deg)
+                    .to_radians()
+                    .tan(),
             exhaustive: false,
         }
     }
@@ -936,6 +965,8 @@ impl<'a> Checker<'a> {
             recent,
             prev_support,
             exhaustive,
+            steepest,
+            overhang_near,
             ..
         } = self;
         r.path_length_mm += len;
@@ -1066,12 +1097,18 @@ impl<'a> Checker<'a> {
                 if overlap < cfg.overlap_target - 1e-6 {
                     r.support.under_target += 1;
                 }
-                let angle = (offset / dz).atan().to_degrees();
-                if r.support.max_overhang_deg.is_none_or(|(v, _)| angle > v) {
-                    r.support.max_overhang_deg = Some((angle, m.line));
-                }
-                if angle > cfg.max_overhang_deg + cfg.overhang_tolerance_deg {
-                    r.support.overhang.add(m.line, angle);
+                // The angle (an arc tangent) only when it can matter: a
+                // new steepest or one near the limit.
+                let ratio = offset / dz;
+                if !(ratio <= *steepest && ratio < *overhang_near) {
+                    *steepest = steepest.max(ratio);
+                    let angle = ratio.atan().to_degrees();
+                    if r.support.max_overhang_deg.is_none_or(|(v, _)| angle > v) {
+                        r.support.max_overhang_deg = Some((angle, m.line));
+                    }
+                    if angle > cfg.max_overhang_deg + cfg.overhang_tolerance_deg {
+                        r.support.overhang.add(m.line, angle);
+                    }
                 }
             }
         }
