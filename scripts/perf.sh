@@ -3,13 +3,12 @@
 # of every stage and of design -> verified G-code (examples and the scaling
 # series), then peak memory per sample, docs/perf/scaling.csv and the plot
 # docs/img/scaling.png. Takes about half an hour on a 2-core machine.
-#   scripts/perf.sh            # scaling series to 10M samples (verified to 3M)
+#   scripts/perf.sh            # scaling series to 10M samples
 #   MAX=1000000 scripts/perf.sh  # quicker: everything to 1M
 set -euo pipefail
 cd "$(dirname "$0")/.."
 max="${MAX:-10000000}"
-vmax=$(( max < 3000000 ? max : 3000000 ))
 SWEEPCLAY_BENCH_MAX="$max" cargo bench -p sweepclay-core --bench pipeline
-SWEEPCLAY_BENCH_MAX="$vmax" cargo bench -p sweepclay-web --bench verified
+SWEEPCLAY_BENCH_MAX="$max" cargo bench -p sweepclay-web --bench verified
 cargo bench -p sweepclay-check --bench check
 cargo run --release -p sweepclay-perf -- "$max"
