@@ -185,35 +185,11 @@ impl BeadGrid {
                 if top < zlo {
                     continue;
                 }
-                // The `CELL_XY` columns of this one inside the query box;
-                // border cells also hold the clay beyond the border.
-                let c = tops.rect(gx, gy);
-                let lo = [
-                    if gx == 0 {
-                        p[0] - r
-                    } else {
-                        c[0].max(p[0] - r)
-                    },
-                    if gy == 0 {
-                        p[1] - r
-                    } else {
-                        c[1].max(p[1] - r)
-                    },
-                ];
-                let hi = [
-                    if gx + 1 == tops.n[0] {
-                        p[0] + r
-                    } else {
-                        (c[2] - 1e-9).min(p[0] + r)
-                    },
-                    if gy + 1 == tops.n[1] {
-                        p[1] + r
-                    } else {
-                        (c[3] - 1e-9).min(p[1] + r)
-                    },
-                ];
-                for x in cell(lo[0], CELL_XY)..=cell(hi[0], CELL_XY) {
-                    for y in cell(lo[1], CELL_XY)..=cell(hi[1], CELL_XY) {
+                // The `CELL_XY` columns of this one inside the query box.
+                let (x0, x1) = tops.clip(gx, 0, p[0] - r, p[0] + r);
+                let (y0, y1) = tops.clip(gy, 1, p[1] - r, p[1] + r);
+                for x in cell(x0, CELL_XY)..=cell(x1, CELL_XY) {
+                    for y in cell(y0, CELL_XY)..=cell(y1, CELL_XY) {
                         for z in z0..=z1.min(cell(top, CELL_Z)) {
                             let mut e = self.cells.get(&(x, y, z)).copied().unwrap_or(u32::MAX);
                             while let Some(&(id, next)) = self.links.get(e as usize) {
@@ -317,6 +293,21 @@ impl TopGrid {
         }
     }
 
+    /// The part of `lo..hi` on axis `a` inside cell `g` (its upper edge
+    /// excluded); a border cell also holds the clay beyond the border, so
+    /// its side is not cut there.
+    fn clip(&self, g: usize, a: usize, lo: f64, hi: f64) -> (f64, f64) {
+        let edge = self.origin[a] + g as f64 * self.cell;
+        (
+            if g == 0 { lo } else { lo.max(edge) },
+            if g + 1 == self.n[a] {
+                hi
+            } else {
+                hi.min(edge + self.cell - 1e-9)
+            },
+        )
+    }
+
     /// The cell's plan rectangle `[x0, y0, x1, y1]`.
     fn rect(&self, x: usize, y: usize) -> [f64; 4] {
         let x0 = self.origin[0] + x as f64 * self.cell;
@@ -396,45 +387,61 @@ enum Class {
     Neither,
 }
 
-/// Judges earlier bead `b` (index `j`) against the new bead `m`, whose
-/// middle is `mid` and which starts at path distance `s_start`.
-fn classify(b: &Bead, j: u32, m: &Move, mid: [f64; 3], s_start: f64, cfg: &CheckConfig) -> Class {
-    if b.step || b.s_end >= s_start - 1e-9 {
-        return Class::Neither;
-    }
-    let (_, d, z, at) = b.closest(mid);
-    // A bead laid earlier in this run lies behind the nozzle, not below
-    // it: little more path than the distance lies between them, and the
-    // new bead clearly moves away from it (its middle ≥ 0.1 mm farther
-    // from it than its start) or starts less than 0.5 mm above it (round
-    // a sharp corner it may turn back toward it). A bead below that the
-    // path returns over after a turn or a step-up is approached (or
-    // passed alongside) and a layer down; a bead laid again right on top
-    // of an earlier one (d ≈ 0) is neither.
-    let from_end = len2(m.from[0] - at[0], m.from[1] - at[1]);
-    if s_start - b.s_end <= 1.5 * d + 1e-6 && (d > from_end + 0.1 || m.from[2] - z < 0.5) {
-        return Class::Neither;
-    }
-    if z <= mid[2] - cfg.min_layer_mm {
-        if mid[2] - z <= cfg.max_gap_mm && d <= cfg.width_max.max(b.width() / 2.0) {
-            return Class::Below(Candidate {
-                id: j,
-                z,
-                at,
-                d,
-                width: b.width(),
-                covers: d <= b.width() / 2.0,
-            });
+/// A new bead whose support is sought: its move, its middle and the path
+/// distance where it starts.
+struct Query<'a> {
+    m: &'a Move,
+    mid: [f64; 3],
+    s_start: f64,
+    cfg: &'a CheckConfig,
+}
+
+impl Query<'_> {
+    /// Judges earlier bead `b` (index `j`) against the new bead.
+    fn classify(&self, b: &Bead, j: u32) -> Class {
+        let Query {
+            m,
+            mid,
+            s_start,
+            cfg,
+        } = *self;
+        if b.step || b.s_end >= s_start - 1e-9 {
+            return Class::Neither;
         }
-    } else if (z - mid[2]).abs() < cfg.min_layer_mm
-        && d < 0.5 * b.width().min(cfg.width_min)
-        // Clay laid in the last 2 w_max of path is the run's own fresh
-        // clay (a corner piles up, it is not laid twice).
-        && s_start - b.s_end > 2.0 * cfg.width_max
-    {
-        return Class::Double;
+        let (_, d, z, at) = b.closest(mid);
+        // A bead laid earlier in this run lies behind the nozzle, not below
+        // it: little more path than the distance lies between them, and the
+        // new bead clearly moves away from it (its middle ≥ 0.1 mm farther
+        // from it than its start) or starts less than 0.5 mm above it (round
+        // a sharp corner it may turn back toward it). A bead below that the
+        // path returns over after a turn or a step-up is approached (or
+        // passed alongside) and a layer down; a bead laid again right on top
+        // of an earlier one (d ≈ 0) is neither.
+        let from_end = len2(m.from[0] - at[0], m.from[1] - at[1]);
+        if s_start - b.s_end <= 1.5 * d + 1e-6 && (d > from_end + 0.1 || m.from[2] - z < 0.5) {
+            return Class::Neither;
+        }
+        if z <= mid[2] - cfg.min_layer_mm {
+            if mid[2] - z <= cfg.max_gap_mm && d <= cfg.width_max.max(b.width() / 2.0) {
+                return Class::Below(Candidate {
+                    id: j,
+                    z,
+                    at,
+                    d,
+                    width: b.width(),
+                    covers: d <= b.width() / 2.0,
+                });
+            }
+        } else if (z - mid[2]).abs() < cfg.min_layer_mm
+            && d < 0.5 * b.width().min(cfg.width_min)
+            // Clay laid in the last 2 w_max of path is the run's own fresh
+            // clay (a corner piles up, it is not laid twice).
+            && s_start - b.s_end > 2.0 * cfg.width_max
+        {
+            return Class::Double;
+        }
+        Class::Neither
     }
-    Class::Neither
 }
 
 /// The beads laid in the last stretch of path, not yet in the settled
@@ -444,7 +451,8 @@ fn classify(b: &Bead, j: u32, m: &Move, mid: [f64; 3], s_start: f64, cfg: &Check
 #[derive(Default)]
 struct Recent {
     low: std::collections::VecDeque<(u32, f32)>,
-    turns: std::collections::VecDeque<(u32, f32)>,
+    /// The turn into each bead of the window, oldest first.
+    turns: std::collections::VecDeque<f32>,
     turning: f64,
     /// Plan direction of the last bead and its path end, if it had one.
     last: Option<([f64; 2], f64)>,
@@ -465,14 +473,11 @@ impl Recent {
         }
     }
 
-    fn push(&mut self, id: u32, m: &Move, s_start: f64, s_end: f64, step: bool, low: f32) {
-        let turn = if step {
-            std::f64::consts::PI
-        } else {
-            self.turn(m, s_start)
-        };
+    /// Bead `id` (move `m`, ending at path distance `s_end`, lowest point
+    /// `low`, turned into by `turn`) joins the window.
+    fn push(&mut self, id: u32, m: &Move, s_end: f64, step: bool, low: f32, turn: f64) {
         self.turning += turn;
-        self.turns.push_back((id, turn as f32));
+        self.turns.push_back(turn as f32);
         while self.low.back().is_some_and(|r| r.1 >= low) {
             self.low.pop_back();
         }
@@ -482,13 +487,12 @@ impl Recent {
         self.last = (l > 1e-9 && !step).then(|| ([dx / l, dy / l], s_end));
     }
 
-    /// Bead `id` leaves the window.
+    /// Bead `id`, the oldest in the window, leaves it.
     fn settle(&mut self, id: u32) {
         if self.low.front().is_some_and(|r| r.0 == id) {
             self.low.pop_front();
         }
-        if self.turns.front().is_some_and(|r| r.0 == id) {
-            let (_, t) = self.turns.pop_front().unwrap_or_default();
+        if let Some(t) = self.turns.pop_front() {
             self.turning -= f64::from(t);
         }
         if self.turns.is_empty() {
@@ -501,7 +505,7 @@ impl Recent {
     }
 
     /// Whether none of these beads can be clay below the new bead `m`
-    /// (middle `mid`) for `classify`. Either all are less than `min_layer`
+    /// (middle `mid`, turned into by `turn`) for `classify`. Either all are less than `min_layer`
     /// below the middle, or the path turns less than 60° in plan through
     /// them and into `m`. Then each is farther from the middle than
     /// cos 30° ≈ 0.87 × the path between (more than the 1/1.5 `classify`
@@ -509,11 +513,11 @@ impl Recent {
     /// length. So, if `m` is longer than 0.45 mm in plan (or all are less
     /// than 0.5 mm below its start), `classify` puts each behind the
     /// nozzle.
-    fn clear_of(&self, m: &Move, mid: [f64; 3], s_start: f64, min_layer: f64) -> bool {
+    fn clear_of(&self, m: &Move, mid: [f64; 3], min_layer: f64, turn: f64) -> bool {
         let low = self.low();
         low > mid[2] - min_layer
             || ((low > m.from[2] - 0.5 || m.xy_length() > 0.45)
-                && self.turning + self.turn(m, s_start) < std::f64::consts::FRAC_PI_3)
+                && self.turning + turn < std::f64::consts::FRAC_PI_3)
     }
 }
 
@@ -527,26 +531,20 @@ impl Recent {
 /// - no settled clay near the middle is high enough above it to be
 ///   climbed to (see `pick_support`) or at the new bead's own height;
 /// - none of the clay laid in the last 2 w_max of path can be clay below
-///   (`recent_clear`, from [`Recent::clear_of`]).
+///   (the caller asks [`Recent::clear_of`] first).
 ///
-/// The cost does not depend on how finely the path is sampled.
-#[allow(clippy::too_many_arguments)]
+/// `beads[..settled]` are in `tops`. The cost does not depend on how
+/// finely the path is sampled.
 fn follow_support(
     beads: &[Bead],
     settled: usize,
     tops: &TopGrid,
-    recent_clear: bool,
     start: u32,
-    m: &Move,
-    mid: [f64; 3],
-    s_start: f64,
-    cfg: &CheckConfig,
+    q: &Query,
 ) -> Option<Candidate> {
-    if !recent_clear {
-        return None;
-    }
+    let (mid, cfg) = (q.mid, q.cfg);
     let eval = |k: usize| match beads.get(k) {
-        Some(b) if k < settled => match classify(b, k as u32, m, mid, s_start, cfg) {
+        Some(b) if k < settled => match q.classify(b, k as u32) {
             Class::Below(c) => Some(c),
             _ => None,
         },
@@ -599,6 +597,70 @@ fn follow_support(
     Some(best)
 }
 
+/// The support of a new bead by the full search (steps 1–4 of
+/// docs/CHECKER.md): every earlier bead near enough, judged by
+/// [`Query::classify`], then [`pick_support`]. Also whether clay already
+/// lies at its height under its middle. `id` is the new bead's index.
+fn search_support(
+    beads: &[Bead],
+    grid: &BeadGrid,
+    stamp: &mut Vec<u32>,
+    cands: &mut Vec<Candidate>,
+    q: &Query,
+    id: u32,
+) -> (Option<Candidate>, bool) {
+    let (mid, cfg) = (q.mid, q.cfg);
+    stamp.resize(beads.len(), u32::MAX);
+    cands.clear();
+    let mut double = false;
+    let covered = std::cell::Cell::new(false);
+    let (zlo, zhi) = (mid[2] - cfg.max_gap_mm, mid[2] + cfg.min_layer_mm);
+    let mut visit = |j: u32| {
+        let ju = j as usize;
+        if stamp[ju] == id {
+            return;
+        }
+        stamp[ju] = id;
+        match q.classify(&beads[ju], j) {
+            Class::Below(c) => {
+                covered.set(covered.get() || c.covers);
+                cands.push(c);
+            }
+            Class::Double => double = true,
+            Class::Neither => {}
+        }
+    };
+    // Beads covering the middle are within w/2; look wider only when none
+    // is (to measure an overhang).
+    grid.for_each(
+        mid,
+        cfg.width_max / 2.0 + 0.5,
+        zlo,
+        zhi,
+        Tops::All,
+        &mut visit,
+    );
+    if !covered.get() {
+        grid.for_each(mid, cfg.width_max, zlo, zhi, Tops::All, &mut visit);
+    }
+    let support = pick_support(cands, cfg.min_layer_mm, mid[2] <= cfg.first_layer_max_mm);
+    (support, double)
+}
+
+/// Moves a settled frontier on: hands each bead from `*next` on that is
+/// `done` (they are in path order) to `f` with its index.
+fn settle(
+    beads: &[Bead],
+    next: &mut usize,
+    done: impl Fn(&Bead) -> bool,
+    mut f: impl FnMut(u32, &Bead),
+) {
+    while let Some(b) = beads.get(*next).filter(|b| done(b)) {
+        f(*next as u32, b);
+        *next += 1;
+    }
+}
+
 /// Overlap of a bead of width `wa` with one of width `wb` whose centre is
 /// `s` to the side, as a fraction of `wa`.
 fn overlap_fraction(wa: f64, wb: f64, s: f64) -> f64 {
@@ -623,7 +685,12 @@ fn minmax(slot: &mut Option<[(f64, usize); 2]>, v: f64, line: usize) {
 
 /// Checks a G-code text. Never panics, whatever the input.
 pub fn check(text: &str, cfg: &CheckConfig) -> Report {
+    check_with(text, cfg, false)
+}
+
+fn check_with(text: &str, cfg: &CheckConfig, exhaustive: bool) -> Report {
     let mut c = Checker::new(cfg);
+    c.exhaustive = exhaustive;
     text.lines().for_each(|l| c.line(l));
     c.finish()
 }
@@ -633,10 +700,7 @@ pub fn check(text: &str, cfg: &CheckConfig) -> Report {
 /// hold the fast path to. The two give the same report.
 #[doc(hidden)]
 pub fn check_exhaustive(text: &str, cfg: &CheckConfig) -> Report {
-    let mut c = Checker::new(cfg);
-    c.exhaustive = true;
-    text.lines().for_each(|l| c.line(l));
-    c.finish()
+    check_with(text, cfg, true)
 }
 
 /// Checks G-code read line by line from `input`, holding no more of the
@@ -726,7 +790,8 @@ struct Checker<'a> {
     pending: Vec<(Deferred, usize, f64)>,
     beads: Vec<Bead>,
     grid: BeadGrid,
-    unsettled: std::collections::VecDeque<u32>,
+    /// Beads `..settled` are in the collision test's settled tops.
+    settled: usize,
     stamp: Vec<u32>,
     s: f64,
     top_z: f64,
@@ -739,8 +804,7 @@ struct Checker<'a> {
     support_tops: TopGrid,
     /// Beads `..support_settled` are in `support_tops`.
     support_settled: usize,
-    /// The lowest point of the beads laid since: a sliding-window minimum
-    /// (ids and heights, both increasing).
+    /// The beads laid since (their lowest point, the path's turning).
     recent: Recent,
     /// The bead the last bead rests on.
     prev_support: Option<u32>,
@@ -766,7 +830,7 @@ impl<'a> Checker<'a> {
             pending: Vec::new(),
             beads: Vec::new(),
             grid: BeadGrid::new(cfg),
-            unsettled: Default::default(),
+            settled: 0,
             stamp: Vec::new(),
             s: 0.0,
             top_z: f64::MIN,
@@ -903,14 +967,13 @@ impl<'a> Checker<'a> {
             ];
             let sp = s_start + t * len;
             // Beads the nozzle has left behind count for collisions.
-            while let Some(&j) = self.unsettled.front() {
-                let b = &self.beads[j as usize];
-                if b.s_end > sp - recent_nozzle {
-                    break;
-                }
-                self.grid.settle(b);
-                self.unsettled.pop_front();
-            }
+            let grid = &mut self.grid;
+            settle(
+                &self.beads,
+                &mut self.settled,
+                |b| b.s_end <= sp - recent_nozzle,
+                |_, b| grid.settle(b),
+            );
             if self.top_z > p[2] + cfg.nozzle_height + cfg.collision_tolerance_mm {
                 let v = self.top_z - p[2] - cfg.nozzle_height;
                 self.defer_or_add(is_extruding, Deferred::Carriage, m.line, v);
@@ -953,7 +1016,6 @@ impl<'a> Checker<'a> {
             r,
             beads,
             grid,
-            unsettled,
             stamp,
             top_z,
             lo,
@@ -986,11 +1048,20 @@ impl<'a> Checker<'a> {
         let id = beads.len() as u32;
         let mut width = cfg.width_min;
         let horizon = s_start - 2.0 * cfg.width_max;
-        while let Some(b) = beads.get(*support_settled).filter(|b| b.s_end < horizon) {
-            support_tops.raise(b);
-            recent.settle(*support_settled as u32);
-            *support_settled += 1;
-        }
+        settle(
+            beads,
+            support_settled,
+            |b| b.s_end < horizon,
+            |j, b| {
+                support_tops.raise(b);
+                recent.settle(j);
+            },
+        );
+        let turn = if step {
+            std::f64::consts::PI
+        } else {
+            recent.turn(m, s_start)
+        };
         if step {
             r.support.steps += 1;
         } else {
@@ -999,61 +1070,24 @@ impl<'a> Checker<'a> {
                 0.5 * (m.from[1] + m.to[1]),
                 0.5 * (m.from[2] + m.to[2]),
             ];
-            let clear = recent.clear_of(m, mid, s_start, cfg.min_layer_mm);
-            let fast = prev_support.filter(|_| !*exhaustive).and_then(|j| {
-                follow_support(
-                    beads,
-                    *support_settled,
-                    support_tops,
-                    clear,
-                    j,
-                    m,
-                    mid,
-                    s_start,
-                    cfg,
-                )
-            });
+            let q = Query {
+                m,
+                mid,
+                s_start,
+                cfg,
+            };
+            let fast = prev_support
+                .filter(|_| !*exhaustive && recent.clear_of(m, mid, cfg.min_layer_mm, turn))
+                .and_then(|j| follow_support(beads, *support_settled, support_tops, j, &q));
             r.support.beads += 1;
             let support = if fast.is_some() {
                 fast
             } else {
-                stamp.resize(beads.len(), u32::MAX);
-                cands.clear();
-                let mut double = false;
-                let covered = std::cell::Cell::new(false);
-                let (zlo, zhi) = (mid[2] - cfg.max_gap_mm, mid[2] + cfg.min_layer_mm);
-                let mut visit = |j: u32| {
-                    let ju = j as usize;
-                    if stamp[ju] == id {
-                        return;
-                    }
-                    stamp[ju] = id;
-                    match classify(&beads[ju], j, m, mid, s_start, cfg) {
-                        Class::Below(c) => {
-                            covered.set(covered.get() || c.covers);
-                            cands.push(c);
-                        }
-                        Class::Double => double = true,
-                        Class::Neither => {}
-                    }
-                };
-                // Beads covering the middle are within w/2; look wider only
-                // when none is (to measure an overhang).
-                grid.for_each(
-                    mid,
-                    cfg.width_max / 2.0 + 0.5,
-                    zlo,
-                    zhi,
-                    Tops::All,
-                    &mut visit,
-                );
-                if !covered.get() {
-                    grid.for_each(mid, cfg.width_max, zlo, zhi, Tops::All, &mut visit);
-                }
+                let (support, double) = search_support(beads, grid, stamp, cands, &q, id);
                 if double {
                     r.support.double_deposition.add(m.line, 0.0);
                 }
-                pick_support(cands, cfg.min_layer_mm, mid[2] <= cfg.first_layer_max_mm)
+                support
             };
             *prev_support = support.map(|c| c.id);
             let (dz, overlap, offset) = match support {
@@ -1124,9 +1158,8 @@ impl<'a> Checker<'a> {
             step,
         );
         grid.insert(&bead, id);
-        unsettled.push_back(id);
         let low = bead.from32[2].min(bead.to32[2]);
-        recent.push(id, m, s_start, s, step, low);
+        recent.push(id, m, s, step, low, turn);
         *top_z = top_z.max(m.from[2].max(m.to[2]));
         beads.push(bead);
     }
