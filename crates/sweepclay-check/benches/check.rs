@@ -6,6 +6,13 @@ use criterion::{criterion_group, criterion_main, Criterion};
 use std::fmt::Write;
 use sweepclay_check::{check, CheckConfig};
 
+/// The allocator the `sweepclay` binary ships with (mimalloc: it keeps
+/// freed pages for reuse, where glibc's returns large blocks to the system
+/// and faults them in again on the next run), so the figures are the
+/// binary's.
+#[global_allocator]
+static ALLOC: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 /// A meander of `lines` parallel runs 14 mm apart, `layers` layers of
 /// alternating direction, as absolute-E G-code.
 fn meander(lines: usize, layers: usize) -> (String, usize) {

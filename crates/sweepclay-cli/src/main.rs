@@ -9,6 +9,12 @@ use sweepclay_check::{check_reader, CheckConfig};
 use sweepclay_core::{examples, printer::PRESETS, Design, Printer, PrinterRef};
 use sweepclay_web::verify::{printer_check, verify_into};
 
+/// mimalloc keeps freed pages for reuse; glibc's allocator returns large
+/// blocks to the system and faults them in again, which cost a third of
+/// the time of slicing a 44k-sample design (docs/PERFORMANCE.md).
+#[global_allocator]
+static ALLOC: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 /// Clay 3D printing of sweeping surfaces: design file → one continuous,
 /// collision-free, self-supporting G-code path, and a checker that says
 /// whether any G-code file prints in clay.

@@ -12,6 +12,13 @@ use criterion::{criterion_group, criterion_main, BatchSize, BenchmarkId, Criteri
 use std::hint::black_box;
 use sweepclay_core::{correct, examples, extrude, finish, gcode, surface, toolpath, Design};
 
+/// The allocator the `sweepclay` binary ships with (mimalloc: it keeps
+/// freed pages for reuse, where glibc's returns large blocks to the system
+/// and faults them in again on the next run), so the figures are the
+/// binary's.
+#[global_allocator]
+static ALLOC: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 /// The scaling series: 10k, 30k, 100k, … up to 10M (or `SWEEPCLAY_BENCH_MAX`).
 fn sizes() -> Vec<usize> {
     let max: usize = std::env::var("SWEEPCLAY_BENCH_MAX")

@@ -11,6 +11,13 @@ use std::hint::black_box;
 use sweepclay_core::{examples, Design};
 use sweepclay_web::verify::verify_into;
 
+/// The allocator the `sweepclay` binary ships with (mimalloc: it keeps
+/// freed pages for reuse, where glibc's returns large blocks to the system
+/// and faults them in again on the next run), so the figures are the
+/// binary's.
+#[global_allocator]
+static ALLOC: mimalloc::MiMalloc = mimalloc::MiMalloc;
+
 fn verified(d: &Design) -> bool {
     let s = sweepclay_core::slice(d).unwrap();
     verify_into(&s, 0.5, std::io::sink()).unwrap().0.printable
