@@ -144,6 +144,45 @@ impl LineParser {
         diags: &mut Vec<Diagnostic>,
         out: &mut Line,
     ) -> bool {
+        out.params.clear();
+        if !plain_words(raw.as_bytes(), &mut out.params) {
+            out.params.clear();
+            if !self.words(raw, n, diags, &mut out.params) {
+                return false;
+            }
+        }
+        let words = &mut out.params;
+        let mut first = usize::from(words.first().is_some_and(|(c, _)| *c == 'N'));
+        let Some(&head) = words.get(first) else {
+            words.clear();
+            return false;
+        };
+        let (letter, code) = match head {
+            (c @ ('G' | 'M' | 'T'), v) => {
+                first += 1;
+                (Some(c), v)
+            }
+            _ => (None, 0.0),
+        };
+        if first > 0 {
+            words.drain(..first);
+        }
+        out.line = n;
+        out.letter = letter;
+        out.code = code;
+        true
+    }
+
+    /// The words of any line (checksums, both kinds of comment, a space
+    /// between a letter and its number, any number `str::parse` reads) into
+    /// `params`. False, with a diagnostic, for a line that cannot be read.
+    fn words(
+        &mut self,
+        raw: &str,
+        n: usize,
+        diags: &mut Vec<Diagnostic>,
+        params: &mut Vec<(char, f64)>,
+    ) -> bool {
         // Checksum: XOR of every byte before '*'.
         let mut body = raw;
         if let Some(star) = raw.find('*') {
@@ -182,7 +221,6 @@ impl LineParser {
             body.split_once(';').map_or(body, |(code, _)| code)
         };
         let len = s.len();
-        out.params.clear();
         let mut i = 0;
         while i < len {
             let (c, cl) = char_at(s, i);
@@ -228,29 +266,91 @@ impl LineParser {
                     }
                 }
             };
-            out.params.push((letter, value));
+            params.push((letter, value));
         }
-        let words = &mut out.params;
-        let mut first = usize::from(words.first().is_some_and(|(c, _)| *c == 'N'));
-        let Some(&head) = words.get(first) else {
-            words.clear();
-            return false;
-        };
-        let (letter, code) = match head {
-            (c @ ('G' | 'M' | 'T'), v) => {
-                first += 1;
-                (Some(c), v)
-            }
-            _ => (None, 0.0),
-        };
-        if first > 0 {
-            words.drain(..first);
-        }
-        out.line = n;
-        out.letter = letter;
-        out.code = code;
         true
     }
+}
+
+/// ASCII whitespace as `char::is_whitespace` has it (with vertical tab).
+fn space(b: u8) -> bool {
+    matches!(b, b' ' | b'\t' | b'\n' | 0x0b | 0x0c | b'\r')
+}
+
+/// The words of a plain line, the kind writers print: ASCII letters each
+/// followed by a plain decimal of at most 15 digits, separated by
+/// whitespace, up to a `;` comment. False when the line holds anything
+/// else (a checksum, a `( )` comment, other bytes or numbers): then
+/// [`LineParser::words`] reads it, with the same result for a line this
+/// reads. One pass over the bytes, the number read as [`decimal`] reads it.
+fn plain_words(raw: &[u8], params: &mut Vec<(char, f64)>) -> bool {
+    let mut bytes = raw.iter();
+    let mut next = bytes.next();
+    while let Some(&b) = next {
+        next = bytes.next();
+        if space(b) {
+            continue;
+        }
+        if b == b';' {
+            return true;
+        }
+        if !b.is_ascii_alphabetic() {
+            return false;
+        }
+        let neg = match next {
+            Some(b'-') => true,
+            Some(b'+') => false,
+            _ => {
+                let (v, rest) = plain_number(&mut bytes, next);
+                let Some(v) = v else { return false };
+                params.push((char::from(b.to_ascii_uppercase()), v));
+                next = rest;
+                continue;
+            }
+        };
+        let first = bytes.next();
+        let (v, rest) = plain_number(&mut bytes, first);
+        let Some(v) = v else { return false };
+        params.push((char::from(b.to_ascii_uppercase()), if neg { -v } else { v }));
+        next = rest;
+    }
+    true
+}
+
+/// Reads unsigned digits with at most one `.` from `first` on, up to a
+/// letter, whitespace, `;` or the end; returns the value (`None` if there
+/// were no digits, more than 15, or another byte) and the byte after.
+fn plain_number<'a>(
+    bytes: &mut std::slice::Iter<'a, u8>,
+    first: Option<&'a u8>,
+) -> (Option<f64>, Option<&'a u8>) {
+    const POW10: [f64; 16] = [
+        1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
+    ];
+    let (mut m, mut n, mut frac, mut dot) = (0u64, 0usize, 0usize, false);
+    let mut cur = first;
+    while let Some(&c) = cur {
+        let d = c.wrapping_sub(b'0');
+        if d < 10 {
+            m = m * 10 + u64::from(d);
+            n += 1;
+            frac += usize::from(dot);
+            if n > 15 {
+                return (None, None);
+            }
+        } else if c == b'.' && !dot {
+            dot = true;
+        } else if c.is_ascii_alphabetic() || space(c) || c == b';' {
+            break;
+        } else {
+            return (None, None);
+        }
+        cur = bytes.next();
+    }
+    if n == 0 {
+        return (None, None);
+    }
+    (Some(m as f64 / POW10[frac]), cur)
 }
 
 #[cfg(test)]
@@ -320,6 +420,43 @@ mod tests {
                 assert_eq!(decimal(t.as_bytes()), Some(want), "{t}");
             }
         }
+    }
+
+    #[test]
+    fn plain_lines_read_as_the_general_reader_reads_them() {
+        // Lines from pieces, and random byte strings over G-code's alphabet.
+        let pieces = [
+            "G1", " X12.5", " Y-3", "E0.00001", " ;c", "\t", "N7 ", "x.5", " Z", "F", "1e3", "*",
+            "(p)", "é", " 2", "\u{b}", "--1", "M82", ";a*(", "1.2.3", "G0",
+        ];
+        let alphabet = b"GXYZEFNMT gxe0123456789.-+;*()\t\x0b\r";
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut rand = move |n: usize| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed % n as u64) as usize
+        };
+        let mut plain = 0;
+        for k in 0..40_000 {
+            let line: String = if k % 2 == 0 {
+                (0..rand(6)).map(|_| pieces[rand(pieces.len())]).collect()
+            } else {
+                (0..rand(24))
+                    .map(|_| char::from(alphabet[rand(alphabet.len())]))
+                    .collect()
+            };
+            let mut fast = Vec::new();
+            if plain_words(line.as_bytes(), &mut fast) {
+                plain += 1;
+                let (mut general, mut d) = (Vec::new(), Vec::new());
+                assert!(LineParser::default().words(&line, 1, &mut d, &mut general));
+                assert_eq!(fast, general, "{line:?}");
+                assert!(d.is_empty(), "{line:?}: {d:?}");
+            }
+        }
+        // Both kinds are met often.
+        assert!(plain > 8_000 && plain < 32_000, "{plain}");
     }
 
     #[test]

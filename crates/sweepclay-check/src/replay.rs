@@ -27,9 +27,11 @@ impl Move {
         (d[0] * d[0] + d[1] * d[1] + d[2] * d[2]).sqrt()
     }
 
-    /// Horizontal length (mm).
+    /// Horizontal length (mm). A square root, not `f64::hypot`, whose
+    /// guard against overflow costs more than the check can pay per move.
     pub fn xy_length(&self) -> f64 {
-        (self.to[0] - self.from[0]).hypot(self.to[1] - self.from[1])
+        let (dx, dy) = (self.to[0] - self.from[0], self.to[1] - self.from[1]);
+        (dx * dx + dy * dy).sqrt()
     }
 }
 
