@@ -85,10 +85,19 @@ fn cell(v: f64, size: f64) -> i32 {
     }
 }
 
+/// A cell's key in one word: 21 bits a coordinate, cells beyond ±2²⁰
+/// (4,000 km) merged into the last (their lists only grow: every reader
+/// tests each bead's geometry).
+fn key(x: i32, y: i32, z: i32) -> u64 {
+    const LIM: i32 = (1 << 20) - 1;
+    let f = |v: i32| (v.clamp(-LIM, LIM) + LIM) as u64;
+    (f(x) << 42) | (f(y) << 21) | f(z)
+}
+
 struct BeadGrid {
     /// Each cell's list of beads, newest first: the index of its first
     /// entry in `links`.
-    cells: FxHashMap<(i32, i32, i32), u32>,
+    cells: FxHashMap<u64, u32>,
     /// List entries: a bead and the index of the next entry (`u32::MAX`
     /// ends the list). One array instead of a vector per cell.
     links: Vec<(u32, u32)>,
@@ -148,7 +157,7 @@ impl BeadGrid {
             for y in ys[0]..=ys[1] {
                 for z in zs[0]..=zs[1] {
                     let entry = self.links.len() as u32;
-                    let next = self.cells.insert((x, y, z), entry).unwrap_or(u32::MAX);
+                    let next = self.cells.insert(key(x, y, z), entry).unwrap_or(u32::MAX);
                     self.links.push((id, next));
                 }
             }
@@ -194,7 +203,7 @@ impl BeadGrid {
                 for x in cell(x0, CELL_XY)..cell(x1, CELL_XY) + 1 {
                     for y in cell(y0, CELL_XY)..cell(y1, CELL_XY) + 1 {
                         for z in z0..z1.min(cell(top, CELL_Z)) + 1 {
-                            let mut e = self.cells.get(&(x, y, z)).copied().unwrap_or(u32::MAX);
+                            let mut e = self.cells.get(&key(x, y, z)).copied().unwrap_or(u32::MAX);
                             while let Some(&(id, next)) = self.links.get(e as usize) {
                                 f(id);
                                 e = next;
@@ -222,6 +231,8 @@ struct TopGrid {
     /// The highest top of each block of 4 × 4 cells (`n / 4` rounded up
     /// a side): most questions are answered by a block or two.
     coarse: Vec<f32>,
+    /// Blocks a row.
+    bx: usize,
     /// The widest bead raised.
     widest: f32,
 }
@@ -253,6 +264,7 @@ impl TopGrid {
             n,
             top: vec![f32::NEG_INFINITY; n[0] * n[1]],
             coarse: vec![f32::NEG_INFINITY; n[0].div_ceil(4) * n[1].div_ceil(4)],
+            bx: n[0].div_ceil(4),
             widest: 0.0,
         }
     }
@@ -279,9 +291,9 @@ impl TopGrid {
                 *v = v.max(top);
             }
         }
-        let cx = nx.div_ceil(4);
+        let bx = self.bx;
         for y in ys[0] / 4..ys[1] / 4 + 1 {
-            for v in &mut self.coarse[y * cx + xs[0] / 4..y * cx + xs[1] / 4 + 1] {
+            for v in &mut self.coarse[y * bx + xs[0] / 4..y * bx + xs[1] / 4 + 1] {
                 *v = v.max(top);
             }
         }
@@ -290,10 +302,10 @@ impl TopGrid {
     /// The highest top in cells `xs`, `ys` (inclusive) or a little beyond:
     /// the blocks of 4 × 4 cells that hold them.
     fn block_max(&self, (xs, ys): ([usize; 2], [usize; 2])) -> f32 {
-        let cx = self.n[0].div_ceil(4);
+        let bx = self.bx;
         let mut m = f32::NEG_INFINITY;
         for y in ys[0] / 4..ys[1] / 4 + 1 {
-            for &v in &self.coarse[y * cx + xs[0] / 4..y * cx + xs[1] / 4 + 1] {
+            for &v in &self.coarse[y * bx + xs[0] / 4..y * bx + xs[1] / 4 + 1] {
                 m = m.max(v);
             }
         }
@@ -311,6 +323,15 @@ impl TopGrid {
             [f[0].min(t[0]), f[1].min(t[1])],
             [f[0].max(t[0]), f[1].max(t[1])],
         );
+        if xs[0] == xs[1] && ys[0] == ys[1] {
+            // Most beads: one cell.
+            let (x, y) = (xs[0], ys[0]);
+            let v = &mut self.top[y * self.n[0] + x];
+            *v = v.max(top);
+            let c = &mut self.coarse[y / 4 * self.bx + x / 4];
+            *c = c.max(top);
+            return;
+        }
         if (xs[1] - xs[0] + 1) * (ys[1] - ys[0] + 1) <= 16 {
             return self.raise_box((xs, ys), top);
         }
@@ -1003,7 +1024,10 @@ impl<'a> Checker<'a> {
         let reach = cfg.nozzle_radius + cfg.width_max / 2.0;
         // Collisions at points every r/2 mm of path (at most 200 a move).
         let every = (cfg.nozzle_radius / 2.0).max(0.5);
-        let (first, last) = ((s_start / every).floor() + 1.0, (self.s / every).floor());
+        // Path distances are ≥ 0, where truncation is the floor (and no
+        // library call).
+        let floor = |v: f64| (v as i64) as f64;
+        let (first, last) = (floor(s_start / every) + 1.0, floor(self.s / every));
         let probes = (last - first + 1.0).clamp(0.0, 200.0) as usize;
         for k in 0..probes {
             let t = if probes < 200 {

@@ -209,8 +209,17 @@ fn prints_in_clay(d: &Design) -> Result<(), TestCaseError> {
     Ok(())
 }
 
+/// 300 random designs a property, or `PROPTEST_CASES` (for longer runs
+/// by hand).
+fn cases() -> u32 {
+    std::env::var("PROPTEST_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(300)
+}
+
 proptest! {
-    #![proptest_config(ProptestConfig { cases: 300, failure_persistence: None, .. ProptestConfig::default() })]
+    #![proptest_config(ProptestConfig { cases: cases(), failure_persistence: None, .. ProptestConfig::default() })]
 
     #[test]
     fn random_designs_print_in_clay(s in spec()) {
