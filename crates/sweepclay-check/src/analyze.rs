@@ -7,7 +7,6 @@ use crate::parse::{Diagnostic, Line, LineParser};
 use crate::replay::{Event, Move, Replayer};
 use crate::report::{Count, Report};
 use crate::CheckConfig;
-use rustc_hash::FxHashMap;
 
 const EPS_E: f64 = 1e-7;
 const CELL_XY: f64 = 4.0;
@@ -85,19 +84,22 @@ fn cell(v: f64, size: f64) -> i32 {
     }
 }
 
-/// A cell's key in one word: 21 bits a coordinate, cells beyond ±2²⁰
-/// (4,000 km) merged into the last (their lists only grow: every reader
-/// tests each bead's geometry).
-fn key(x: i32, y: i32, z: i32) -> u64 {
-    const LIM: i32 = (1 << 20) - 1;
-    let f = |v: i32| (v.clamp(-LIM, LIM) + LIM) as u64;
-    (f(x) << 42) | (f(y) << 21) | f(z)
-}
+/// Cells are indexed over the build volume with a margin of this many
+/// cells a side; clay beyond is counted in the border cells, whose lists
+/// only grow by it (every reader tests each bead's geometry).
+const MARGIN_CELLS: i32 = 8;
+
+/// Cells a side of the bead lists, at most (4 m in plan, 8 m high); a
+/// larger build volume shares the border cells.
+const MAX_CELLS: [i32; 3] = [1024, 1024, 4096];
 
 struct BeadGrid {
     /// Each cell's list of beads, newest first: the index of its first
-    /// entry in `links`.
-    cells: FxHashMap<u64, u32>,
+    /// entry in `links` (`u32::MAX`: empty). A plan column's cells, bottom
+    /// to top, are allocated when a bead first reaches it.
+    columns: Vec<Box<[u32]>>,
+    /// Cells a side: x, y, z (the first at `-MARGIN_CELLS`).
+    dims: [i32; 3],
     /// List entries: a bead and the index of the next entry (`u32::MAX`
     /// ends the list). One array instead of a vector per cell.
     links: Vec<(u32, u32)>,
@@ -121,8 +123,19 @@ enum Tops {
 impl BeadGrid {
     fn new(cfg: &CheckConfig) -> BeadGrid {
         let plate = [cfg.build_volume[0], cfg.build_volume[1]];
+        let dims = [0, 1, 2].map(|a| {
+            let size = if a == 2 { CELL_Z } else { CELL_XY };
+            let v = cfg.build_volume[a];
+            let inside = if v.is_finite() {
+                cell(v.max(0.0), size)
+            } else {
+                0
+            };
+            (inside + 1 + 2 * MARGIN_CELLS).clamp(1, MAX_CELLS[a])
+        });
         BeadGrid {
-            cells: FxHashMap::default(),
+            columns: vec![Box::default(); (dims[0] * dims[1]) as usize],
+            dims,
             links: Vec::new(),
             column_max: TopGrid::new(plate, CELL_XY),
             settled_max: TopGrid::new(plate, CELL_XY),
@@ -148,17 +161,28 @@ impl BeadGrid {
         (n <= 100_000).then_some((x, y, z, ztop))
     }
 
+    /// A cell range on axis `a` as indices into the grid (inclusive),
+    /// clamped into it.
+    fn clamp(&self, a: usize, r: [i32; 2]) -> [usize; 2] {
+        r.map(|v| (v.saturating_add(MARGIN_CELLS)).clamp(0, self.dims[a] - 1) as usize)
+    }
+
     fn insert(&mut self, b: &Bead, id: u32) {
         self.column_max.raise(b);
         let Some((xs, ys, zs, _)) = Self::span(b) else {
             return;
         };
-        for x in xs[0]..=xs[1] {
-            for y in ys[0]..=ys[1] {
-                for z in zs[0]..=zs[1] {
-                    let entry = self.links.len() as u32;
-                    let next = self.cells.insert(key(x, y, z), entry).unwrap_or(u32::MAX);
-                    self.links.push((id, next));
+        let (xs, ys, zs) = (self.clamp(0, xs), self.clamp(1, ys), self.clamp(2, zs));
+        let (nx, nz) = (self.dims[0] as usize, self.dims[2] as usize);
+        for y in ys[0]..ys[1] + 1 {
+            for x in xs[0]..xs[1] + 1 {
+                let column = &mut self.columns[y * nx + x];
+                if column.is_empty() {
+                    *column = vec![u32::MAX; nz].into_boxed_slice();
+                }
+                for head in &mut column[zs[0]..zs[1] + 1] {
+                    self.links.push((id, *head));
+                    *head = self.links.len() as u32 - 1;
                 }
             }
         }
@@ -200,10 +224,17 @@ impl BeadGrid {
                 // The `CELL_XY` columns of this one inside the query box.
                 let (x0, x1) = tops.clip(gx, 0, p[0] - r, p[0] + r);
                 let (y0, y1) = tops.clip(gy, 1, p[1] - r, p[1] + r);
-                for x in cell(x0, CELL_XY)..cell(x1, CELL_XY) + 1 {
-                    for y in cell(y0, CELL_XY)..cell(y1, CELL_XY) + 1 {
-                        for z in z0..z1.min(cell(top, CELL_Z)) + 1 {
-                            let mut e = self.cells.get(&key(x, y, z)).copied().unwrap_or(u32::MAX);
+                let xs = self.clamp(0, [cell(x0, CELL_XY), cell(x1, CELL_XY)]);
+                let ys = self.clamp(1, [cell(y0, CELL_XY), cell(y1, CELL_XY)]);
+                let zs = self.clamp(2, [z0, z1.min(cell(top, CELL_Z))]);
+                if z0 > z1.min(cell(top, CELL_Z)) {
+                    continue;
+                }
+                for y in ys[0]..ys[1] + 1 {
+                    for x in xs[0]..xs[1] + 1 {
+                        let column = &self.columns[y * self.dims[0] as usize + x];
+                        for &head in column.get(zs[0]..zs[1] + 1).unwrap_or_default() {
+                            let mut e = head;
                             while let Some(&(id, next)) = self.links.get(e as usize) {
                                 f(id);
                                 e = next;

@@ -252,6 +252,33 @@ fn nozzle_below_a_printed_wall_fails() {
 }
 
 #[test]
+fn clay_far_outside_the_bed_is_still_seen() {
+    // The collision fixture 250 mm beyond a 200 mm bed (past the indexed
+    // margin): its cells are shared with the bed's border, and the
+    // support and the collision are found all the same.
+    let mut g = wall_from(450.0, 490.0, 10);
+    g.bead([450.0, 55.0, LAYER], W, LAYER);
+    g.run([490.0, 55.0, LAYER], W, LAYER);
+    let r = verdict(&g.out);
+    fails_for(&r, "nozzle collision", &["outside the build volume"]);
+    assert_eq!(r.support.unsupported.count, 0, "{}", r.render());
+    let (worst, _) = r.nozzle_collisions.worst.unwrap();
+    assert!((worst - 10.8).abs() < 0.01, "{worst}");
+    // A build volume of 1 mm: every bead in the border cells.
+    let tiny = CheckConfig {
+        build_volume: [1.0, 1.0, 1.0],
+        ..CheckConfig::default()
+    };
+    let t = check(&g.out, &tiny);
+    assert_eq!(t.support, r.support);
+    assert_eq!(t.nozzle_collisions, r.nozzle_collisions);
+    assert_eq!(
+        sweepclay_check::check_exhaustive(&g.out, &tiny).support,
+        r.support
+    );
+}
+
+#[test]
 fn carriage_over_a_tall_wall_fails() {
     // A 42 mm wall, then down to the bed 20 mm away: the carriage (30 mm
     // up) hits it. (The nozzle also grazes the wall while it leaves it.)
