@@ -165,7 +165,9 @@ impl LineParser {
             _ => (None, 0.0),
         };
         if first > 0 {
-            words.drain(..first);
+            let n = words.len() - first;
+            words.copy_within(first.., 0);
+            words.truncate(n);
         }
         out.line = n;
         out.letter = letter;
