@@ -224,12 +224,13 @@ impl BeadGrid {
                 // The `CELL_XY` columns of this one inside the query box.
                 let (x0, x1) = tops.clip(gx, 0, p[0] - r, p[0] + r);
                 let (y0, y1) = tops.clip(gy, 1, p[1] - r, p[1] + r);
-                let xs = self.clamp(0, [cell(x0, CELL_XY), cell(x1, CELL_XY)]);
-                let ys = self.clamp(1, [cell(y0, CELL_XY), cell(y1, CELL_XY)]);
-                let zs = self.clamp(2, [z0, z1.min(cell(top, CELL_Z))]);
-                if z0 > z1.min(cell(top, CELL_Z)) {
+                let zmax = z1.min(cell(top, CELL_Z));
+                if z0 > zmax {
                     continue;
                 }
+                let xs = self.clamp(0, [cell(x0, CELL_XY), cell(x1, CELL_XY)]);
+                let ys = self.clamp(1, [cell(y0, CELL_XY), cell(y1, CELL_XY)]);
+                let zs = self.clamp(2, [z0, zmax]);
                 for y in ys[0]..ys[1] + 1 {
                     for x in xs[0]..xs[1] + 1 {
                         let column = &self.columns[y * self.dims[0] as usize + x];
