@@ -1354,6 +1354,48 @@ mod tests {
     use super::*;
 
     #[test]
+    fn column_top_blocks_bound_their_cells() {
+        // Beads of every length and direction raise a 2 mm grid over a
+        // 200 mm bed; each block must hold its cells' highest top, and a
+        // box's cells must be under the blocks that hold it.
+        let mut g = TopGrid::new([200.0, 200.0], 2.0);
+        let mut seed = 0x9e37_79b9_7f4a_7c15u64;
+        let mut rand = move |hi: f64| {
+            seed ^= seed << 13;
+            seed ^= seed >> 7;
+            seed ^= seed << 17;
+            (seed % 1_000_000) as f64 / 1e6 * hi
+        };
+        for _ in 0..3_000 {
+            let from = [rand(260.0) - 30.0, rand(260.0) - 30.0, rand(50.0)];
+            let len = if rand(1.0) < 0.9 {
+                rand(4.0)
+            } else {
+                rand(120.0)
+            };
+            let a = rand(std::f64::consts::TAU);
+            let to = [from[0] + len * a.cos(), from[1] + len * a.sin(), from[2]];
+            g.raise(&Bead::new(from, to, 3.0, 0.0, false));
+        }
+        for y in 0..g.n[1] {
+            for x in 0..g.n[0] {
+                let top = g.top[y * g.n[0] + x];
+                assert!(g.coarse[y / 4 * g.bx + x / 4] >= top, "{x} {y}");
+            }
+        }
+        for _ in 0..3_000 {
+            let (x0, y0) = (rand(g.n[0] as f64) as usize, rand(g.n[1] as f64) as usize);
+            let xs = [x0, (x0 + rand(9.0) as usize).min(g.n[0] - 1)];
+            let ys = [y0, (y0 + rand(9.0) as usize).min(g.n[1] - 1)];
+            let cells = (ys[0]..=ys[1])
+                .flat_map(|y| (xs[0]..=xs[1]).map(move |x| (x, y)))
+                .map(|(x, y)| g.top[y * g.n[0] + x])
+                .fold(f32::NEG_INFINITY, f32::max);
+            assert!(g.block_max((xs, ys)) >= cells);
+        }
+    }
+
+    #[test]
     fn turn_bound_is_an_upper_bound_of_the_angle_and_close_to_it() {
         for k in 0..=100_000 {
             let c = 1.0 - 0.5 * f64::from(k) / 100_000.0;

@@ -99,34 +99,12 @@ fn skip_while(s: &str, mut i: usize, keep: impl Fn(char) -> bool) -> usize {
 /// `str::parse`. `None` for anything else (exponents, more digits), which
 /// `str::parse` then reads.
 fn decimal(s: &[u8]) -> Option<f64> {
-    const POW10: [f64; 16] = [
-        1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
-    ];
-    let (neg, digits) = match s.first()? {
-        b'-' => (true, &s[1..]),
-        b'+' => (false, &s[1..]),
-        _ => (false, s),
-    };
-    let (mut m, mut n, mut frac, mut dot) = (0u64, 0usize, 0usize, false);
-    for &b in digits {
-        match b {
-            b'0'..=b'9' => {
-                m = m * 10 + u64::from(b - b'0');
-                n += 1;
-                frac += usize::from(dot);
-            }
-            b'.' if !dot => dot = true,
-            _ => return None,
-        }
-        if n > 15 {
-            return None;
-        }
+    let mut bytes = s.iter();
+    let first = bytes.next();
+    match number(&mut bytes, first) {
+        (v, None) => v,
+        _ => None,
     }
-    if n == 0 {
-        return None;
-    }
-    let v = m as f64 / POW10[frac];
-    Some(if neg { -v } else { v })
 }
 
 fn ends_word(c: char) -> bool {
@@ -284,7 +262,7 @@ fn space(b: u8) -> bool {
 /// whitespace, up to a `;` comment. False when the line holds anything
 /// else (a checksum, a `( )` comment, other bytes or numbers): then
 /// [`LineParser::words`] reads it, with the same result for a line this
-/// reads. One pass over the bytes, the number read as [`decimal`] reads it.
+/// reads. One pass over the bytes.
 fn plain_words(raw: &[u8], params: &mut Vec<(char, f64)>) -> bool {
     let mut bytes = raw.iter();
     let mut next = bytes.next();
@@ -299,38 +277,30 @@ fn plain_words(raw: &[u8], params: &mut Vec<(char, f64)>) -> bool {
         if !b.is_ascii_alphabetic() {
             return false;
         }
-        let neg = match next {
-            Some(b'-') => true,
-            Some(b'+') => false,
-            _ => {
-                let (v, rest) = plain_number(&mut bytes, next);
-                let Some(v) = v else { return false };
-                params.push((char::from(b.to_ascii_uppercase()), v));
-                next = rest;
-                continue;
-            }
-        };
-        let first = bytes.next();
-        let (v, rest) = plain_number(&mut bytes, first);
+        let (v, rest) = number(&mut bytes, next);
         let Some(v) = v else { return false };
-        params.push((char::from(b.to_ascii_uppercase()), if neg { -v } else { v }));
+        params.push((char::from(b.to_ascii_uppercase()), v));
         next = rest;
     }
     true
 }
 
-/// Reads unsigned digits with at most one `.` from `first` on, up to a
-/// letter, whitespace, `;` or the end; returns the value (`None` if there
-/// were no digits, more than 15, or another byte) and the byte after.
-fn plain_number<'a>(
+/// A plain decimal from `first` on (sign, digits, at most one `.`), up
+/// to a letter, whitespace, `;` or the end: the value (`None` if there
+/// were no digits, more than 15, or another byte) and the byte after it.
+fn number<'a>(
     bytes: &mut std::slice::Iter<'a, u8>,
     first: Option<&'a u8>,
 ) -> (Option<f64>, Option<&'a u8>) {
     const POW10: [f64; 16] = [
         1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
     ];
-    let (mut m, mut n, mut frac, mut dot) = (0u64, 0usize, 0usize, false);
     let mut cur = first;
+    let neg = cur == Some(&b'-');
+    if matches!(cur, Some(b'-' | b'+')) {
+        cur = bytes.next();
+    }
+    let (mut m, mut n, mut frac, mut dot) = (0u64, 0usize, 0usize, false);
     while let Some(&c) = cur {
         let d = c.wrapping_sub(b'0');
         if d < 10 {
@@ -352,7 +322,8 @@ fn plain_number<'a>(
     if n == 0 {
         return (None, None);
     }
-    (Some(m as f64 / POW10[frac]), cur)
+    let v = m as f64 / POW10[frac];
+    (Some(if neg { -v } else { v }), cur)
 }
 
 #[cfg(test)]
