@@ -103,20 +103,22 @@ struct BeadGrid {
     /// List entries: a bead and the index of the next entry (`u32::MAX`
     /// ends the list). One array instead of a vector per cell.
     links: Vec<(u32, u32)>,
-    /// Highest clay top in each plan column, every bead.
-    column_max: TopGrid,
-    /// The same for settled beads only: those far enough back along the
-    /// path that the nozzle is no longer laying them (see `settle`).
+    /// Highest clay top in each plan column of the settled beads: those
+    /// far enough back along the path that the nozzle is no longer laying
+    /// them (see `settle`).
     settled_max: TopGrid,
 }
 
 /// Cell ranges of a bead: plan x, plan y, z (inclusive), and its top.
 type Span = ([i32; 2], [i32; 2], [i32; 2], f64);
 
-/// Which beads a query's column tops count.
+/// Which cells a query reads.
 #[derive(Clone, Copy, PartialEq)]
 enum Tops {
+    /// All in its box.
     All,
+    /// Only those of plan columns whose settled clay reaches its lowest
+    /// height (for a query that skips beads not settled).
     Settled,
 }
 
@@ -137,7 +139,6 @@ impl BeadGrid {
             columns: vec![Box::default(); (dims[0] * dims[1]) as usize],
             dims,
             links: Vec::new(),
-            column_max: TopGrid::new(plate, CELL_XY),
             settled_max: TopGrid::new(plate, CELL_XY),
         }
     }
@@ -168,7 +169,6 @@ impl BeadGrid {
     }
 
     fn insert(&mut self, b: &Bead, id: u32) {
-        self.column_max.raise(b);
         let Some((xs, ys, zs, _)) = Self::span(b) else {
             return;
         };
@@ -194,7 +194,8 @@ impl BeadGrid {
     }
 
     /// Ids in cells within `r` (plan) of `p` and heights `zlo..=zhi`,
-    /// newest first, skipping plan columns whose `tops` are below `zlo`.
+    /// newest first in each cell; with `Tops::Settled`, only in plan
+    /// columns whose settled clay reaches `zlo`.
     fn for_each(
         &self,
         p: [f64; 3],
@@ -205,13 +206,16 @@ impl BeadGrid {
         mut f: impl FnMut(u32),
     ) {
         let (z0, z1) = (cell(zlo, CELL_Z), cell(zhi, CELL_Z));
-        let tops = match tops {
-            Tops::All => &self.column_max,
-            Tops::Settled => &self.settled_max,
-        };
+        let (lo, hi) = ([p[0] - r, p[1] - r], [p[0] + r, p[1] + r]);
+        if tops == Tops::All {
+            let xs = [cell(lo[0], CELL_XY), cell(hi[0], CELL_XY)];
+            let ys = [cell(lo[1], CELL_XY), cell(hi[1], CELL_XY)];
+            return self.visit(xs, ys, [z0, z1], &mut f);
+        }
+        let tops = &self.settled_max;
         // The column tops first (a load each); the bead lists of a column
         // only when its clay reaches `zlo`.
-        let (gxs, gys) = tops.range([p[0] - r, p[1] - r], [p[0] + r, p[1] + r]);
+        let (gxs, gys) = tops.range(lo, hi);
         if f64::from(tops.block_max((gxs, gys))) < zlo {
             return;
         }
@@ -224,23 +228,28 @@ impl BeadGrid {
                 // The `CELL_XY` columns of this one inside the query box.
                 let (x0, x1) = tops.clip(gx, 0, p[0] - r, p[0] + r);
                 let (y0, y1) = tops.clip(gy, 1, p[1] - r, p[1] + r);
-                let zmax = z1.min(cell(top, CELL_Z));
-                if z0 > zmax {
-                    continue;
-                }
-                let xs = self.clamp(0, [cell(x0, CELL_XY), cell(x1, CELL_XY)]);
-                let ys = self.clamp(1, [cell(y0, CELL_XY), cell(y1, CELL_XY)]);
-                let zs = self.clamp(2, [z0, zmax]);
-                for y in ys[0]..ys[1] + 1 {
-                    for x in xs[0]..xs[1] + 1 {
-                        let column = &self.columns[y * self.dims[0] as usize + x];
-                        for &head in column.get(zs[0]..zs[1] + 1).unwrap_or_default() {
-                            let mut e = head;
-                            while let Some(&(id, next)) = self.links.get(e as usize) {
-                                f(id);
-                                e = next;
-                            }
-                        }
+                let xs = [cell(x0, CELL_XY), cell(x1, CELL_XY)];
+                let ys = [cell(y0, CELL_XY), cell(y1, CELL_XY)];
+                self.visit(xs, ys, [z0, z1.min(cell(top, CELL_Z))], &mut f);
+            }
+        }
+    }
+
+    /// Ids in the cells of ranges `xs`, `ys`, `zs` (inclusive, whole
+    /// cells, clamped into the grid), newest first in each cell.
+    fn visit(&self, xs: [i32; 2], ys: [i32; 2], zs: [i32; 2], f: &mut impl FnMut(u32)) {
+        if zs[0] > zs[1] {
+            return;
+        }
+        let (xs, ys, zs) = (self.clamp(0, xs), self.clamp(1, ys), self.clamp(2, zs));
+        for y in ys[0]..ys[1] + 1 {
+            for x in xs[0]..xs[1] + 1 {
+                let column = &self.columns[y * self.dims[0] as usize + x];
+                for &head in column.get(zs[0]..zs[1] + 1).unwrap_or_default() {
+                    let mut e = head;
+                    while let Some(&(id, next)) = self.links.get(e as usize) {
+                        f(id);
+                        e = next;
                     }
                 }
             }
