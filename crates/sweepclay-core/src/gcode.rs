@@ -122,46 +122,49 @@ pub struct MoveFormat {
     pub travel_feed_mm_min: f64,
 }
 
+/// `x.round() as i64` (half away from zero) for |x| < 9·10¹⁵, without
+/// the library call `f64::round` is on x86-64's baseline: the truncation
+/// is exact there, and so is the fraction `x - t`.
+#[inline]
+fn round(x: f64) -> i64 {
+    let t = x as i64;
+    let f = x - t as f64;
+    // Without branches: the fraction's side of ±0.5 is a coin toss.
+    t + i64::from(f >= 0.5) - i64::from(f <= -0.5)
+}
+
 /// Appends `v` with `decimals` (≤ 8) digits after the point: the integer
 /// `round(v · 10^decimals)` split at the point, no `-0`. Equal to
 /// `format!("{v:.N}")` except where v·10^N lies within a rounding error of
 /// a tie (both are then correct to half a unit of the last digit).
 pub fn push_fixed(buf: &mut Vec<u8>, v: f64, decimals: usize) {
     const POW: [f64; 9] = [1.0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8];
-    const IPOW: [i64; 9] = [
-        1,
-        10,
-        100,
-        1000,
-        10_000,
-        100_000,
-        1_000_000,
-        10_000_000,
-        100_000_000,
-    ];
-    let r = (v * POW[decimals]).round();
-    if r.is_nan() || r.abs() >= 9.0e15 {
+    let x = v * POW[decimals];
+    if x.is_nan() || x.abs() >= 9.0e15 {
         // Out of i64's exact range, or not a number: the slow, general way.
         use std::io::Write as _;
         let _ = write!(buf, "{v:.decimals$}");
         return;
     }
-    let mut n = r as i64;
+    let mut n = round(x);
     if n < 0 {
         buf.push(b'-');
         n = -n;
     }
+    // All the digits at once, the point put in before the last `decimals`.
     let mut ib = itoa::Buffer::new();
-    buf.extend_from_slice(ib.format(n / IPOW[decimals]).as_bytes());
-    if decimals > 0 {
+    let digits = ib.format(n).as_bytes();
+    if decimals == 0 {
+        buf.extend_from_slice(digits);
+    } else if digits.len() > decimals {
+        let (int, frac) = digits.split_at(digits.len() - decimals);
+        buf.extend_from_slice(int);
         buf.push(b'.');
-        let mut frac = n % IPOW[decimals];
-        let mut digits = [b'0'; 8];
-        for d in digits[..decimals].iter_mut().rev() {
-            *d = b'0' + (frac % 10) as u8;
-            frac /= 10;
-        }
-        buf.extend_from_slice(&digits[..decimals]);
+        buf.extend_from_slice(frac);
+    } else {
+        buf.extend_from_slice(b"0.");
+        buf.extend(std::iter::repeat_n(b'0', decimals - digits.len()));
+        buf.extend_from_slice(digits);
     }
 }
 
@@ -323,6 +326,35 @@ mod tests {
              ;WIDTH:3.500\n\
              G1 X103.000 Y50.000 Z2.500 E1.25000\n"
         );
+    }
+
+    #[test]
+    fn round_is_f64_round() {
+        let mut rng = 0x2545_f491_4f6c_dd1du64;
+        let mut xs = vec![
+            0.0,
+            -0.0,
+            0.5,
+            -0.5,
+            1.5,
+            -2.5,
+            0.49999999999999994,
+            -0.49999999999999994,
+        ];
+        xs.extend([4503599627370495.5, -4503599627370495.5, 8.99e15, -8.99e15]);
+        for k in 0..200_000u64 {
+            rng ^= rng << 13;
+            rng ^= rng >> 7;
+            rng ^= rng << 17;
+            let mag = [1.0, 1e3, 1e6, 1e12][k as usize % 4];
+            xs.push(((rng >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * mag);
+            // Exact halves and their neighbours.
+            let h = (rng % 1_000_000) as f64 + 0.5;
+            xs.extend([h, -h, h.next_up(), h.next_down()]);
+        }
+        for x in xs {
+            assert_eq!(round(x), x.round() as i64, "{x}");
+        }
     }
 
     #[test]
