@@ -312,9 +312,11 @@ impl TopGrid {
 
     /// Cell index along axis `a`, clamped into the rectangle.
     fn index(&self, v: f64, a: usize) -> usize {
-        // `as` truncates toward zero and saturates (negative and NaN to 0),
-        // which is the floor for every cell index but the first.
-        (((v - self.origin[a]) * self.inv) as usize).min(self.n[a] - 1)
+        // `as` truncates toward zero and saturates (NaN to 0), which is the
+        // floor for every cell index but the first; to `i32`, which is a
+        // few instructions less than to `usize` (n is at most 1016).
+        let c = ((v - self.origin[a]) * self.inv) as i32;
+        c.clamp(0, self.n[a] as i32 - 1) as usize
     }
 
     /// Cell ranges `[x0, x1], [y0, y1]` (inclusive) of a plan box.
