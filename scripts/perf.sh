@@ -2,7 +2,7 @@
 # Regenerates the figures of docs/PERFORMANCE.md: the criterion benchmarks
 # of every stage and of design -> verified G-code (examples and the scaling
 # series), then peak memory per sample, docs/perf/scaling.csv and the plot
-# docs/img/scaling.png. Takes about half an hour on a 2-core machine.
+# docs/img/scaling.png. Takes 20–30 minutes on a 2-core machine.
 #   scripts/perf.sh            # scaling series to 10M samples
 #   MAX=1000000 scripts/perf.sh  # quicker: everything to 1M
 set -euo pipefail
