@@ -215,6 +215,11 @@ impl BeadGrid {
             return self.visit(xs, ys, [z0, z1], &mut f);
         }
         let tops = &self.settled_max;
+        // Most queries of a print laid bottom up: no settled clay that
+        // high anywhere.
+        if f64::from(tops.highest) < zlo {
+            return;
+        }
         // The column tops first (a load each); the bead lists of a column
         // only when its clay reaches `zlo`.
         let (gxs, gys) = tops.range(lo, hi);
@@ -278,6 +283,8 @@ struct TopGrid {
     bx: usize,
     /// The widest bead raised.
     widest: f32,
+    /// The highest top raised.
+    highest: f32,
 }
 
 impl TopGrid {
@@ -309,6 +316,7 @@ impl TopGrid {
             coarse: vec![f32::NEG_INFINITY; n[0].div_ceil(4) * n[1].div_ceil(4)],
             bx: n[0].div_ceil(4),
             widest: 0.0,
+            highest: f32::NEG_INFINITY,
         }
     }
 
@@ -372,18 +380,26 @@ impl TopGrid {
         let (f, t) = (b.from(), b.to());
         let top = b.from32[2].max(b.to32[2]);
         self.widest = self.widest.max(b.width32);
+        self.highest = self.highest.max(top);
         let (xs, ys) = self.range(
             [f[0].min(t[0]), f[1].min(t[1])],
             [f[0].max(t[0]), f[1].max(t[1])],
         );
-        if xs[0] == xs[1] && ys[0] == ys[1] {
-            // Most beads: one cell. (Without the loops; raise_box does the
-            // same in the same instructions but about 2 % slower a check.)
-            let (x, y) = (xs[0], ys[0]);
-            let v = &mut self.top[y * self.n[0] + x];
-            *v = v.max(top);
-            let c = &mut self.coarse[y / 4 * self.bx + x / 4];
-            *c = c.max(top);
+        if xs[1] - xs[0] <= 1 && ys[1] - ys[0] <= 1 {
+            // Most beads: a cell or two a side. The four corners, some
+            // perhaps the same cell, without loops.
+            let nx = self.n[0];
+            for (x, y) in [
+                (xs[0], ys[0]),
+                (xs[1], ys[0]),
+                (xs[0], ys[1]),
+                (xs[1], ys[1]),
+            ] {
+                let v = &mut self.top[y * nx + x];
+                *v = v.max(top);
+                let c = &mut self.coarse[y / 4 * self.bx + x / 4];
+                *c = c.max(top);
+            }
             return;
         }
         if (xs[1] - xs[0] + 1) * (ys[1] - ys[0] + 1) <= 16 {
@@ -553,6 +569,19 @@ impl Query<'_> {
     }
 }
 
+impl Query<'_> {
+    /// Whether none of `beads` (the first has index `first`) is clay below
+    /// the new bead: `classify` puts none of them in `Below`. Oldest first,
+    /// since clay below in the last stretch of path (the end of the pass
+    /// before a reversal) is usually its oldest part.
+    fn none_below(&self, beads: &[Bead], first: usize) -> bool {
+        beads
+            .iter()
+            .zip(first as u32..)
+            .all(|(b, j)| !matches!(self.classify(b, j), Class::Below(_)))
+    }
+}
+
 /// An upper bound of `acos c` for `c ≥ 0.5` (a turn under 60°):
 /// `√(2(1 − c)) (1 + (1 − c)/6)`, at most 3.5 % over and cheaper than
 /// `acos`; π below.
@@ -650,7 +679,8 @@ impl Recent {
 /// - no settled clay near the middle is high enough above it to be
 ///   climbed to (see `pick_support`) or at the new bead's own height;
 /// - none of the clay laid in the last 2 w_max of path can be clay below
-///   (the caller asks [`Recent::clear_of`] first).
+///   (the caller asks [`Recent::clear_of`] first, or if its bound does not
+///   hold, [`Query::none_below`]).
 ///
 /// `beads[..settled]` are in `tops`. The cost does not depend on how
 /// finely the path is sampled.
@@ -813,10 +843,10 @@ pub fn check(text: &str, cfg: &CheckConfig) -> Report {
 }
 
 fn check_with(text: &str, cfg: &CheckConfig, exhaustive: bool) -> Report {
-    let mut c = Checker::new(cfg);
-    c.exhaustive = exhaustive;
-    text.lines().for_each(|l| c.line(l));
-    c.finish()
+    let mut w = CheckWriter::new(cfg);
+    w.checker.exhaustive = exhaustive;
+    w.feed(text.as_bytes());
+    w.finish()
 }
 
 /// [`check`] with the support always found by the full search, never by
@@ -866,20 +896,28 @@ impl<'a> CheckWriter<'a> {
     }
 }
 
-impl std::io::Write for CheckWriter<'_> {
-    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        let mut rest = buf;
-        while let Some(nl) = rest.iter().position(|&b| b == b'\n') {
+impl CheckWriter<'_> {
+    /// Feeds every complete line of `buf` (after what was left over from
+    /// the last write) and keeps the rest.
+    fn feed(&mut self, buf: &[u8]) {
+        let mut start = 0;
+        for nl in memchr::memchr_iter(b'\n', buf) {
             if self.partial.is_empty() {
-                self.checker.bytes(&rest[..nl]);
+                self.checker.bytes(&buf[start..nl]);
             } else {
-                self.partial.extend_from_slice(&rest[..nl]);
+                self.partial.extend_from_slice(&buf[start..nl]);
                 self.checker.bytes(&self.partial);
                 self.partial.clear();
             }
-            rest = &rest[nl + 1..];
+            start = nl + 1;
         }
-        self.partial.extend_from_slice(rest);
+        self.partial.extend_from_slice(&buf[start..]);
+    }
+}
+
+impl std::io::Write for CheckWriter<'_> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        self.feed(buf);
         Ok(buf.len())
     }
 
@@ -975,22 +1013,17 @@ impl<'a> Checker<'a> {
         }
     }
 
-    /// A line as bytes, without its `\n`: a `\r` before it is dropped,
-    /// bytes that are not UTF-8 are replaced.
-    fn bytes(&mut self, mut line: &[u8]) {
-        if line.last() == Some(&b'\r') {
-            line = &line[..line.len() - 1];
+    /// A line as bytes, without its `\n`: a `\r` before it is dropped.
+    fn bytes(&mut self, mut raw: &[u8]) {
+        if raw.last() == Some(&b'\r') {
+            raw = &raw[..raw.len() - 1];
         }
-        match std::str::from_utf8(line) {
-            Ok(l) => self.line(l),
-            Err(_) => self.line(&String::from_utf8_lossy(line)),
-        }
-    }
-
-    fn line(&mut self, raw: &str) {
         self.r.lines += 1;
         let n = self.r.lines;
-        if !self.parser.parse(raw, n, &mut self.diags, &mut self.line) {
+        if !self
+            .parser
+            .parse_bytes(raw, n, &mut self.diags, &mut self.line)
+        {
             return;
         }
         match self.replayer.feed(&self.line, &mut self.diags) {
@@ -1206,8 +1239,15 @@ impl<'a> Checker<'a> {
                 s_start,
                 cfg,
             };
+            // The shortcut needs the clay of the last 2 w_max of path not to
+            // be clay below: the bound of `clear_of` says so for most beads;
+            // for the rest (reversals, drops) each such bead is asked.
             let fast = prev_support
-                .filter(|_| !*exhaustive && recent.clear_of(m, mid, cfg.min_layer_mm, turn, xy))
+                .filter(|_| {
+                    !*exhaustive
+                        && (recent.clear_of(m, mid, cfg.min_layer_mm, turn, xy)
+                            || q.none_below(&beads[*support_settled..], *support_settled))
+                })
                 .and_then(|j| follow_support(beads, *support_settled, support_tops, j, &q));
             r.support.beads += 1;
             let support = if fast.is_some() {

@@ -99,10 +99,8 @@ fn skip_while(s: &str, mut i: usize, keep: impl Fn(char) -> bool) -> usize {
 /// `str::parse`. `None` for anything else (exponents, more digits), which
 /// `str::parse` then reads.
 fn decimal(s: &[u8]) -> Option<f64> {
-    let mut bytes = s.iter();
-    let first = bytes.next();
-    match number(&mut bytes, first) {
-        (v, None) => v,
+    match number(s, 0) {
+        (v, end) if end == s.len() => v,
         _ => None,
     }
 }
@@ -122,10 +120,27 @@ impl LineParser {
         diags: &mut Vec<Diagnostic>,
         out: &mut Line,
     ) -> bool {
+        self.parse_bytes(raw.as_bytes(), n, diags, out)
+    }
+
+    /// [`LineParser::parse`] of a line as bytes. A plain line is read as
+    /// it is; any other is first made text (bytes that are not UTF-8
+    /// replaced, as by `String::from_utf8_lossy`).
+    pub fn parse_bytes(
+        &mut self,
+        raw: &[u8],
+        n: usize,
+        diags: &mut Vec<Diagnostic>,
+        out: &mut Line,
+    ) -> bool {
         out.params.clear();
-        if !plain_words(raw.as_bytes(), &mut out.params) {
+        if !plain_words(raw, &mut out.params) {
             out.params.clear();
-            if !self.words(raw, n, diags, &mut out.params) {
+            let read = match std::str::from_utf8(raw) {
+                Ok(text) => self.words(text, n, diags, &mut out.params),
+                Err(_) => self.words(&String::from_utf8_lossy(raw), n, diags, &mut out.params),
+            };
+            if !read {
                 return false;
             }
         }
@@ -264,10 +279,9 @@ fn space(b: u8) -> bool {
 /// [`LineParser::words`] reads it, with the same result for a line this
 /// reads. One pass over the bytes.
 fn plain_words(raw: &[u8], params: &mut Vec<(char, f64)>) -> bool {
-    let mut bytes = raw.iter();
-    let mut next = bytes.next();
-    while let Some(&b) = next {
-        next = bytes.next();
+    let mut i = 0;
+    while let Some(&b) = raw.get(i) {
+        i += 1;
         if space(b) {
             continue;
         }
@@ -277,53 +291,55 @@ fn plain_words(raw: &[u8], params: &mut Vec<(char, f64)>) -> bool {
         if !b.is_ascii_alphabetic() {
             return false;
         }
-        let (v, rest) = number(&mut bytes, next);
+        let (v, end) = number(raw, i);
         let Some(v) = v else { return false };
         params.push((char::from(b.to_ascii_uppercase()), v));
-        next = rest;
+        i = end;
     }
     true
 }
 
-/// A plain decimal from `first` on (sign, digits, at most one `.`), up
-/// to a letter, whitespace, `;` or the end: the value (`None` if there
-/// were no digits, more than 15, or another byte) and the byte after it.
-fn number<'a>(
-    bytes: &mut std::slice::Iter<'a, u8>,
-    first: Option<&'a u8>,
-) -> (Option<f64>, Option<&'a u8>) {
+/// A plain decimal in `s` from byte `i` on (sign, digits, at most one
+/// `.`), up to a letter, whitespace, `;` or the end: the value (`None` if
+/// there were no digits, more than 15, or another byte) and the index of
+/// the byte after it.
+fn number(s: &[u8], mut i: usize) -> (Option<f64>, usize) {
     const POW10: [f64; 16] = [
         1e0, 1e1, 1e2, 1e3, 1e4, 1e5, 1e6, 1e7, 1e8, 1e9, 1e10, 1e11, 1e12, 1e13, 1e14, 1e15,
     ];
-    let mut cur = first;
-    let neg = cur == Some(&b'-');
-    if matches!(cur, Some(b'-' | b'+')) {
-        cur = bytes.next();
+    let neg = s.get(i) == Some(&b'-');
+    if matches!(s.get(i), Some(b'-' | b'+')) {
+        i += 1;
     }
-    let (mut m, mut n, mut frac, mut dot) = (0u64, 0usize, 0usize, false);
-    while let Some(&c) = cur {
+    let start = i;
+    // The index of the `.`, if any.
+    let mut dot = usize::MAX;
+    let mut m = 0u64;
+    while let Some(&c) = s.get(i) {
         let d = c.wrapping_sub(b'0');
         if d < 10 {
-            m = m * 10 + u64::from(d);
-            n += 1;
-            frac += usize::from(dot);
-            if n > 15 {
-                return (None, None);
-            }
-        } else if c == b'.' && !dot {
-            dot = true;
-        } else if c.is_ascii_alphabetic() || space(c) || c == b';' {
-            break;
+            // Wraps only past 19 digits, which are rejected below.
+            m = m.wrapping_mul(10).wrapping_add(u64::from(d));
+        } else if c == b'.' && dot == usize::MAX {
+            dot = i;
         } else {
-            return (None, None);
+            break;
         }
-        cur = bytes.next();
+        i += 1;
     }
-    if n == 0 {
-        return (None, None);
+    let (n, frac) = if dot == usize::MAX {
+        (i - start, 0)
+    } else {
+        (i - start - 1, i - dot - 1)
+    };
+    let ends = s
+        .get(i)
+        .is_none_or(|&c| c.is_ascii_alphabetic() || space(c) || c == b';');
+    if n == 0 || n > 15 || !ends {
+        return (None, i);
     }
     let v = m as f64 / POW10[frac];
-    (Some(if neg { -v } else { v }), cur)
+    (Some(if neg { -v } else { v }), i)
 }
 
 #[cfg(test)]
