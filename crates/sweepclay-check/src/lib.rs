@@ -45,6 +45,15 @@ pub use analyze::{check, check_reader, CheckWriter};
 pub use parse::Diagnostic;
 pub use report::{Count, Report, SupportStats};
 
+/// One xorshift step: the unit tests' reproducible random numbers.
+#[cfg(test)]
+fn xorshift(state: &mut u64) -> u64 {
+    *state ^= *state << 13;
+    *state ^= *state >> 7;
+    *state ^= *state << 17;
+    *state
+}
+
 use serde::Serialize;
 
 /// What the checker assumes about the printer and the clay. Lengths in mm.

@@ -126,7 +126,7 @@ impl LineParser {
     /// [`LineParser::parse`] of a line as bytes. A plain line is read as
     /// it is; any other is first made text (bytes that are not UTF-8
     /// replaced, as by `String::from_utf8_lossy`).
-    pub fn parse_bytes(
+    pub(crate) fn parse_bytes(
         &mut self,
         raw: &[u8],
         n: usize,
@@ -136,11 +136,8 @@ impl LineParser {
         out.params.clear();
         if !plain_words(raw, &mut out.params) {
             out.params.clear();
-            let read = match std::str::from_utf8(raw) {
-                Ok(text) => self.words(text, n, diags, &mut out.params),
-                Err(_) => self.words(&String::from_utf8_lossy(raw), n, diags, &mut out.params),
-            };
-            if !read {
+            // Borrowed, not copied, when the bytes are UTF-8.
+            if !self.words(&String::from_utf8_lossy(raw), n, diags, &mut out.params) {
                 return false;
             }
         }
@@ -312,7 +309,8 @@ fn number(s: &[u8], mut i: usize) -> (Option<f64>, usize) {
         i += 1;
     }
     let start = i;
-    // The index of the `.`, if any.
+    // The index of the `.`; `usize::MAX` when there is none (an `Option`
+    // costs 0.7 % more instructions a check, callgrind on the 44k text).
     let mut dot = usize::MAX;
     let mut m = 0u64;
     while let Some(&c) = s.get(i) {
@@ -420,12 +418,7 @@ mod tests {
         ];
         let alphabet = b"GXYZEFNMT gxe0123456789.-+;*()\t\x0b\r";
         let mut seed = 0x2545_f491_4f6c_dd1du64;
-        let mut rand = move |n: usize| {
-            seed ^= seed << 13;
-            seed ^= seed >> 7;
-            seed ^= seed << 17;
-            (seed % n as u64) as usize
-        };
+        let mut rand = move |n: usize| (crate::xorshift(&mut seed) % n as u64) as usize;
         let mut plain = 0;
         for k in 0..40_000 {
             let line: String = if k % 2 == 0 {

@@ -328,6 +328,14 @@ mod tests {
         );
     }
 
+    /// One xorshift step: reproducible random numbers.
+    fn xorshift(state: &mut u64) -> u64 {
+        *state ^= *state << 13;
+        *state ^= *state >> 7;
+        *state ^= *state << 17;
+        *state
+    }
+
     #[test]
     fn round_is_f64_round() {
         let mut rng = 0x2545_f491_4f6c_dd1du64;
@@ -343,13 +351,11 @@ mod tests {
         ];
         xs.extend([4503599627370495.5, -4503599627370495.5, 8.99e15, -8.99e15]);
         for k in 0..200_000u64 {
-            rng ^= rng << 13;
-            rng ^= rng >> 7;
-            rng ^= rng << 17;
+            let r = xorshift(&mut rng);
             let mag = [1.0, 1e3, 1e6, 1e12][k as usize % 4];
-            xs.push(((rng >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * mag);
+            xs.push(((r >> 11) as f64 / (1u64 << 53) as f64 - 0.5) * mag);
             // Exact halves and their neighbours.
-            let h = (rng % 1_000_000) as f64 + 0.5;
+            let h = (r % 1_000_000) as f64 + 0.5;
             xs.extend([h, -h, h.next_up(), h.next_down()]);
         }
         for x in xs {
@@ -363,11 +369,9 @@ mod tests {
         let mut mismatches = 0;
         let cases = 200_000;
         for k in 0..cases {
-            rng ^= rng << 13;
-            rng ^= rng >> 7;
-            rng ^= rng << 17;
+            let r = xorshift(&mut rng);
             let mag = [1e-4, 1.0, 150.0, 1e4][k % 4];
-            let v = ((rng >> 11) as f64 / (1u64 << 53) as f64 - 0.3) * mag;
+            let v = ((r >> 11) as f64 / (1u64 << 53) as f64 - 0.3) * mag;
             for d in [3, 5] {
                 let mut b = Vec::new();
                 push_fixed(&mut b, v, d);
