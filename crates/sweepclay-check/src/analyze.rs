@@ -880,8 +880,19 @@ pub struct CheckWriter<'a> {
 impl<'a> CheckWriter<'a> {
     /// A check with `cfg`, fed by writing to it.
     pub fn new(cfg: &'a CheckConfig) -> Self {
+        Self::with_capacity(cfg, 0)
+    }
+
+    /// A check with `cfg` of G-code of about `moves` moves (a writer
+    /// knows how many it writes): the per-bead arrays are sized for them
+    /// at once instead of growing by doubling, which at millions of moves
+    /// holds the old and the new array at once and leaves up to half the
+    /// last one unused. More moves than that are fine.
+    pub fn with_capacity(cfg: &'a CheckConfig, moves: usize) -> Self {
+        let mut checker = Checker::new(cfg);
+        checker.reserve(moves);
         CheckWriter {
-            checker: Checker::new(cfg),
+            checker,
             partial: Vec::new(),
         }
     }
@@ -1009,6 +1020,17 @@ impl<'a> Checker<'a> {
                     .tan(),
             exhaustive: false,
         }
+    }
+
+    /// Room for `moves` beads in every per-bead array. A bead usually
+    /// lies in one or two cells of the bead lists; a quarter more entries
+    /// than beads covers the designs of a million samples and more, whose
+    /// beads are short next to a cell.
+    fn reserve(&mut self, moves: usize) {
+        self.beads.reserve_exact(moves);
+        self.layer_heights.reserve_exact(moves);
+        self.stamp.reserve_exact(moves);
+        self.grid.links.reserve_exact(moves + moves / 4);
     }
 
     /// A line as bytes, without its `\n`: a `\r` before it is dropped.
@@ -1340,8 +1362,12 @@ impl<'a> Checker<'a> {
             r.size_mm = [hi[0] - lo[0], hi[1] - lo[1], hi[2].max(0.0)];
         }
         if !self.layer_heights.is_empty() {
-            self.layer_heights.sort_by(f64::total_cmp);
-            let median = self.layer_heights[self.layer_heights.len() / 2];
+            // The element a sort would put in the middle, in linear time
+            // (a total order: the same value as sorting).
+            let mid = self.layer_heights.len() / 2;
+            let (_, &mut median, _) = self
+                .layer_heights
+                .select_nth_unstable_by(mid, f64::total_cmp);
             if median > 0.0 {
                 r.layers = (hi[2] / median).round() as usize;
             }

@@ -138,6 +138,30 @@ fn zig_zag_wall_is_printable() {
 }
 
 #[test]
+fn layers_are_the_height_over_the_median_layer_height() {
+    // 6 layers of 0.8 mm, 8 of 1.2 and 6 of 1.6: 24 mm, median 1.2 mm
+    // (the thinnest would say 30 layers, the thickest 15).
+    let heights = [[0.8; 6].as_slice(), &[1.2; 8], &[1.6; 6]].concat();
+    let mut g = G::new([50.0, 50.0, 0.8]);
+    let mut z = 0.0;
+    for (k, h) in heights.iter().enumerate() {
+        z += h;
+        let (x0, x1) = if k % 2 == 0 {
+            (50.0, 90.0)
+        } else {
+            (90.0, 50.0)
+        };
+        if k > 0 {
+            g.bead([x0, 50.0, z], W, *h);
+        }
+        g.run([x1, 50.0, z], W, *h);
+    }
+    let r = verdict(&g.out);
+    assert!((r.size_mm[2] - 24.0).abs() < 1e-9, "{:?}", r.size_mm);
+    assert_eq!(r.layers, 20, "{}", r.render());
+}
+
+#[test]
 fn spiral_vase_is_printable() {
     // A helix of radius 30 around (100, 100) rising one layer per turn from
     // 0.6 mm: the first turn rests on the bed (its layer height is its own
@@ -411,12 +435,16 @@ fn reading_line_by_line_gives_the_same_report() {
         // As JSON: a degenerate bead's NaN angle is not equal to itself.
         let json = |r: &Report| serde_json::to_string(r).unwrap();
         assert_eq!(json(&streamed), json(&check(&text, &cfg)));
-        // Written in odd-sized pieces, as a writer would.
-        let mut w = sweepclay_check::CheckWriter::new(&cfg);
-        for piece in text.as_bytes().chunks(7) {
-            std::io::Write::write_all(&mut w, piece).unwrap();
+        // Written in odd-sized pieces, as a writer would; sized for fewer
+        // moves than there are, for none, or for many more.
+        let moves = text.lines().count();
+        for hint in [0, 1, moves / 2, 10 * moves] {
+            let mut w = sweepclay_check::CheckWriter::with_capacity(&cfg, hint);
+            for piece in text.as_bytes().chunks(7) {
+                std::io::Write::write_all(&mut w, piece).unwrap();
+            }
+            assert_eq!(json(&w.finish()), json(&streamed), "sized for {hint}");
         }
-        assert_eq!(json(&w.finish()), json(&streamed));
     }
     assert!(
         verdict(&tail.out).printable,

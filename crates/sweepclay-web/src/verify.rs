@@ -73,7 +73,10 @@ pub fn verify_into<W: Write>(
         overlap_min: min_overlap,
         ..check_config(&surface.printer, &surface.params)
     };
-    let mut tee = Tee(out, CheckWriter::new(&cfg));
+    let mut tee = Tee(
+        out,
+        CheckWriter::with_capacity(&cfg, s.toolpath.points.len()),
+    );
     let point_lines = gcode::emit(s, &mut tee)?;
     tee.flush()?;
     let Tee(_, checker) = tee;
