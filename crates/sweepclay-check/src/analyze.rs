@@ -44,6 +44,11 @@ impl Bead {
         self.to32.map(f64::from)
     }
 
+    /// The highest point of the centreline.
+    fn top32(&self) -> f32 {
+        self.from32[2].max(self.to32[2])
+    }
+
     fn width(&self) -> f64 {
         f64::from(self.width32)
     }
@@ -105,8 +110,11 @@ struct BeadGrid {
     links: Vec<(u32, u32)>,
     /// Highest clay top in each plan column of the settled beads: those
     /// far enough back along the path that the nozzle is no longer laying
-    /// them (see `settle`).
+    /// them (see `settle`). Its `highest` counts every settled bead; its
+    /// columns only beads `..raised` until a query needs them
+    /// ([`BeadGrid::catch_up`]).
     settled_max: TopGrid,
+    raised: usize,
 }
 
 /// Cell ranges of a bead: plan x, plan y, z (inclusive).
@@ -140,6 +148,7 @@ impl BeadGrid {
             dims,
             links: Vec::new(),
             settled_max: TopGrid::new(plate, CELL_XY),
+            raised: 0,
         }
     }
 
@@ -190,9 +199,22 @@ impl BeadGrid {
         }
     }
 
-    /// Counts a bead in the settled column tops.
+    /// Counts a bead in the settled clay's highest top; its columns wait
+    /// for [`BeadGrid::catch_up`]. A print laid bottom up keeps its settled
+    /// clay below the nozzle's tip, so its probes never read the columns
+    /// and this saves a raise a bead (7 % of the instructions of a check).
     fn settle(&mut self, b: &Bead) {
-        self.settled_max.raise(b);
+        let tops = &mut self.settled_max;
+        tops.highest = tops.highest.max(b.top32());
+    }
+
+    /// Raises the columns of the settled beads not yet in them, `beads`
+    /// up to `settled`: before a query reads them.
+    fn catch_up(&mut self, beads: &[Bead], settled: usize) {
+        for b in &beads[self.raised..settled] {
+            self.settled_max.raise(b);
+        }
+        self.raised = settled;
     }
 
     /// Ids in cells within `r` (plan) of `p` and heights `zlo..=zhi`,
@@ -378,7 +400,7 @@ impl TopGrid {
     /// (other slicers) the cells around points every half cell along it.
     fn raise(&mut self, b: &Bead) {
         let (f, t) = (b.from(), b.to());
-        let top = b.from32[2].max(b.to32[2]);
+        let top = b.top32();
         self.widest = self.widest.max(b.width32);
         self.highest = self.highest.max(top);
         let (xs, ys) = self.range(
@@ -1160,6 +1182,9 @@ impl<'a> Checker<'a> {
             }
             let mut worst: f64 = 0.0;
             let zlo = p[2] + cfg.collision_tolerance_mm;
+            if f64::from(self.grid.settled_max.highest) >= zlo {
+                self.grid.catch_up(&self.beads, self.settled);
+            }
             let beads = &self.beads;
             self.grid.for_each(
                 p,
