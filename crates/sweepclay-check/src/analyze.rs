@@ -1044,15 +1044,20 @@ impl<'a> Checker<'a> {
         }
     }
 
-    /// Room for `moves` beads in every per-bead array. A bead usually
-    /// lies in one or two cells of the bead lists; a quarter more entries
-    /// than beads covers the designs of a million samples and more, whose
-    /// beads are short next to a cell.
+    /// Room for `moves` beads in every per-bead array, as far as memory
+    /// allows (an array that gets none grows as it would have). A bead
+    /// usually lies in one or two cells of the bead lists; a quarter more
+    /// entries than beads covers the designs of a million samples and
+    /// more, whose beads are short next to a cell.
     fn reserve(&mut self, moves: usize) {
-        self.beads.reserve_exact(moves);
-        self.layer_heights.reserve_exact(moves);
-        self.stamp.reserve_exact(moves);
-        self.grid.links.reserve_exact(moves + moves / 4);
+        // A failed reservation only leaves the growing to `push`.
+        let _ = self.beads.try_reserve_exact(moves);
+        let _ = self.layer_heights.try_reserve_exact(moves);
+        let _ = self.stamp.try_reserve_exact(moves);
+        let _ = self
+            .grid
+            .links
+            .try_reserve_exact(moves.saturating_add(moves / 4));
     }
 
     /// A line as bytes, without its `\n`: a `\r` before it is dropped.

@@ -436,9 +436,10 @@ fn reading_line_by_line_gives_the_same_report() {
         let json = |r: &Report| serde_json::to_string(r).unwrap();
         assert_eq!(json(&streamed), json(&check(&text, &cfg)));
         // Written in odd-sized pieces, as a writer would; sized for fewer
-        // moves than there are, for none, or for many more.
+        // moves than there are, for none, for many more, or for more than
+        // memory holds.
         let moves = text.lines().count();
-        for hint in [0, 1, moves / 2, 10 * moves] {
+        for hint in [0, 1, moves / 2, 10 * moves, usize::MAX] {
             let mut w = sweepclay_check::CheckWriter::with_capacity(&cfg, hint);
             for piece in text.as_bytes().chunks(7) {
                 std::io::Write::write_all(&mut w, piece).unwrap();
