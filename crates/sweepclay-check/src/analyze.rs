@@ -108,27 +108,20 @@ struct BeadGrid {
     /// List entries: a bead and the index of the next entry (`u32::MAX`
     /// ends the list). One array instead of a vector per cell.
     links: Vec<(u32, u32)>,
-    /// Highest clay top in each plan column of the settled beads: those
-    /// far enough back along the path that the nozzle is no longer laying
-    /// them (see `settle`). Its `highest` counts every settled bead; its
-    /// columns only beads `..raised` until a query needs them
-    /// ([`BeadGrid::catch_up`]).
+    /// Beads `..settled` are settled: far enough back along the path that
+    /// the nozzle is no longer laying them (see [`BeadGrid::settle`]).
+    settled: usize,
+    /// The highest top of every settled bead.
+    settled_top: f32,
+    /// Highest clay top in each plan column of the settled beads
+    /// `..raised`; the others wait until a query reads the columns
+    /// ([`BeadGrid::settled_near`]).
     settled_max: TopGrid,
     raised: usize,
 }
 
 /// Cell ranges of a bead: plan x, plan y, z (inclusive).
 type Span = ([i32; 2], [i32; 2], [i32; 2]);
-
-/// Which cells a query reads.
-#[derive(Clone, Copy, PartialEq)]
-enum Cells {
-    /// All in its box.
-    All,
-    /// Only those of plan columns whose settled clay reaches its lowest
-    /// height (for a query that skips beads not settled).
-    Settled,
-}
 
 impl BeadGrid {
     fn new(cfg: &CheckConfig) -> BeadGrid {
@@ -147,6 +140,8 @@ impl BeadGrid {
             columns: vec![Box::default(); (dims[0] * dims[1]) as usize],
             dims,
             links: Vec::new(),
+            settled: 0,
+            settled_top: f32::NEG_INFINITY,
             settled_max: TopGrid::new(plate, CELL_XY),
             raised: 0,
         }
@@ -199,49 +194,51 @@ impl BeadGrid {
         }
     }
 
-    /// Counts a bead in the settled clay's highest top; its columns wait
-    /// for [`BeadGrid::catch_up`]. A print laid bottom up keeps its settled
-    /// clay below the nozzle's tip, so its probes never read the columns
-    /// and this saves a raise a bead (7 % of the instructions of a check).
-    fn settle(&mut self, b: &Bead) {
-        let tops = &mut self.settled_max;
-        tops.highest = tops.highest.max(b.top32());
+    /// Settles the beads from the frontier on that are `done` (they are
+    /// in path order): they count in the highest settled top at once, in
+    /// the column tops only when a query reads them. A print laid bottom
+    /// up keeps its settled clay below the nozzle's tip, so its probes
+    /// never read the columns, which saves a raise a bead (7 % of the
+    /// instructions of a check).
+    fn settle(&mut self, beads: &[Bead], done: impl Fn(&Bead) -> bool) {
+        let top = &mut self.settled_top;
+        settle(beads, &mut self.settled, done, |_, b| {
+            *top = top.max(b.top32());
+        });
     }
 
-    /// Raises the columns of the settled beads not yet in them, `beads`
-    /// up to `settled`: before a query reads them.
-    fn catch_up(&mut self, beads: &[Bead], settled: usize) {
-        for b in &beads[self.raised..settled] {
-            self.settled_max.raise(b);
-        }
-        self.raised = settled;
+    /// Ids in the cells within `r` (plan) of `p` and heights `zlo..=zhi`,
+    /// newest first in each cell.
+    fn in_box(&self, p: [f64; 3], r: f64, zlo: f64, zhi: f64, mut f: impl FnMut(u32)) {
+        let xs = [cell(p[0] - r, CELL_XY), cell(p[0] + r, CELL_XY)];
+        let ys = [cell(p[1] - r, CELL_XY), cell(p[1] + r, CELL_XY)];
+        self.visit(xs, ys, [cell(zlo, CELL_Z), cell(zhi, CELL_Z)], &mut f);
     }
 
-    /// Ids in cells within `r` (plan) of `p` and heights `zlo..=zhi`,
-    /// newest first in each cell; with `Cells::Settled`, only in plan
-    /// columns whose settled clay reaches `zlo`.
-    fn for_each(
-        &self,
+    /// [`BeadGrid::in_box`], but only in plan columns whose settled clay
+    /// reaches `zlo` (for a query that skips beads not settled; `beads`
+    /// are all the beads).
+    fn settled_near(
+        &mut self,
+        beads: &[Bead],
         p: [f64; 3],
         r: f64,
         zlo: f64,
         zhi: f64,
-        cells: Cells,
         mut f: impl FnMut(u32),
     ) {
-        let (z0, z1) = (cell(zlo, CELL_Z), cell(zhi, CELL_Z));
-        let (lo, hi) = ([p[0] - r, p[1] - r], [p[0] + r, p[1] + r]);
-        if cells == Cells::All {
-            let xs = [cell(lo[0], CELL_XY), cell(hi[0], CELL_XY)];
-            let ys = [cell(lo[1], CELL_XY), cell(hi[1], CELL_XY)];
-            return self.visit(xs, ys, [z0, z1], &mut f);
-        }
-        let tops = &self.settled_max;
         // Most queries of a print laid bottom up: no settled clay that
         // high anywhere.
-        if f64::from(tops.highest) < zlo {
+        if f64::from(self.settled_top) < zlo {
             return;
         }
+        for b in &beads[self.raised..self.settled] {
+            self.settled_max.raise(b);
+        }
+        self.raised = self.settled;
+        let (z0, z1) = (cell(zlo, CELL_Z), cell(zhi, CELL_Z));
+        let (lo, hi) = ([p[0] - r, p[1] - r], [p[0] + r, p[1] + r]);
+        let tops = &self.settled_max;
         // The column tops first (a load each); the bead lists of a column
         // only when its clay reaches `zlo`.
         let (gxs, gys) = tops.range(lo, hi);
@@ -305,8 +302,6 @@ struct TopGrid {
     bx: usize,
     /// The widest bead raised.
     widest: f32,
-    /// The highest top raised.
-    highest: f32,
 }
 
 impl TopGrid {
@@ -338,7 +333,6 @@ impl TopGrid {
             coarse: vec![f32::NEG_INFINITY; n[0].div_ceil(4) * n[1].div_ceil(4)],
             bx: n[0].div_ceil(4),
             widest: 0.0,
-            highest: f32::NEG_INFINITY,
         }
     }
 
@@ -402,7 +396,6 @@ impl TopGrid {
         let (f, t) = (b.from(), b.to());
         let top = b.top32();
         self.widest = self.widest.max(b.width32);
-        self.highest = self.highest.max(top);
         let (xs, ys) = self.range(
             [f[0].min(t[0]), f[1].min(t[1])],
             [f[0].max(t[0]), f[1].max(t[1])],
@@ -808,16 +801,9 @@ fn search_support(
     };
     // Beads covering the middle are within w/2; look wider only when none
     // is (to measure an overhang).
-    grid.for_each(
-        mid,
-        cfg.width_max / 2.0 + 0.5,
-        zlo,
-        zhi,
-        Cells::All,
-        &mut visit,
-    );
+    grid.in_box(mid, cfg.width_max / 2.0 + 0.5, zlo, zhi, &mut visit);
     if !covered.get() {
-        grid.for_each(mid, cfg.width_max, zlo, zhi, Cells::All, &mut visit);
+        grid.in_box(mid, cfg.width_max, zlo, zhi, &mut visit);
     }
     let support = pick_support(cands, cfg.min_layer_mm, mid[2] <= cfg.first_layer_max_mm);
     (support, double)
@@ -983,8 +969,6 @@ struct Checker<'a> {
     pending: Vec<(Deferred, usize, f64)>,
     beads: Vec<Bead>,
     grid: BeadGrid,
-    /// Beads `..settled` are in the collision test's settled tops.
-    settled: usize,
     stamp: Vec<u32>,
     s: f64,
     top_z: f64,
@@ -1023,7 +1007,6 @@ impl<'a> Checker<'a> {
             pending: Vec::new(),
             beads: Vec::new(),
             grid: BeadGrid::new(cfg),
-            settled: 0,
             stamp: Vec::new(),
             s: 0.0,
             top_z: f64::MIN,
@@ -1174,30 +1157,17 @@ impl<'a> Checker<'a> {
             ];
             let sp = s_start + t * len;
             // Beads the nozzle has left behind count for collisions.
-            let grid = &mut self.grid;
-            settle(
-                &self.beads,
-                &mut self.settled,
-                |b| b.s_end <= sp - recent_nozzle,
-                |_, b| grid.settle(b),
-            );
+            self.grid
+                .settle(&self.beads, |b| b.s_end <= sp - recent_nozzle);
             if self.top_z > p[2] + cfg.nozzle_height + cfg.collision_tolerance_mm {
                 let v = self.top_z - p[2] - cfg.nozzle_height;
                 self.defer_or_add(is_extruding, Deferred::Carriage, m.line, v);
             }
             let mut worst: f64 = 0.0;
             let zlo = p[2] + cfg.collision_tolerance_mm;
-            if f64::from(self.grid.settled_max.highest) >= zlo {
-                self.grid.catch_up(&self.beads, self.settled);
-            }
             let beads = &self.beads;
-            self.grid.for_each(
-                p,
-                reach,
-                zlo,
-                p[2] + cfg.nozzle_height,
-                Cells::Settled,
-                |id| {
+            self.grid
+                .settled_near(beads, p, reach, zlo, p[2] + cfg.nozzle_height, |id| {
                     let b = &beads[id as usize];
                     if b.s_end > sp - recent_nozzle {
                         return;
@@ -1206,8 +1176,7 @@ impl<'a> Checker<'a> {
                     if z > zlo && d < cfg.nozzle_radius + b.width() / 2.0 {
                         worst = worst.max(z - p[2]);
                     }
-                },
-            );
+                });
             if worst > 0.0 {
                 self.defer_or_add(is_extruding, Deferred::Nozzle, m.line, worst);
             }
