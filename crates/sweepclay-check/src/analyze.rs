@@ -3,6 +3,7 @@
 //! ("what clay is below this bead?", "is clay inside the nozzle cylinder?")
 //! looks at a few cells, not at every earlier bead.
 
+use crate::blocks::{Blocks, Bound, Visit};
 use crate::parse::{Diagnostic, Line, LineParser};
 use crate::replay::{Event, Move, Replayer};
 use crate::report::{Count, Report};
@@ -105,9 +106,9 @@ struct BeadGrid {
     columns: Vec<Box<[u32]>>,
     /// Cells a side: x, y, z (the first at `-MARGIN_CELLS`).
     dims: [i32; 3],
-    /// List entries: a bead and the index of the next entry (`u32::MAX`
-    /// ends the list). One array instead of a vector per cell.
-    links: Vec<(u32, u32)>,
+    /// List entries: a run of consecutive beads, one pass of the path
+    /// through the cell. One array instead of a vector per cell.
+    links: Vec<Run>,
     /// Beads `..settled` are settled: far enough back along the path that
     /// the nozzle is no longer laying them (see [`BeadGrid::settle`]).
     settled: usize,
@@ -122,6 +123,14 @@ struct BeadGrid {
 
 /// Cell ranges of a bead: plan x, plan y, z (inclusive).
 type Span = ([i32; 2], [i32; 2], [i32; 2]);
+
+/// An entry of a cell's list: beads `first..=last` and the index of the
+/// next entry in `BeadGrid::links` (`u32::MAX` ends the list).
+struct Run {
+    first: u32,
+    last: u32,
+    next: u32,
+}
 
 impl BeadGrid {
     fn new(cfg: &CheckConfig) -> BeadGrid {
@@ -187,8 +196,18 @@ impl BeadGrid {
                     *column = vec![u32::MAX; nz].into_boxed_slice();
                 }
                 for head in &mut column[zs[0]..zs[1] + 1] {
-                    self.links.push((id, *head));
-                    *head = self.links.len() as u32 - 1;
+                    match self.links.get_mut(*head as usize) {
+                        // The path is still in the cell: its run goes on.
+                        Some(run) if run.last.checked_add(1) == Some(id) => run.last = id,
+                        _ => {
+                            self.links.push(Run {
+                                first: id,
+                                last: id,
+                                next: *head,
+                            });
+                            *head = self.links.len() as u32 - 1;
+                        }
+                    }
                 }
             }
         }
@@ -207,12 +226,12 @@ impl BeadGrid {
         });
     }
 
-    /// Ids in the cells within `r` (plan) of `p` and heights `zlo..=zhi`,
-    /// newest first in each cell.
-    fn in_box(&self, p: [f64; 3], r: f64, zlo: f64, zhi: f64, mut f: impl FnMut(u32)) {
+    /// The runs of beads in the cells within `r` (plan) of `p` and
+    /// heights `zlo..=zhi`, newest first in each cell.
+    fn in_box(&self, p: [f64; 3], r: f64, zlo: f64, zhi: f64, mut f: impl FnMut(&Run)) {
         let xs = [cell(p[0] - r, CELL_XY), cell(p[0] + r, CELL_XY)];
         let ys = [cell(p[1] - r, CELL_XY), cell(p[1] + r, CELL_XY)];
-        self.visit(xs, ys, [cell(zlo, CELL_Z), cell(zhi, CELL_Z)], &mut f);
+        self.visit_runs(xs, ys, [cell(zlo, CELL_Z), cell(zhi, CELL_Z)], &mut f);
     }
 
     /// [`BeadGrid::in_box`], but only in plan columns whose settled clay
@@ -264,6 +283,15 @@ impl BeadGrid {
     /// Ids in the cells of ranges `xs`, `ys`, `zs` (inclusive, whole
     /// cells, clamped into the grid), newest first in each cell.
     fn visit(&self, xs: [i32; 2], ys: [i32; 2], zs: [i32; 2], f: &mut impl FnMut(u32)) {
+        self.visit_runs(xs, ys, zs, &mut |run| {
+            (run.first..=run.last).rev().for_each(&mut *f)
+        });
+    }
+
+    /// The runs of beads in the cells of ranges `xs`, `ys`, `zs`
+    /// (inclusive, whole cells, clamped into the grid), newest first in
+    /// each cell.
+    fn visit_runs(&self, xs: [i32; 2], ys: [i32; 2], zs: [i32; 2], f: &mut impl FnMut(&Run)) {
         if zs[0] > zs[1] {
             return;
         }
@@ -273,9 +301,9 @@ impl BeadGrid {
                 let column = &self.columns[y * self.dims[0] as usize + x];
                 for &head in column.get(zs[0]..zs[1] + 1).unwrap_or_default() {
                     let mut e = head;
-                    while let Some(&(id, next)) = self.links.get(e as usize) {
-                        f(id);
-                        e = next;
+                    while let Some(run) = self.links.get(e as usize) {
+                        f(run);
+                        e = run.next;
                     }
                 }
             }
@@ -766,47 +794,282 @@ fn follow_support(
     Some(best)
 }
 
+/// How the full search walks the beads near the middle. Each way gives
+/// the same answer; the tests hold them to it.
+#[derive(Clone, Copy, Debug, PartialEq)]
+enum Walk {
+    /// Plain while the beads are few ([`PLAIN_MAX`]), else pruned.
+    Auto,
+    /// Every bead: the reference.
+    Plain,
+    /// Questions that skip blocks of beads.
+    Pruned,
+}
+
+/// Up to this many beads in its cells, the full search classifies each
+/// (cheaper than asking blocks when beads are long next to a block).
+const PLAIN_MAX: usize = 64;
+
 /// The support of a new bead by the full search (steps 1–4 of
-/// docs/CHECKER.md): every earlier bead near enough, judged by
-/// [`Query::classify`], then [`pick_support`]. Also whether clay already
-/// lies at its height under its middle. `id` is the new bead's index.
+/// docs/CHECKER.md), and whether clay already lies at its height under
+/// its middle: every earlier bead in the cells within w_max/2 + 0.5 mm of
+/// the middle (within w_max if none of them covers it), judged by
+/// [`Query::classify`], then [`pick_support`].
+///
+/// The cells' beads come as runs of consecutive beads (merged, so each
+/// bead once). A few are each classified ([`Walk::Plain`]). Many (a
+/// finely sampled path) are asked questions instead ([`Walk::Pruned`],
+/// [`search_pruned`]), whose cost does not grow with the sampling.
 fn search_support(
     beads: &[Bead],
     grid: &BeadGrid,
-    stamp: &mut Vec<u32>,
-    cands: &mut Vec<Candidate>,
+    blocks: &mut Blocks,
+    scratch: &mut Scratch,
     q: &Query,
-    id: u32,
+    walk: Walk,
 ) -> (Option<Candidate>, bool) {
     let (mid, cfg) = (q.mid, q.cfg);
-    stamp.resize(beads.len(), u32::MAX);
+    let (zlo, zhi) = (mid[2] - cfg.max_gap_mm, mid[2] + cfg.min_layer_mm);
+    let Scratch { runs, cands } = scratch;
+    runs.clear();
+    grid.in_box(mid, cfg.width_max / 2.0 + 0.5, zlo, zhi, |r| {
+        runs.push([r.first, r.last])
+    });
+    merge_runs(runs);
+    let wider = |runs: &mut Vec<[u32; 2]>| {
+        grid.in_box(mid, cfg.width_max, zlo, zhi, |r| {
+            runs.push([r.first, r.last])
+        });
+        merge_runs(runs);
+    };
+    let many = runs
+        .iter()
+        .map(|r| (r[1] - r[0]) as usize + 1)
+        .sum::<usize>()
+        > PLAIN_MAX;
+    if walk == Walk::Pruned || (walk == Walk::Auto && many) {
+        // The blocks take the beads laid since the last such search.
+        for b in &beads[blocks.len()..] {
+            blocks.push(&Bound::bead(b.from32, b.to32, b.width32));
+        }
+        return search_pruned(beads, blocks, runs, q, wider);
+    }
     cands.clear();
     let mut double = false;
     let covered = std::cell::Cell::new(false);
-    let (zlo, zhi) = (mid[2] - cfg.max_gap_mm, mid[2] + cfg.min_layer_mm);
-    let mut visit = |j: u32| {
-        let ju = j as usize;
-        if stamp[ju] == id {
-            return;
+    let mut classify = |j: u32| match q.classify(&beads[j as usize], j) {
+        Class::Below(c) => {
+            covered.set(covered.get() || c.covers);
+            cands.push(c);
         }
-        stamp[ju] = id;
-        match q.classify(&beads[ju], j) {
-            Class::Below(c) => {
-                covered.set(covered.get() || c.covers);
-                cands.push(c);
-            }
-            Class::Double => double = true,
-            Class::Neither => {}
-        }
+        Class::Double => double = true,
+        Class::Neither => {}
     };
-    // Beads covering the middle are within w/2; look wider only when none
-    // is (to measure an overhang).
-    grid.in_box(mid, cfg.width_max / 2.0 + 0.5, zlo, zhi, &mut visit);
+    runs.iter()
+        .for_each(|&[first, last]| (first..=last).for_each(&mut classify));
     if !covered.get() {
-        grid.in_box(mid, cfg.width_max, zlo, zhi, &mut visit);
+        // Look wider only when nothing covers (to measure an overhang):
+        // the beads not in the first box.
+        let n = runs.len();
+        grid.in_box(mid, cfg.width_max, zlo, zhi, |r| {
+            runs.push([r.first, r.last])
+        });
+        let (first_box, second) = runs.split_at_mut(n);
+        second.sort_unstable_by_key(|r| r[0]);
+        let mut k = 0;
+        let mut next = 0u64;
+        for &[first, last] in second.iter() {
+            let mut j = u64::from(first).max(next);
+            while j <= u64::from(last) {
+                // Skip the first box's runs that end before `j`; jump over
+                // the one that holds it.
+                while first_box.get(k).is_some_and(|r| u64::from(r[1]) < j) {
+                    k += 1;
+                }
+                match first_box.get(k) {
+                    Some(r) if u64::from(r[0]) <= j => j = u64::from(r[1]) + 1,
+                    _ => {
+                        classify(j as u32);
+                        j += 1;
+                    }
+                }
+            }
+            next = next.max(u64::from(last) + 1);
+        }
     }
     let support = pick_support(cands, cfg.min_layer_mm, mid[2] <= cfg.first_layer_max_mm);
     (support, double)
+}
+
+/// The full search's buffers, kept to reuse their memory.
+#[derive(Default)]
+struct Scratch {
+    runs: Vec<[u32; 2]>,
+    cands: Vec<Candidate>,
+}
+
+/// Sorts runs of beads and merges those that overlap or touch: each
+/// bead once.
+fn merge_runs(runs: &mut Vec<[u32; 2]>) {
+    runs.sort_unstable_by_key(|r| r[0]);
+    let mut n = 0;
+    for k in 0..runs.len() {
+        let r = runs[k];
+        if n > 0 && u64::from(r[0]) <= u64::from(runs[n - 1][1]) + 1 {
+            runs[n - 1][1] = runs[n - 1][1].max(r[1]);
+        } else {
+            runs[n] = r;
+            n += 1;
+        }
+    }
+    runs.truncate(n);
+}
+
+/// [`search_support`] by questions over `runs` (the first box's; `wider`
+/// adds the second's): [`pick_support`]'s steps as "the nearest bead that
+/// `classify` puts below with this property": the nearest covering the
+/// middle, else the nearest below at all, then each step of the climb.
+/// Each question skips the blocks of beads (see [`Blocks`]) whose bounds
+/// show that none of theirs can be the answer: too far, too high or too
+/// low, too narrow to cover the middle, or not high enough to climb to.
+/// The bounds are widened by a margin far above rounding, so a skip never
+/// drops an answer.
+fn search_pruned(
+    beads: &[Bead],
+    blocks: &Blocks,
+    runs: &mut Vec<[u32; 2]>,
+    q: &Query,
+    wider: impl FnOnce(&mut Vec<[u32; 2]>),
+) -> (Option<Candidate>, bool) {
+    let (mid, cfg) = (q.mid, q.cfg);
+    let ml = cfg.min_layer_mm;
+    let slack = 1e-6
+        + 1e-9
+            * (mid.iter().fold(0.0f64, |m, v| m.max(v.abs()))
+                + cfg.width_max.abs()
+                + cfg.max_gap_mm.abs());
+    let find = Nearest {
+        beads,
+        blocks,
+        q,
+        slack,
+    };
+    // No bead of the block is in `classify`'s height window for clay
+    // below.
+    let off_window = |b: &Bound| {
+        f64::from(b.lo[2]) - slack > mid[2] - ml
+            || mid[2] - (f64::from(b.hi[2]) + slack) > cfg.max_gap_mm
+    };
+    let no_cover = |b: &Bound, lb: f64| off_window(b) || lb > f64::from(b.half_width);
+    let mut double = false;
+    let mut cover = find.nearest(runs, no_cover, |c| c.covers, Some(&mut double));
+    if cover.is_none() {
+        // The first box's beads come again, and still cover nothing.
+        wider(runs);
+        cover = find.nearest(runs, no_cover, |c| c.covers, Some(&mut double));
+    }
+    let covering = cover.is_some();
+    // The group `pick_support` walks: the covering beads, or if none
+    // covers, every bead below.
+    let out_of_group = |b: &Bound, lb: f64| {
+        if covering {
+            no_cover(b, lb)
+        } else {
+            off_window(b) || lb > cfg.width_max.max(f64::from(b.half_width))
+        }
+    };
+    let mut best = match cover {
+        Some(c) => c,
+        None if mid[2] <= cfg.first_layer_max_mm => return (None, double),
+        None => match find.nearest(runs, out_of_group, |_| true, None) {
+            Some(c) => c,
+            None => return (None, double),
+        },
+    };
+    loop {
+        let climb = |b: &Bound, lb: f64| {
+            let rise = f64::from(b.hi[2]) + slack - best.z;
+            out_of_group(b, lb) || rise < ml || rise < 0.5 * (b.plan_distance(best.at) - slack)
+        };
+        let next = find.nearest(
+            runs,
+            climb,
+            |c| {
+                let rise = c.z - best.z;
+                c.covers == covering
+                    && rise >= ml
+                    && rise >= 0.5 * len2(c.at[0] - best.at[0], c.at[1] - best.at[1])
+            },
+            None,
+        );
+        match next {
+            Some(c) => best = c,
+            None => return (Some(best), double),
+        }
+    }
+}
+
+/// The questions of [`search_pruned`] over runs of beads.
+struct Nearest<'a> {
+    beads: &'a [Bead],
+    blocks: &'a Blocks,
+    q: &'a Query<'a>,
+    /// Margin on every bound.
+    slack: f64,
+}
+
+impl Nearest<'_> {
+    /// The nearest bead of `runs` ([`Candidate::nearer`]) that `classify`
+    /// puts below and `keep` accepts. Skips the blocks `skip` rejects,
+    /// given their bounds and a lower bound of their beads' distances to
+    /// the middle, and those no nearer than the nearest found so far.
+    /// With `double`, also sets it if a bead of `runs` is
+    /// [`Class::Double`] (in the same walk: a block is walked if either
+    /// question needs it).
+    fn nearest(
+        &self,
+        runs: &[[u32; 2]],
+        skip: impl Fn(&Bound, f64) -> bool,
+        keep: impl Fn(&Candidate) -> bool,
+        mut double: Option<&mut bool>,
+    ) -> Option<Candidate> {
+        let (mid, cfg, slack) = (self.q.mid, self.q.cfg, self.slack);
+        let ml = cfg.min_layer_mm;
+        let mut best: Option<Candidate> = None;
+        for &[first, last] in runs {
+            self.blocks.scan(first, last, &mut |v| match v {
+                Visit::Block(b) => {
+                    let lb = b.plan_distance([mid[0], mid[1]]) - slack;
+                    !(best.is_some_and(|c| lb > c.d) || skip(b, lb))
+                        || double.as_ref().is_some_and(|found| {
+                            // A bead at the new bead's height, under its
+                            // middle.
+                            !**found
+                                && lb < 0.5 * cfg.width_min
+                                && f64::from(b.hi[2]) + slack > mid[2] - ml
+                                && f64::from(b.lo[2]) - slack < mid[2] + ml
+                        })
+                }
+                Visit::Bead(j) => {
+                    match self.q.classify(&self.beads[j as usize], j) {
+                        Class::Below(c) => {
+                            if keep(&c) && best.is_none_or(|o| c.nearer(&o).is_lt()) {
+                                best = Some(c);
+                            }
+                        }
+                        Class::Double => {
+                            if let Some(found) = double.as_mut() {
+                                **found = true;
+                            }
+                        }
+                        Class::Neither => {}
+                    }
+                    true
+                }
+            });
+        }
+        best
+    }
 }
 
 /// Moves a settled frontier on: hands each bead from `*next` on that is
@@ -847,22 +1110,32 @@ fn minmax(slot: &mut Option<[(f64, usize); 2]>, v: f64, line: usize) {
 
 /// Checks a G-code text. Never panics, whatever the input.
 pub fn check(text: &str, cfg: &CheckConfig) -> Report {
-    check_with(text, cfg, false)
+    check_with(text, cfg, false, Walk::Auto)
 }
 
-fn check_with(text: &str, cfg: &CheckConfig, exhaustive: bool) -> Report {
+fn check_with(text: &str, cfg: &CheckConfig, exhaustive: bool, walk: Walk) -> Report {
     let mut w = CheckWriter::new(cfg);
     w.checker.exhaustive = exhaustive;
+    w.checker.walk = walk;
     w.feed(text.as_bytes());
     w.finish()
 }
 
 /// [`check`] with the support always found by the full search, never by
-/// following the bead below (`follow_support`): the reference the tests
-/// hold the fast path to. The two give the same report.
+/// following the bead below (`follow_support`), and the full search
+/// always classifying every bead near the middle: the reference the
+/// tests hold the fast path to. The two give the same report.
 #[doc(hidden)]
 pub fn check_exhaustive(text: &str, cfg: &CheckConfig) -> Report {
-    check_with(text, cfg, true)
+    check_with(text, cfg, true, Walk::Plain)
+}
+
+/// [`check_exhaustive`], but with every full search asking blocks of
+/// beads however few the beads (`search_pruned`): the tests hold the two
+/// to the same report, also on designs too coarse for [`check`] to prune.
+#[doc(hidden)]
+pub fn check_pruned(text: &str, cfg: &CheckConfig) -> Report {
+    check_with(text, cfg, true, Walk::Pruned)
 }
 
 /// Checks G-code read line by line from `input`, holding no more of the
@@ -969,13 +1242,14 @@ struct Checker<'a> {
     pending: Vec<(Deferred, usize, f64)>,
     beads: Vec<Bead>,
     grid: BeadGrid,
-    stamp: Vec<u32>,
+    /// Bounds of blocks of consecutive beads, for the full search.
+    blocks: Blocks,
+    scratch: Scratch,
     s: f64,
     top_z: f64,
     lo: [f64; 3],
     hi: [f64; 3],
     layer_heights: Vec<f64>,
-    cands: Vec<Candidate>,
     /// Clay tops of the beads laid more than 2 w_max of path back, in
     /// finer cells, for the support's fast path (`follow_support`).
     support_tops: TopGrid,
@@ -991,6 +1265,8 @@ struct Checker<'a> {
     overhang_near: f64,
     /// Always search (tests compare the fast path against this).
     exhaustive: bool,
+    /// How the full search walks the beads.
+    walk: Walk,
 }
 
 impl<'a> Checker<'a> {
@@ -1007,13 +1283,13 @@ impl<'a> Checker<'a> {
             pending: Vec::new(),
             beads: Vec::new(),
             grid: BeadGrid::new(cfg),
-            stamp: Vec::new(),
+            blocks: Blocks::default(),
+            scratch: Scratch::default(),
             s: 0.0,
             top_z: f64::MIN,
             lo: [f64::MAX; 3],
             hi: [f64::MIN; 3],
             layer_heights: Vec::new(),
-            cands: Vec::new(),
             support_tops: TopGrid::new([cfg.build_volume[0], cfg.build_volume[1]], 2.0),
             support_settled: 0,
             recent: Recent::default(),
@@ -1024,23 +1300,20 @@ impl<'a> Checker<'a> {
                     .to_radians()
                     .tan(),
             exhaustive: false,
+            walk: Walk::Auto,
         }
     }
 
     /// Room for `moves` beads in every per-bead array, as far as memory
-    /// allows (an array that gets none grows as it would have). A bead
-    /// usually lies in one or two cells of the bead lists; a quarter more
-    /// entries than beads covers the designs of a million samples and
-    /// more, whose beads are short next to a cell.
+    /// allows (an array that gets none grows as it would have). The bead
+    /// lists grow as they go: they hold a run of beads an entry, from
+    /// 9 entries a bead (long beads across many cells) down to 0.04
+    /// (3 million samples), too wide a range to guess.
     fn reserve(&mut self, moves: usize) {
         // A failed reservation only leaves the growing to `push`.
         let _ = self.beads.try_reserve_exact(moves);
         let _ = self.layer_heights.try_reserve_exact(moves);
-        let _ = self.stamp.try_reserve_exact(moves);
-        let _ = self
-            .grid
-            .links
-            .try_reserve_exact(moves.saturating_add(moves / 4));
+        self.blocks.reserve(moves);
     }
 
     /// A line as bytes, without its `\n`: a `\r` before it is dropped.
@@ -1195,17 +1468,18 @@ impl<'a> Checker<'a> {
             r,
             beads,
             grid,
-            stamp,
+            blocks,
+            scratch,
             top_z,
             lo,
             hi,
             layer_heights,
-            cands,
             support_tops,
             support_settled,
             recent,
             prev_support,
             exhaustive,
+            walk,
             steepest,
             overhang_near,
             ..
@@ -1272,7 +1546,7 @@ impl<'a> Checker<'a> {
             let support = if fast.is_some() {
                 fast
             } else {
-                let (support, double) = search_support(beads, grid, stamp, cands, &q, id);
+                let (support, double) = search_support(beads, grid, blocks, scratch, &q, *walk);
                 if double {
                     r.support.double_deposition.add(m.line, 0.0);
                 }

@@ -35,13 +35,14 @@
 //! ```
 
 mod analyze;
+mod blocks;
 pub mod parse;
 pub mod replay;
 mod report;
 
-#[doc(hidden)]
-pub use analyze::check_exhaustive;
 pub use analyze::{check, check_reader, CheckWriter};
+#[doc(hidden)]
+pub use analyze::{check_exhaustive, check_pruned};
 pub use parse::Diagnostic;
 pub use report::{Count, Report, SupportStats};
 

@@ -300,6 +300,10 @@ fn clay_far_outside_the_bed_is_still_seen() {
         sweepclay_check::check_exhaustive(&g.out, &tiny).support,
         r.support
     );
+    assert_eq!(
+        sweepclay_check::check_pruned(&g.out, &tiny).support,
+        r.support
+    );
 }
 
 #[test]
@@ -412,6 +416,55 @@ proptest! {
             text += "\n";
         }
         let _ = check(&text, &CheckConfig::default());
+    }
+}
+
+/// A scribbled print: layers of a wandering path of short and long moves
+/// that turn, reverse and cross themselves, with random bead volumes and
+/// drops. Each move is (length, turn in radians, rise, E per mm).
+fn scribble(moves: &[(f64, f64, f64, f64)], layer: f64) -> String {
+    let mut g = String::from("G21\nG90\nM82\n");
+    let (mut at, mut heading, mut e) = ([100.0f64, 100.0, layer], 0.0f64, 0.0f64);
+    g += &format!("G0 X{:.3} Y{:.3} Z{:.3}\n", at[0], at[1], at[2]);
+    for (k, &(len, turn, rise, per_mm)) in moves.iter().enumerate() {
+        heading += turn;
+        // A layer up every 40 moves, and the odd drop or climb.
+        let z = if k % 40 == 39 {
+            at[2] + layer
+        } else {
+            at[2] + rise
+        };
+        at = [
+            (at[0] + len * heading.cos()).clamp(60.0, 140.0),
+            (at[1] + len * heading.sin()).clamp(60.0, 140.0),
+            z.max(0.2),
+        ];
+        e += per_mm * len;
+        g += &format!("G1 X{:.3} Y{:.3} Z{:.3} E{:.5}\n", at[0], at[1], at[2], e);
+    }
+    g
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: 300, failure_persistence: None, .. ProptestConfig::default() })]
+
+    /// The full search gives the same report whether it classifies every
+    /// bead near the middle or skips blocks of beads by their bounds.
+    #[test]
+    fn pruned_full_search_agrees_with_the_plain_one(
+        moves in prop::collection::vec(
+            (prop_oneof![0.01..0.3f64, 0.3..4.0f64],
+             prop_oneof![-0.3..0.3f64, Just(std::f64::consts::PI), -3.2..3.2f64],
+             prop_oneof![Just(0.0), -0.6..0.6f64],
+             0.0..3.0f64),
+            1..400),
+        layer in 0.3..2.0f64,
+    ) {
+        let text = scribble(&moves, layer);
+        let cfg = CheckConfig::default();
+        let json = |r: &Report| serde_json::to_string(r).unwrap();
+        let plain = sweepclay_check::check_exhaustive(&text, &cfg);
+        prop_assert_eq!(json(&sweepclay_check::check_pruned(&text, &cfg)), json(&plain));
     }
 }
 

@@ -1,11 +1,12 @@
 //! Helpers shared by the integration tests of the pipeline.
 
-use sweepclay_check::{check, check_exhaustive, CheckConfig, Report};
+use sweepclay_check::{check, check_exhaustive, check_pruned, CheckConfig, Report};
 use sweepclay_core::{gcode, Sliced};
 
 /// The checker configured from the design's printer and parameters, as
 /// `sweepclay slice` configures it. Also holds the checker's fast support
-/// path to its full search: both must give the same report.
+/// path and its pruned full search to its plain full search: all three
+/// must give the same report.
 pub fn check_sliced(s: &Sliced) -> Report {
     let p = &s.corrected.surface.params;
     let pr = &s.corrected.surface.printer;
@@ -23,10 +24,15 @@ pub fn check_sliced(s: &Sliced) -> Report {
     };
     let text = gcode::to_string(s);
     let report = check(&text, &cfg);
+    let plain = check_exhaustive(&text, &cfg);
     assert_eq!(
-        report,
-        check_exhaustive(&text, &cfg),
+        report, plain,
         "the checker's fast support path and its full search disagree"
+    );
+    assert_eq!(
+        check_pruned(&text, &cfg),
+        plain,
+        "the checker's pruned full search and its plain one disagree"
     );
     report
 }
