@@ -106,8 +106,9 @@ impl Blocks {
         }
     }
 
-    /// Whether the block of bead `k` at `level` holds the bounds of all
-    /// its beads so far (the finest always does).
+    /// Whether the bounds of bead `k`'s block at `level` hold bead `k`
+    /// (and so every bead of the block before it): always at the finest
+    /// level, at a coarser one once the finer block of `k` is complete.
     fn complete(&self, level: usize, k: usize) -> bool {
         level == 0 || (k >> SHIFTS[level - 1]) < self.len >> SHIFTS[level - 1]
     }
