@@ -1,7 +1,10 @@
 //! The checks: continuity, bounds, collision and support, from the replayed
 //! moves. Beads are kept in a grid of 4 × 4 × 2 mm cells so each question
 //! ("what clay is below this bead?", "is clay inside the nozzle cylinder?")
-//! looks at a few cells, not at every earlier bead.
+//! looks at a few cells, not at every earlier bead; a cell lists runs of
+//! consecutive beads, and where a cell holds many (a finely sampled path)
+//! the support search skips whole blocks of them by their bounds
+//! ([`crate::blocks`]).
 
 use crate::blocks::{Blocks, Bound, Visit};
 use crate::parse::{Diagnostic, Line, LineParser};
@@ -1810,6 +1813,33 @@ mod tests {
         assert!(pick_support(&c, 0.3, true).is_none());
         assert_eq!(pick_support(&c, 0.3, false).unwrap().z, 1.2, "an overhang");
         assert!(pick_support(&[], 0.3, false).is_none());
+    }
+
+    #[test]
+    fn merged_runs_hold_each_bead_of_the_runs_once() {
+        let mut state = 3u64;
+        for case in 0..500 {
+            let n = case % 40;
+            let mut runs: Vec<[u32; 2]> = (0..n)
+                .map(|_| {
+                    let a = (crate::xorshift(&mut state) % 200) as u32;
+                    [a, a + (crate::xorshift(&mut state) % 6) as u32]
+                })
+                .collect();
+            if case == 1 {
+                runs.push([u32::MAX - 1, u32::MAX]);
+                runs.push([u32::MAX, u32::MAX]);
+            }
+            let want: std::collections::BTreeSet<u32> =
+                runs.iter().flat_map(|r| r[0]..=r[1]).collect();
+            merge_runs(&mut runs);
+            let got: Vec<u32> = runs.iter().flat_map(|r| r[0]..=r[1]).collect();
+            assert_eq!(got, want.into_iter().collect::<Vec<_>>(), "case {case}");
+            // Disjoint and not touching: nothing left to merge.
+            assert!(runs
+                .windows(2)
+                .all(|w| u64::from(w[0][1]) + 1 < u64::from(w[1][0])));
+        }
     }
 
     #[test]
