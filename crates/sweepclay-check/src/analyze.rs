@@ -802,15 +802,17 @@ fn follow_support(
     Some(best)
 }
 
-/// How the full search walks the beads near the middle. Each way gives
-/// the same answer; the tests hold them to it.
+/// How the support of a bead is found. Each way gives the same answer;
+/// the tests hold them to it.
 #[derive(Clone, Copy, Debug, PartialEq)]
 enum Walk {
-    /// Plain while the beads are few ([`PLAIN_MAX`]), else pruned.
+    /// The checker's: the shortcut (`follow_support`) where it holds,
+    /// else the full search, plain while the beads are few
+    /// ([`PLAIN_MAX`]), else pruned.
     Auto,
-    /// Every bead: the reference.
+    /// Always the full search, classifying every bead: the reference.
     Plain,
-    /// Questions that skip blocks of beads.
+    /// Always the full search, by questions that skip blocks of beads.
     Pruned,
 }
 
@@ -825,7 +827,9 @@ const PLAIN_MAX: usize = 64;
 /// [`Query::classify`], then [`pick_support`].
 ///
 /// The cells' beads come as runs of consecutive beads (merged, so each
-/// bead once). A few are each classified ([`Walk::Plain`]). Many (a
+/// bead once a box; when nothing covers, the wider box holds the first
+/// box's beads again, in either walk: a repeated candidate changes no
+/// answer). A few are each classified ([`Walk::Plain`]). Many (a
 /// finely sampled path) are asked questions instead ([`Walk::Pruned`],
 /// [`search_pruned`]), whose cost does not grow with the sampling.
 fn search_support(
@@ -876,34 +880,12 @@ fn search_support(
     runs.iter()
         .for_each(|&[first, last]| (first..=last).for_each(&mut classify));
     if !covered.get() {
-        // Look wider only when nothing covers (to measure an overhang):
-        // the beads not in the first box.
-        let n = runs.len();
-        grid.in_box(mid, cfg.width_max, zlo, zhi, |r| {
-            runs.push([r.first, r.last])
-        });
-        let (first_box, second) = runs.split_at_mut(n);
-        second.sort_unstable_by_key(|r| r[0]);
-        let mut k = 0;
-        let mut next = 0u64;
-        for &[first, last] in second.iter() {
-            let mut j = u64::from(first).max(next);
-            while j <= u64::from(last) {
-                // Skip the first box's runs that end before `j`; jump over
-                // the one that holds it.
-                while first_box.get(k).is_some_and(|r| u64::from(r[1]) < j) {
-                    k += 1;
-                }
-                match first_box.get(k) {
-                    Some(r) if u64::from(r[0]) <= j => j = u64::from(r[1]) + 1,
-                    _ => {
-                        classify(j as u32);
-                        j += 1;
-                    }
-                }
-            }
-            next = next.max(u64::from(last) + 1);
-        }
+        // Look wider only when nothing covers (to measure an overhang).
+        // The first box's beads come again: the same candidate twice
+        // changes no answer of `pick_support`.
+        wider(runs);
+        runs.iter()
+            .for_each(|&[first, last]| (first..=last).for_each(&mut classify));
     }
     let support = pick_support(cands, cfg.min_layer_mm, mid[2] <= cfg.first_layer_max_mm);
     (support, double)
@@ -1118,12 +1100,11 @@ fn minmax(slot: &mut Option<[(f64, usize); 2]>, v: f64, line: usize) {
 
 /// Checks a G-code text. Never panics, whatever the input.
 pub fn check(text: &str, cfg: &CheckConfig) -> Report {
-    check_with(text, cfg, false, Walk::Auto)
+    check_with(text, cfg, Walk::Auto)
 }
 
-fn check_with(text: &str, cfg: &CheckConfig, exhaustive: bool, walk: Walk) -> Report {
+fn check_with(text: &str, cfg: &CheckConfig, walk: Walk) -> Report {
     let mut w = CheckWriter::new(cfg);
-    w.checker.exhaustive = exhaustive;
     w.checker.walk = walk;
     w.feed(text.as_bytes());
     w.finish()
@@ -1135,7 +1116,7 @@ fn check_with(text: &str, cfg: &CheckConfig, exhaustive: bool, walk: Walk) -> Re
 /// tests hold the fast path to. The two give the same report.
 #[doc(hidden)]
 pub fn check_exhaustive(text: &str, cfg: &CheckConfig) -> Report {
-    check_with(text, cfg, true, Walk::Plain)
+    check_with(text, cfg, Walk::Plain)
 }
 
 /// [`check_exhaustive`], but with every full search asking blocks of
@@ -1143,7 +1124,7 @@ pub fn check_exhaustive(text: &str, cfg: &CheckConfig) -> Report {
 /// to the same report, also on designs too coarse for [`check`] to prune.
 #[doc(hidden)]
 pub fn check_pruned(text: &str, cfg: &CheckConfig) -> Report {
-    check_with(text, cfg, true, Walk::Pruned)
+    check_with(text, cfg, Walk::Pruned)
 }
 
 /// Checks G-code read line by line from `input`, holding no more of the
@@ -1271,9 +1252,7 @@ struct Checker<'a> {
     /// just under the overhang limit's.
     steepest: f64,
     overhang_near: f64,
-    /// Always search (tests compare the fast path against this).
-    exhaustive: bool,
-    /// How the full search walks the beads.
+    /// How supports are found (tests compare the ways).
     walk: Walk,
 }
 
@@ -1307,7 +1286,6 @@ impl<'a> Checker<'a> {
                 * (cfg.max_overhang_deg + cfg.overhang_tolerance_deg)
                     .to_radians()
                     .tan(),
-            exhaustive: false,
             walk: Walk::Auto,
         }
     }
@@ -1486,7 +1464,6 @@ impl<'a> Checker<'a> {
             support_settled,
             recent,
             prev_support,
-            exhaustive,
             walk,
             steepest,
             overhang_near,
@@ -1545,7 +1522,7 @@ impl<'a> Checker<'a> {
             // for the rest (reversals, drops) each such bead is asked.
             let fast = prev_support
                 .filter(|_| {
-                    !*exhaustive
+                    *walk == Walk::Auto
                         && (recent.clear_of(m, mid, cfg.min_layer_mm, turn, xy)
                             || q.none_below(&beads[*support_settled..], *support_settled))
                 })
