@@ -431,28 +431,26 @@ impl TopGrid {
             [f[0].min(t[0]), f[1].min(t[1])],
             [f[0].max(t[0]), f[1].max(t[1])],
         );
+        // Most beads: three cells a side or fewer, so two blocks a side at
+        // most. Their cells and blocks without the loops of raise_box: the
+        // first and last of each side (some perhaps the same), and, for a
+        // third cell, the middle one.
         if xs[1] - xs[0] <= 2 && ys[1] - ys[0] <= 2 {
-            // Most beads: three cells a side or fewer. The first, middle
-            // and last cell of each side (some perhaps the same) and the
-            // four corner blocks (a 3-cell side lies in two blocks at
-            // most), without the loops of raise_box.
             let nx = self.n[0];
-            let xm = (xs[0] + xs[1]) / 2;
-            let ym = (ys[0] + ys[1]) / 2;
-            for y in [ys[0], ym, ys[1]] {
-                for x in [xs[0], xm, xs[1]] {
-                    let v = &mut self.top[y * nx + x];
-                    raise_to(v, top);
-                }
-            }
             for (x, y) in [
                 (xs[0], ys[0]),
                 (xs[1], ys[0]),
                 (xs[0], ys[1]),
                 (xs[1], ys[1]),
             ] {
-                let c = &mut self.coarse[y / 4 * self.bx + x / 4];
-                raise_to(c, top);
+                raise_to(&mut self.top[y * nx + x], top);
+                raise_to(&mut self.coarse[y / 4 * self.bx + x / 4], top);
+            }
+            if xs[1] - xs[0] == 2 || ys[1] - ys[0] == 2 {
+                let (xm, ym) = ((xs[0] + xs[1]) / 2, (ys[0] + ys[1]) / 2);
+                for (x, y) in [(xm, ys[0]), (xm, ym), (xm, ys[1]), (xs[0], ym), (xs[1], ym)] {
+                    raise_to(&mut self.top[y * nx + x], top);
+                }
             }
             return;
         }
@@ -1747,8 +1745,10 @@ mod tests {
             g.raise(&bead);
             beads.push(bead);
         }
-        // Each cell a centreline passes through is at least as high as it.
-        for b in &beads {
+        // Each cell a centreline passes through is at least as high as it,
+        // among all the beads and for a bead alone (1–7 mm long: boxes of
+        // one to four cells a side).
+        let through = |g: &TopGrid, b: &Bead| {
             let (f, t) = (b.from(), b.to());
             for k in 0..=200 {
                 let u = f64::from(k) / 200.0;
@@ -1756,6 +1756,18 @@ mod tests {
                 let (x, y) = (g.index(p[0], 0), g.index(p[1], 1));
                 assert!(g.top[y * g.n[0] + x] >= b.top32(), "{p:?}");
             }
+        };
+        for b in &beads {
+            through(&g, b);
+        }
+        for _ in 0..300 {
+            let mut alone = TopGrid::new([40.0, 40.0], 2.0);
+            let from = [rand(30.0), rand(30.0), rand(50.0)];
+            let (len, a) = (1.0 + rand(6.0), rand(std::f64::consts::TAU));
+            let to = [from[0] + len * a.cos(), from[1] + len * a.sin(), from[2]];
+            let b = Bead::new(from, to, 3.0, 0.0, false);
+            alone.raise(&b);
+            through(&alone, &b);
         }
         for y in 0..g.n[1] {
             for x in 0..g.n[0] {
