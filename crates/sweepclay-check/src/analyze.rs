@@ -388,12 +388,12 @@ impl TopGrid {
         let nx = self.n[0];
         for y in ys[0]..ys[1] + 1 {
             for v in &mut self.top[y * nx + xs[0]..y * nx + xs[1] + 1] {
-                raise_to(v, top);
+                *v = larger(*v, top);
             }
         }
         for row in self.blocks((xs, ys)) {
             for v in &mut self.coarse[row] {
-                raise_to(v, top);
+                *v = larger(*v, top);
             }
         }
     }
@@ -434,7 +434,11 @@ impl TopGrid {
         // Most beads: three cells a side or fewer, so two blocks a side at
         // most. Their cells and blocks without the loops of raise_box: the
         // first and last of each side (some perhaps the same), and, for a
-        // third cell, the middle one.
+        // third cell, the middle one. Check of the 44k text 12.39–12.47 ms
+        // against 12.78–12.96 with loops over the cells and blocks (min of
+        // 40, alternated); raising nine fixed cells for every bead instead
+        // chained each store to the next load where beads lie in one cell
+        // (1M: 1–2 % slower).
         if xs[1] - xs[0] <= 2 && ys[1] - ys[0] <= 2 {
             let nx = self.n[0];
             for (x, y) in [
@@ -443,13 +447,14 @@ impl TopGrid {
                 (xs[0], ys[1]),
                 (xs[1], ys[1]),
             ] {
-                raise_to(&mut self.top[y * nx + x], top);
-                raise_to(&mut self.coarse[y / 4 * self.bx + x / 4], top);
+                self.top[y * nx + x] = larger(self.top[y * nx + x], top);
+                let c = &mut self.coarse[y / 4 * self.bx + x / 4];
+                *c = larger(*c, top);
             }
             if xs[1] - xs[0] == 2 || ys[1] - ys[0] == 2 {
                 let (xm, ym) = ((xs[0] + xs[1]) / 2, (ys[0] + ys[1]) / 2);
                 for (x, y) in [(xm, ys[0]), (xm, ym), (xm, ys[1]), (xs[0], ym), (xs[1], ym)] {
-                    raise_to(&mut self.top[y * nx + x], top);
+                    self.top[y * nx + x] = larger(self.top[y * nx + x], top);
                 }
             }
             return;
@@ -493,18 +498,11 @@ impl TopGrid {
     }
 }
 
-/// `*v = v.max(top)` for a `*v` that is not NaN (a running maximum
-/// from `-inf`): the same value, by one compare, where `f32::max` adds a
-/// NaN test.
+/// `a.max(b)` for an `a` that is not NaN (a running maximum, from `-inf`
+/// or 0): the same value, by one compare, where `f32::max` and `f64::max`
+/// add a NaN test.
 #[inline(always)]
-fn raise_to(v: &mut f32, top: f32) {
-    *v = if *v < top { top } else { *v };
-}
-
-/// `a.max(b)` for an `a` that is not NaN (a running maximum): the same
-/// value, by one compare, where `f64::max` adds a NaN test.
-#[inline(always)]
-fn larger(a: f64, b: f64) -> f64 {
+fn larger<T: PartialOrd>(a: T, b: T) -> T {
     if a < b {
         b
     } else {
@@ -512,8 +510,20 @@ fn larger(a: f64, b: f64) -> f64 {
     }
 }
 
-/// Plan distance from `p` to a rectangle `[x0, y0, x1, y1]` (0 inside).
-fn rect_distance(r: [f64; 4], p: [f64; 2]) -> f64 {
+/// `a.min(b)` for an `a` that is not NaN (a running minimum): see
+/// [`larger`].
+#[inline(always)]
+fn smaller<T: PartialOrd>(a: T, b: T) -> T {
+    if b < a {
+        b
+    } else {
+        a
+    }
+}
+
+/// Plan distance from `p` to a rectangle `[x0, y0, x1, y1]` (0 inside; 0
+/// for a NaN `p`).
+pub(crate) fn rect_distance(r: [f64; 4], p: [f64; 2]) -> f64 {
     let dx = (r[0] - p[0]).max(p[0] - r[2]).max(0.0);
     let dy = (r[1] - p[1]).max(p[1] - r[3]).max(0.0);
     len2(dx, dy)
@@ -900,15 +910,17 @@ fn search_support(
         Class::Double => double = true,
         Class::Neither => {}
     };
-    runs.iter()
-        .for_each(|&[first, last]| (first..=last).for_each(&mut classify));
+    let mut classify_runs = |runs: &[[u32; 2]]| {
+        runs.iter()
+            .for_each(|&[first, last]| (first..=last).for_each(&mut classify))
+    };
+    classify_runs(runs);
     if !covered.get() {
         // Look wider only when nothing covers (to measure an overhang).
         // The first box's beads come again: the same candidate twice
         // changes no answer of `pick_support`.
         wider(runs);
-        runs.iter()
-            .for_each(|&[first, last]| (first..=last).for_each(&mut classify));
+        classify_runs(runs);
     }
     let support = pick_support(cands, cfg.min_layer_mm, mid[2] <= cfg.first_layer_max_mm);
     (support, double)
@@ -1497,7 +1509,7 @@ impl<'a> Checker<'a> {
         r.volume_ml += volume / 1000.0;
         for p in [m.from, m.to] {
             for a in 0..3 {
-                lo[a] = if p[a] < lo[a] { p[a] } else { lo[a] };
+                lo[a] = smaller(lo[a], p[a]);
                 hi[a] = larger(hi[a], p[a]);
             }
         }

@@ -10,6 +10,8 @@
 //! beads. The bounds are exact minima and maxima of the beads'
 //! single-precision values, so they hold every bead of the block.
 
+use crate::analyze::rect_distance;
+
 /// Bounds of a block of consecutive beads.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub(crate) struct Bound {
@@ -41,13 +43,8 @@ impl Bound {
 
     /// Plan distance from `p` to the box (0 inside; 0 for a NaN `p`).
     pub fn plan_distance(&self, p: [f64; 2]) -> f64 {
-        let along = |a: usize| {
-            (f64::from(self.lo[a]) - p[a])
-                .max(p[a] - f64::from(self.hi[a]))
-                .max(0.0)
-        };
-        let (dx, dy) = (along(0), along(1));
-        (dx * dx + dy * dy).sqrt()
+        let rect = [self.lo[0], self.lo[1], self.hi[0], self.hi[1]];
+        rect_distance(rect.map(f64::from), p)
     }
 }
 
