@@ -10,7 +10,7 @@
 //! beads. The bounds are exact minima and maxima of the beads'
 //! single-precision values, so they hold every bead of the block.
 
-use crate::analyze::rect_distance;
+use crate::geom::rect_distance;
 
 /// Bounds of a block of consecutive beads.
 #[derive(Clone, Copy, Debug, PartialEq)]

@@ -34,15 +34,21 @@
 //! assert!(report.printable, "{}", report.render());
 //! ```
 
-mod analyze;
+mod bead;
 mod blocks;
+mod checker;
+mod geom;
+mod grid;
 pub mod parse;
 pub mod replay;
 mod report;
+mod support;
+mod tops;
+mod verdict;
 
-pub use analyze::{check, check_reader, CheckWriter};
+pub use checker::{check, check_reader, CheckWriter};
 #[doc(hidden)]
-pub use analyze::{check_exhaustive, check_pruned};
+pub use checker::{check_exhaustive, check_pruned};
 pub use parse::Diagnostic;
 pub use report::{Count, Report, SupportStats};
 
