@@ -14,6 +14,8 @@ pub(crate) struct Bead {
     pub(crate) s_end: f64,
     /// Turnaround step (steeper than 1:2): clay, but no support for others.
     pub(crate) step: bool,
+    /// Its layer height: the gap to the clay it rests on (0 if none).
+    pub(crate) height32: f32,
 }
 
 impl Bead {
@@ -24,6 +26,7 @@ impl Bead {
             width32: width as f32,
             s_end,
             step,
+            height32: 0.0,
         }
     }
 
@@ -42,6 +45,15 @@ impl Bead {
 
     pub(crate) fn width(&self) -> f64 {
         f64::from(self.width32)
+    }
+
+    /// Whether `p` lies beside the bead's centreline in plan, between the
+    /// perpendiculars at its ends (not beyond an end).
+    pub(crate) fn spans(&self, p: [f64; 3]) -> bool {
+        let (from, to) = (self.from(), self.to());
+        let (dx, dy) = (to[0] - from[0], to[1] - from[1]);
+        let t = (p[0] - from[0]) * dx + (p[1] - from[1]) * dy;
+        (0.0..=dx * dx + dy * dy).contains(&t)
     }
 
     /// Closest point of the bead's centreline (in plan) to `p`:

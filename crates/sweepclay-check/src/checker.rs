@@ -8,13 +8,31 @@ use crate::geom::{larger, len2, minmax, overlap_fraction, smaller};
 use crate::grid::{settle, BeadGrid};
 use crate::parse::{Diagnostic, Line, LineParser};
 use crate::replay::{Event, Move, Replayer};
-use crate::report::Report;
+use crate::report::{Finding, Report, Segment};
 use crate::support::{follow_support, search_support, Query, Recent, Scratch, Walk};
 use crate::tops::TopGrid;
 use crate::verdict::verdict;
+use crate::verdict::WIDTH_TOLERANCE;
 use crate::CheckConfig;
 
 const EPS_E: f64 = 1e-7;
+
+/// Lines longer than this (bytes) are not G-code any firmware reads (Marlin
+/// takes 96): one diagnostic, and the line is skipped.
+pub const MAX_LINE: usize = 4096;
+
+/// Diagnostics kept in a report; the rest are counted.
+const MAX_DIAGNOSTICS: usize = 50;
+
+/// After this many failures the file is not printable beyond doubt: the
+/// support and collision analysis stops (a diagnostic says where), so a
+/// file whose clay piles up or leaves the bed still checks in linear time.
+pub const MAX_FAILURES: usize = 10_000;
+
+/// Runs before the print, and findings held back while it is not yet
+/// known whether they are in it, at most.
+const MAX_LEAD_RUNS: usize = 64;
+const MAX_HELD: usize = 100_000;
 
 /// Checks a G-code text. Never panics, whatever the input.
 pub fn check(text: &str, cfg: &CheckConfig) -> Report {
@@ -63,6 +81,8 @@ pub fn check_reader<R: std::io::BufRead>(
 pub struct CheckWriter<'a> {
     checker: Checker<'a>,
     partial: Vec<u8>,
+    /// The partial line is over [`MAX_LINE`]: the rest of it is dropped.
+    overlong: bool,
 }
 
 impl<'a> CheckWriter<'a> {
@@ -82,13 +102,16 @@ impl<'a> CheckWriter<'a> {
         CheckWriter {
             checker,
             partial: Vec::new(),
+            overlong: false,
         }
     }
 
     /// The report on everything written (a last line without a newline
     /// included).
     pub fn finish(mut self) -> Report {
-        if !self.partial.is_empty() {
+        if self.overlong {
+            self.checker.overlong();
+        } else if !self.partial.is_empty() {
             self.checker.bytes(&self.partial);
         }
         self.checker.finish()
@@ -99,16 +122,31 @@ impl<'a> CheckWriter<'a> {
     fn feed(&mut self, buf: &[u8]) {
         let mut start = 0;
         for nl in memchr::memchr_iter(b'\n', buf) {
-            if self.partial.is_empty() {
+            if self.partial.is_empty() && !self.overlong {
                 self.checker.bytes(&buf[start..nl]);
             } else {
-                self.partial.extend_from_slice(&buf[start..nl]);
-                self.checker.bytes(&self.partial);
+                self.keep(&buf[start..nl]);
+                if self.overlong {
+                    self.checker.overlong();
+                } else {
+                    self.checker.bytes(&self.partial);
+                }
                 self.partial.clear();
+                self.overlong = false;
             }
             start = nl + 1;
         }
-        self.partial.extend_from_slice(&buf[start..]);
+        self.keep(&buf[start..]);
+    }
+
+    /// Keeps the start of a line that goes on in the next write, up to
+    /// [`MAX_LINE`] bytes: memory never grows with a line's length.
+    fn keep(&mut self, part: &[u8]) {
+        if self.partial.len() + part.len() > MAX_LINE {
+            self.overlong = true;
+        } else {
+            self.partial.extend_from_slice(part);
+        }
     }
 }
 
@@ -123,30 +161,100 @@ impl std::io::Write for CheckWriter<'_> {
     }
 }
 
-/// A count whose occurrences only count if an extrusion follows them
-/// (travel, pauses and collisions between two beads, not after the last).
+/// A finding whose occurrences only count if a bead follows them (travel,
+/// retractions, pauses, blobs and collisions between two beads, not after
+/// the last: that is the end code).
 #[derive(Clone, Copy)]
-enum Deferred {
-    Travel,
-    Pause,
-    Nozzle,
-    Carriage,
+struct Deferred(Finding);
+
+/// A finding held back while the checker does not yet know whether it is
+/// in the print or in the start code: `run` is the run it belongs to, or,
+/// with `gap`, the run it comes before.
+struct Held {
+    run: usize,
+    gap: bool,
+    kind: Finding,
+    line: usize,
+    v: f64,
+}
+
+/// An extrusion run before the print is known to have begun.
+struct LeadRun {
+    first_bead: u32,
+    line: usize,
+    last_line: usize,
+    /// Moves replayed before it.
+    moves_before: usize,
+    /// Height of its first bead.
+    z: f64,
+    clay_mm3: f64,
+    beads: usize,
+    /// Beads with nothing under them and far from the bed: a purge in the
+    /// air.
+    air: usize,
+    /// Beads resting on the bed.
+    on_bed: usize,
+}
+
+/// Where the print begins (docs/CHECKER.md, "Start and end code"): the
+/// first run that clay is laid on. Runs before it that nothing rests on
+/// (a skirt or purge line on the bed, a purge in the air, a stationary
+/// prime) are start code. Until a bead rests on an earlier run, what the
+/// runs so far did is held here.
+#[derive(Default)]
+struct Lead {
+    /// Decided: `print_run` is the print's first run.
+    decided: bool,
+    print_run: usize,
+    runs: Vec<LeadRun>,
+    held: Vec<Held>,
+    /// Beads of the air purges (their clay falls off; it is no obstacle).
+    air: Vec<u32>,
+    /// What the start code holds, once decided.
+    start: Segment,
+}
+
+/// A stretch of consecutive beads laid on clay at their own height: their
+/// clay and the part of it that has no room (docs/CHECKER.md, "Clay on
+/// clay").
+#[derive(Default)]
+struct Stretch {
+    first_line: usize,
+    length: f64,
+    volume: f64,
+    excess: f64,
 }
 
 /// The check as a state machine fed one line at a time, in one pass: what
-/// happens after the first bead is held back until the next bead proves it
-/// was not after the last one.
+/// happens after a bead is held back until the next bead proves it was
+/// not after the last one.
 struct Checker<'a> {
     cfg: &'a CheckConfig,
     parser: LineParser,
     line: Line,
     replayer: Replayer,
     diags: Vec<Diagnostic>,
+    diags_dropped: usize,
     r: Report,
-    /// An extruding move has been seen.
+    /// A bead has been laid.
     started: bool,
     in_run: bool,
+    /// Runs begun so far (start code included).
+    runs: usize,
     pending: Vec<(Deferred, usize, f64)>,
+    lead: Lead,
+    /// Moves and line of the last bead, for the end code.
+    last_bead: (usize, usize),
+    /// Cross-section (mm²) under which a move whose E rises is a travel
+    /// carrying a rounding residue of E, not a bead.
+    min_area: f64,
+    /// Beads are still analysed for support and collisions (see
+    /// [`MAX_FAILURES`]).
+    deep: bool,
+    stretch: Stretch,
+    /// The last judged bead was a stub, and its overlap.
+    prev_stub: bool,
+    prev_overlap: f64,
     beads: Vec<Bead>,
     grid: BeadGrid,
     /// Bounds of blocks of consecutive beads, for the full search.
@@ -176,16 +284,29 @@ struct Checker<'a> {
 
 impl<'a> Checker<'a> {
     fn new(cfg: &'a CheckConfig) -> Self {
+        let mut parser = LineParser::default();
+        parser.firmware = cfg.firmware;
+        let mut replayer = Replayer::default();
+        replayer.firmware = cfg.firmware;
         Checker {
             cfg,
-            parser: LineParser::default(),
+            parser,
             line: Line::empty(),
-            replayer: Replayer::default(),
+            replayer,
             diags: Vec::new(),
+            diags_dropped: 0,
             r: Report::default(),
             started: false,
             in_run: false,
+            runs: 0,
             pending: Vec::new(),
+            lead: Lead::default(),
+            last_bead: (0, 0),
+            min_area: 0.01 * cfg.width_min * cfg.min_layer_mm,
+            deep: true,
+            stretch: Stretch::default(),
+            prev_stub: false,
+            prev_overlap: 0.0,
             beads: Vec::new(),
             grid: BeadGrid::new(cfg),
             blocks: Blocks::default(),
@@ -220,87 +341,242 @@ impl<'a> Checker<'a> {
         self.blocks.reserve(moves);
     }
 
+    /// A line over [`MAX_LINE`] bytes: counted, noted, skipped.
+    fn overlong(&mut self) {
+        self.r.lines += 1;
+        self.diagnose(Diagnostic {
+            line: self.r.lines,
+            message: format!("line longer than {MAX_LINE} bytes skipped (no firmware reads it)"),
+        });
+    }
+
+    fn diagnose(&mut self, d: Diagnostic) {
+        self.diags.push(d);
+        self.trim_diagnostics();
+    }
+
+    /// Keeps the first [`MAX_DIAGNOSTICS`], counting the rest.
+    fn trim_diagnostics(&mut self) {
+        if self.diags.len() > MAX_DIAGNOSTICS {
+            self.diags_dropped += self.diags.len() - MAX_DIAGNOSTICS;
+            self.diags.truncate(MAX_DIAGNOSTICS);
+        }
+    }
+
     /// A line as bytes, without its `\n`: a `\r` before it is dropped.
     fn bytes(&mut self, mut raw: &[u8]) {
+        if raw.len() > MAX_LINE {
+            return self.overlong();
+        }
         if raw.last() == Some(&b'\r') {
             raw = &raw[..raw.len() - 1];
         }
         self.r.lines += 1;
         let n = self.r.lines;
-        if !self
+        let parsed = self
             .parser
-            .parse_bytes(raw, n, &mut self.diags, &mut self.line)
-        {
-            return;
-        }
-        match self.replayer.feed(&self.line, &mut self.diags) {
-            Some(Event::Pause(line)) if self.started => {
-                self.pending.push((Deferred::Pause, line, 0.0));
+            .parse_bytes(raw, n, &mut self.diags, &mut self.line);
+        let event = if parsed {
+            self.replayer.feed(&self.line, &mut self.diags)
+        } else {
+            None
+        };
+        self.trim_diagnostics();
+        match event {
+            Some(Event::Pause(line)) => {
+                self.pending.push((Deferred(Finding::Pause), line, 0.0));
                 self.in_run = false;
             }
-            Some(Event::Move(m)) => self.step(&m),
-            Some(Event::Pause(_)) | None => {}
+            Some(Event::Move(m)) => {
+                // Into the box's own frame: its lowest corner at 0.
+                let b = self.cfg.bed_min;
+                let shift = |p: [f64; 3]| [p[0] - b[0], p[1] - b[1], p[2] - b[2]];
+                let m = Move {
+                    from: shift(m.from),
+                    to: shift(m.to),
+                    ..m
+                };
+                self.step(&m)
+            }
+            None => {}
         }
     }
 
-    fn defer_or_add(&mut self, extruding: bool, kind: Deferred, line: usize, v: f64) {
-        if extruding {
-            self.count(kind).add(line, v);
+    /// Records a finding: at once in the print, held back while it is not
+    /// yet known whether the print has begun.
+    fn record(&mut self, kind: Finding, line: usize, v: f64, gap: bool) {
+        if self.lead.decided {
+            self.r.findings[kind].add(line, v);
+            return;
+        }
+        if self.lead.held.len() >= MAX_HELD {
+            // So much before anything rests on anything: all of it is the
+            // print.
+            self.decide(0);
+            return self.record(kind, line, v, gap);
+        }
+        let run = if gap {
+            self.runs
         } else {
-            self.pending.push((kind, line, v));
+            self.runs.saturating_sub(1)
+        };
+        self.lead.held.push(Held {
+            run,
+            gap,
+            kind,
+            line,
+            v,
+        });
+    }
+
+    fn defer_or_add(&mut self, extruding: bool, kind: Finding, line: usize, v: f64) {
+        if extruding {
+            self.record(kind, line, v, false);
+        } else {
+            self.pending.push((Deferred(kind), line, v));
         }
     }
 
-    fn count(&mut self, kind: Deferred) -> &mut crate::report::Count {
-        match kind {
-            Deferred::Travel => &mut self.r.travel_moves,
-            Deferred::Pause => &mut self.r.pauses,
-            Deferred::Nozzle => &mut self.r.nozzle_collisions,
-            Deferred::Carriage => &mut self.r.carriage_collisions,
+    /// The print begins at run `k`: what was held for runs before it (and
+    /// in the gap before it) is start code, the rest counts.
+    fn decide(&mut self, k: usize) {
+        let lead = &mut self.lead;
+        if lead.decided {
+            return;
         }
+        lead.decided = true;
+        lead.print_run = k;
+        let cfg = self.cfg;
+        let first = lead.runs.get(k);
+        let first_z = first.map(|r| r.z);
+        let first_line = first.map_or(usize::MAX, |r| r.line);
+        let high = first_z.filter(|&z| z > cfg.first_layer_max_mm);
+        let start = &mut lead.start;
+        for h in std::mem::take(&mut lead.held) {
+            if h.run > k || (h.run == k && !h.gap) {
+                // A first layer too high is one finding, not a bead with no
+                // clay below for every bead of it.
+                if h.kind == Finding::Unsupported
+                    && high.is_some_and(|z| h.v <= z + cfg.min_layer_mm)
+                {
+                    continue;
+                }
+                self.r.findings[h.kind].add(h.line, h.v);
+            } else {
+                start.cover(h.line);
+                if h.kind == Finding::ExtrusionWithoutMotion {
+                    start.clay_ml += h.v / cfg.e_per_mm3 / 1000.0;
+                }
+                start.note(match h.kind {
+                    Finding::ExtrusionWithoutMotion => {
+                        format!("prime without motion (line {})", h.line)
+                    }
+                    Finding::Retraction => format!("retraction (line {})", h.line),
+                    Finding::TravelMove => "travel moves".to_string(),
+                    Finding::Pause => format!("pause (line {})", h.line),
+                    Finding::Unsupported => "purge in the air (its clay is no obstacle)".into(),
+                    other => format!("{} (line {})", other.label(), h.line),
+                });
+            }
+        }
+        for run in &lead.runs[..k.min(lead.runs.len())] {
+            start.cover(run.line);
+            start.cover(run.last_line);
+            start.clay_ml += run.clay_mm3 / 1000.0;
+            let what = if run.air * 2 > run.beads {
+                "purge in the air"
+            } else if run.on_bed * 2 > run.beads {
+                "clay on the bed beside the part (skirt or purge line)"
+            } else {
+                "clay that nothing rests on"
+            };
+            start.note(format!(
+                "{what}: {} bead(s), lines {}-{}",
+                run.beads, run.line, run.last_line
+            ));
+        }
+        if let Some(run) = first {
+            start.moves = run.moves_before;
+            if run.moves_before > 0 {
+                start.note("homing and moves to the start".into());
+            }
+            if start.lines[0] == 0 {
+                start.lines[0] = 1;
+            }
+        }
+        if start.items.is_empty() {
+            lead.start = Segment::default();
+        } else if first_line != usize::MAX {
+            start.lines[1] = first_line.saturating_sub(1);
+        }
+        // Clay purged into the air falls off: it is no obstacle to the
+        // print (a height no question reaches).
+        let first_bead = first.map_or(u32::MAX, |r| r.first_bead);
+        for &id in &lead.air {
+            if id < first_bead {
+                if let Some(b) = self.beads.get_mut(id as usize) {
+                    b.from32[2] = f32::NEG_INFINITY;
+                    b.to32[2] = f32::NEG_INFINITY;
+                }
+            }
+        }
+        lead.air = Vec::new();
+        if let Some(z) = first_z {
+            self.r.first_layer_z = Some(z);
+        }
+        if let (Some(z), Some(run)) = (high, first) {
+            self.r.findings[Finding::FirstLayerHigh].add(run.line, z);
+        }
+        self.r.run_starts = lead.runs[k.min(lead.runs.len())..]
+            .iter()
+            .map(|r| r.line)
+            .take(20)
+            .collect();
     }
 
     fn step(&mut self, m: &Move) {
         let cfg = self.cfg;
-        let is_extruding = m.de > EPS_E;
         let len = m.length();
+        // A move whose E rises by a rounding residue is a travel.
+        let is_extruding =
+            m.de > EPS_E && (len == 0.0 || m.de / cfg.e_per_mm3 >= self.min_area * len);
+        let bead = is_extruding && len > 0.0;
         // Continuity.
         self.r.moves += 1;
         if m.de < -EPS_E {
-            if self.started {
-                self.r.retractions.add(m.line, -m.de);
-            }
+            self.pending
+                .push((Deferred(Finding::Retraction), m.line, -m.de));
             self.in_run = false;
-        } else if is_extruding {
+        } else if is_extruding && len == 0.0 {
+            self.pending
+                .push((Deferred(Finding::ExtrusionWithoutMotion), m.line, m.de));
+            self.in_run = false;
+        } else if bead {
             self.started = true;
-            // Whatever happened since the last bead was between beads.
-            for (kind, line, v) in std::mem::take(&mut self.pending) {
-                self.count(kind).add(line, v);
-            }
             self.r.extruding_moves += 1;
-            if len == 0.0 {
-                self.r.extrusion_without_motion.add(m.line, m.de);
+            // Whatever happened since the last bead was between beads: in
+            // the gap before the run this bead begins or goes on.
+            for (Deferred(kind), line, v) in std::mem::take(&mut self.pending) {
+                self.record(kind, line, v, true);
             }
             if !self.in_run {
-                self.r.extrusion_runs += 1;
-                if self.r.run_starts.len() < 20 {
-                    self.r.run_starts.push(m.line);
-                }
+                self.new_run(m);
             }
             self.in_run = true;
         } else if len > 0.0 {
             if self.started {
-                self.pending.push((Deferred::Travel, m.line, len));
+                self.pending
+                    .push((Deferred(Finding::TravelMove), m.line, len));
             }
             self.in_run = false;
         }
-        // Bounds.
+        // Bounds (the machine cannot go there, start code or not).
         let out =
             m.to.iter()
                 .zip(cfg.build_volume)
                 .fold(0.0f64, |o, (&v, lim)| larger(larger(o, -v), v - lim));
         if out > 1e-3 {
-            self.r.out_of_bounds.add(m.line, out);
+            self.r.findings[Finding::OutOfBounds].add(m.line, out);
         }
 
         // Deposition replay: support and collisions.
@@ -312,9 +588,68 @@ impl<'a> Checker<'a> {
         if !self.started {
             return;
         }
+        if self.deep && self.failures() > MAX_FAILURES {
+            self.deep = false;
+            self.diagnose(Diagnostic {
+                line: m.line,
+                message: format!(
+                    "over {MAX_FAILURES} failures: support and collisions are not analysed from here on"
+                ),
+            });
+        }
+        if self.deep {
+            self.probe(m, len, s_start, bead);
+        }
+        if bead {
+            self.bead(m, len, s_start);
+        }
+    }
+
+    /// Failures so far, held ones included.
+    fn failures(&self) -> usize {
+        self.r
+            .findings
+            .occurred()
+            .map(|(_, c)| c.count)
+            .sum::<usize>()
+            + self.lead.held.len()
+    }
+
+    /// A bead begins a new extrusion run.
+    fn new_run(&mut self, m: &Move) {
+        self.runs += 1;
+        if self.lead.decided {
+            if self.r.run_starts.len() < 20 {
+                self.r.run_starts.push(m.line);
+            }
+            return;
+        }
+        if self.lead.runs.len() >= MAX_LEAD_RUNS {
+            // Run after run and nothing laid on any: all of it counts.
+            self.decide(0);
+            if self.r.run_starts.len() < 20 {
+                self.r.run_starts.push(m.line);
+            }
+            return;
+        }
+        self.lead.runs.push(LeadRun {
+            first_bead: self.beads.len() as u32,
+            line: m.line,
+            last_line: m.line,
+            moves_before: self.r.moves - 1,
+            z: m.from[2].max(m.to[2]),
+            clay_mm3: 0.0,
+            beads: 0,
+            air: 0,
+            on_bed: 0,
+        });
+    }
+
+    /// Collisions at points every r/2 mm of path (at most 200 a move).
+    fn probe(&mut self, m: &Move, len: f64, s_start: f64, is_extruding: bool) {
+        let cfg = self.cfg;
         let recent_nozzle = cfg.nozzle_radius + cfg.width_max;
         let reach = cfg.nozzle_radius + cfg.width_max / 2.0;
-        // Collisions at points every r/2 mm of path (at most 200 a move).
         let every = (cfg.nozzle_radius / 2.0).max(0.5);
         // Path distances are ≥ 0, where truncation is the floor (and no
         // library call).
@@ -338,7 +673,7 @@ impl<'a> Checker<'a> {
                 .settle(&self.beads, |b| b.s_end <= sp - recent_nozzle);
             if self.top_z > p[2] + cfg.nozzle_height + cfg.collision_tolerance_mm {
                 let v = self.top_z - p[2] - cfg.nozzle_height;
-                self.defer_or_add(is_extruding, Deferred::Carriage, m.line, v);
+                self.defer_or_add(is_extruding, Finding::CarriageCollision, m.line, v);
             }
             let mut worst: f64 = 0.0;
             let zlo = p[2] + cfg.collision_tolerance_mm;
@@ -355,19 +690,44 @@ impl<'a> Checker<'a> {
                     }
                 });
             if worst > 0.0 {
-                self.defer_or_add(is_extruding, Deferred::Nozzle, m.line, worst);
+                self.defer_or_add(is_extruding, Finding::NozzleCollision, m.line, worst);
             }
         }
-        if !is_extruding || len == 0.0 {
-            return;
+    }
+
+    /// Ends a stretch of beads on clay at their own height: a failure if
+    /// it is longer than 2 w_max and most of its clay had no room.
+    fn close_stretch(&mut self) {
+        let st = std::mem::take(&mut self.stretch);
+        if st.length > 2.0 * self.cfg.width_max && st.excess > 0.75 * st.volume {
+            self.record(Finding::DoubleDeposition, st.first_line, st.excess, false);
         }
-        self.bead(m, len, s_start);
     }
 
     /// Support analysis of an extruding move, then its bead joins the clay.
     fn bead(&mut self, m: &Move, len: f64, s_start: f64) {
         let cfg = self.cfg;
         let s = self.s;
+        let volume = m.de / cfg.e_per_mm3;
+        self.last_bead = (self.r.moves, m.line);
+        if !self.lead.decided {
+            if let Some(run) = self.lead.runs.last_mut() {
+                run.beads += 1;
+                run.clay_mm3 += volume;
+                run.last_line = m.line;
+            }
+        }
+        let low_z = m.from[2].min(m.to[2]);
+        if low_z < cfg.first_layer_min_mm {
+            self.record(
+                Finding::IntoBed,
+                m.line,
+                cfg.first_layer_min_mm - low_z,
+                false,
+            );
+        }
+        let mut found: Option<(Option<u32>, Option<f64>, bool)> = None;
+        let self_decided = self.lead.decided;
         let Checker {
             r,
             beads,
@@ -385,19 +745,20 @@ impl<'a> Checker<'a> {
             walk,
             steepest,
             overhang_near,
+            stretch,
+            deep,
+            prev_stub,
+            prev_overlap,
             ..
         } = self;
+        let mut held: Vec<(Finding, f64)> = Vec::new();
         r.path_length_mm += len;
-        let volume = m.de / cfg.e_per_mm3;
         r.volume_ml += volume / 1000.0;
         for p in [m.from, m.to] {
             for a in 0..3 {
                 lo[a] = smaller(lo[a], p[a]);
                 hi[a] = larger(hi[a], p[a]);
             }
-        }
-        if r.first_layer_z.is_none() {
-            r.first_layer_z = Some(m.from[2].max(m.to[2]));
         }
         let rise = (m.to[2] - m.from[2]).abs();
         // The plan vector and length, once for every use below.
@@ -406,6 +767,7 @@ impl<'a> Checker<'a> {
         let step = xy <= 2.0 * rise;
         let id = beads.len() as u32;
         let mut width = cfg.width_min;
+        let mut height = 0.0;
         let horizon = s_start - 2.0 * cfg.width_max;
         settle(
             beads,
@@ -421,9 +783,10 @@ impl<'a> Checker<'a> {
         } else {
             recent.turn(d, xy, s_start)
         };
+        let mut on_clay = false;
         if step {
             r.support.steps += 1;
-        } else {
+        } else if *deep {
             let mid = [
                 0.5 * (m.from[0] + m.to[0]),
                 0.5 * (m.from[1] + m.to[1]),
@@ -446,36 +809,78 @@ impl<'a> Checker<'a> {
                 })
                 .and_then(|j| follow_support(beads, *support_settled, support_tops, j, &q));
             r.support.beads += 1;
-            let support = if fast.is_some() {
-                fast
+            let (support, own) = if fast.is_some() {
+                (fast, None)
             } else {
-                let (support, double) = search_support(beads, grid, blocks, scratch, &q, *walk);
-                if double {
-                    r.support.double_deposition.add(m.line, 0.0);
-                }
-                support
+                search_support(beads, grid, blocks, scratch, &q, *walk)
             };
             *prev_support = support.map(|c| c.id);
-            let (dz, overlap, offset) = match support {
+            let near_bed = mid[2] <= cfg.first_layer_max_mm;
+            if let Some(z_own) = own {
+                // Clay at its own height under its middle: the bead is
+                // pressed onto it. Its clay has the gap above that clay to
+                // spread in, at most twice the widest bead wide.
+                on_clay = true;
+                r.support.on_clay += 1;
+                let gap = (mid[2] - z_own).max(0.0);
+                let room = len * gap * 2.0 * cfg.width_max;
+                if stretch.length == 0.0 {
+                    stretch.first_line = m.line;
+                }
+                stretch.length += len;
+                stretch.volume += volume;
+                stretch.excess += (volume - room).max(0.0);
+                if gap > 0.05 {
+                    width = volume / (len * gap);
+                    height = gap;
+                    minmax(&mut r.support.width, width, m.line);
+                    if width > cfg.width_max * (1.0 + WIDTH_TOLERANCE) {
+                        r.support.wide.add(m.line, width);
+                    }
+                } else {
+                    width = cfg.width_max;
+                }
+            }
+            found = Some((support.map(|c| c.id), own, near_bed));
+            let (dz, overlap, offset, below_h) = match support {
+                _ if on_clay => (f64::NAN, f64::NAN, 0.0, 0.0),
                 Some(c) => {
                     let dz = mid[2] - c.z;
                     width = volume / (len * dz);
-                    (dz, overlap_fraction(width, c.width, c.d), c.d)
+                    // A bead thinner than the one below it and wider (a
+                    // vase's first turn rising from its flat loop), or
+                    // wider than the widest bead, is pressed onto it and
+                    // spreads over its shoulders: judged by its core, a
+                    // bead as wide as the one it is pressed on.
+                    let pressed = width > c.width && dz < 0.95 * c.height;
+                    let core = if width > cfg.width_max || pressed {
+                        width.min(c.width.max(cfg.width_min))
+                    } else {
+                        width
+                    };
+                    (dz, overlap_fraction(core, c.width, c.d), c.d, c.height)
                 }
-                None if mid[2] <= cfg.first_layer_max_mm => {
+                None if near_bed => {
                     r.support.on_bed += 1;
                     width = volume / (len * mid[2].max(1e-6));
-                    (mid[2], 1.0, 0.0)
+                    (mid[2], 1.0, 0.0, 0.0)
                 }
                 None => {
-                    r.support.unsupported.add(m.line, mid[2]);
-                    (f64::NAN, f64::NAN, 0.0)
+                    held.push((Finding::Unsupported, mid[2]));
+                    (f64::NAN, f64::NAN, 0.0, 0.0)
                 }
             };
-            if dz.is_finite() {
+            // A bead into the bed has no layer height or width to speak of.
+            if dz.is_finite() && low_z >= cfg.first_layer_min_mm {
+                height = dz;
                 layer_heights.push(dz);
                 minmax(&mut r.support.layer_height, dz, m.line);
                 minmax(&mut r.support.width, width, m.line);
+                if width > cfg.width_max * (1.0 + WIDTH_TOLERANCE) {
+                    r.support.wide.add(m.line, width);
+                } else if width < cfg.width_min * (1.0 - WIDTH_TOLERANCE) {
+                    r.support.thin.add(m.line, cfg.width_min - width);
+                }
                 let bin = if overlap < 0.5 {
                     0
                 } else if overlap < 0.6 {
@@ -491,15 +896,29 @@ impl<'a> Checker<'a> {
                 if r.support.min_overlap.is_none_or(|(v, _)| overlap < v) {
                     r.support.min_overlap = Some((overlap, m.line));
                 }
+                // A bead much shorter than it is wide (a slicer's stub at a
+                // layer change) is a blob joined to the bead before: it is
+                // as well supported as that bead, if that one is no stub.
+                let stub = xy < 0.25 * cfg.width_min;
+                let overlap = if stub && !*prev_stub {
+                    overlap.max(*prev_overlap)
+                } else {
+                    overlap
+                };
+                *prev_stub = stub;
+                *prev_overlap = overlap;
                 if overlap < cfg.overlap_min - 1e-9 {
-                    r.support.under_min.add(m.line, cfg.overlap_min - overlap);
+                    held.push((Finding::UnderMinOverlap, cfg.overlap_min - overlap));
                 }
                 if overlap < cfg.overlap_target - 1e-6 {
                     r.support.under_target += 1;
                 }
-                // The angle (an arc tangent) only when it can matter: a
-                // new steepest or one near the limit.
-                let ratio = offset / dz;
+                // The angle against the bead's real geometry: a bead
+                // thinner than the one it rests on leans over that bead's
+                // height, not over its own (a finishing turn 0.3 mm up is
+                // no 80° overhang). An arc tangent only when it can
+                // matter: a new steepest or one near the limit.
+                let ratio = offset / dz.max(below_h);
                 if !(ratio <= *steepest && ratio < *overhang_near) {
                     *steepest = steepest.max(ratio);
                     let angle = ratio.atan().to_degrees();
@@ -507,12 +926,12 @@ impl<'a> Checker<'a> {
                         r.support.max_overhang_deg = Some((angle, m.line));
                     }
                     if angle > cfg.max_overhang_deg + cfg.overhang_tolerance_deg {
-                        r.support.overhang.add(m.line, angle);
+                        held.push((Finding::Overhang, angle));
                     }
                 }
             }
         }
-        let bead = Bead::new(
+        let mut bead = Bead::new(
             m.from,
             m.to,
             if width.is_finite() {
@@ -523,16 +942,96 @@ impl<'a> Checker<'a> {
             s,
             step,
         );
-        grid.insert(&bead, id);
+        bead.height32 = if height.is_finite() {
+            height as f32
+        } else {
+            0.0
+        };
+        if *deep {
+            grid.insert(&bead, id);
+        }
         let low = bead.from32[2].min(bead.to32[2]);
         let heading = (xy > 1e-9 && !step).then(|| [d[0] / xy, d[1] / xy]);
         recent.push(id, heading, s, low, turn);
-        *top_z = top_z.max(m.from[2].max(m.to[2]));
+        // A purge in the air before the print is no clay the carriage can
+        // hit (its clay falls off).
+        let air = !self_decided && matches!(found, Some((None, None, false)));
+        if !air {
+            *top_z = top_z.max(m.from[2].max(m.to[2]));
+        }
         beads.push(bead);
+        if !on_clay && !step {
+            self.close_stretch();
+        }
+        for (kind, v) in held {
+            self.record(kind, m.line, v, false);
+        }
+        let Some((support, _own, near_bed)) = found else {
+            return;
+        };
+        if self.lead.decided {
+            return;
+        }
+        match support {
+            // Clay laid on an earlier run's bead: that run is the print's.
+            Some(j) => {
+                let k = self.lead.runs.partition_point(|r| r.first_bead <= j);
+                self.decide(k.saturating_sub(1));
+            }
+            None if !near_bed && !on_clay => {
+                if let Some(run) = self.lead.runs.last_mut() {
+                    run.air += 1;
+                }
+                if self.lead.air.len() < MAX_HELD {
+                    self.lead.air.push(id);
+                }
+            }
+            None => {
+                if let Some(run) = self.lead.runs.last_mut() {
+                    run.on_bed += usize::from(near_bed);
+                }
+            }
+        }
     }
 
     fn finish(mut self) -> Report {
+        self.close_stretch();
+        if !self.lead.decided {
+            // Nothing rests on anything (a single layer): the print begins
+            // at the first run that is not a purge in the air.
+            let runs = &self.lead.runs;
+            let k = runs.iter().position(|r| r.air * 2 <= r.beads).unwrap_or(0);
+            self.decide(k);
+        }
+        let start = std::mem::take(&mut self.lead.start);
+        self.r.start_code = (!start.items.is_empty()).then_some(start);
+        self.r.extrusion_runs = self.runs.saturating_sub(self.lead.print_run);
+        // What follows the last bead is the end code.
+        let (moves_at, line_at) = self.last_bead;
+        if self.started && (self.r.moves > moves_at || !self.pending.is_empty()) {
+            let mut end = Segment {
+                lines: [line_at + 1, self.r.lines],
+                moves: self.r.moves - moves_at,
+                ..Segment::default()
+            };
+            for (Deferred(kind), line, _) in &self.pending {
+                end.note(match kind {
+                    Finding::Retraction => format!("end retraction (line {line})"),
+                    Finding::TravelMove => "lifting off and travel".into(),
+                    Finding::Pause => format!("pause (line {line})"),
+                    _ => "moves through the clay after the print (homing), not judged".into(),
+                });
+            }
+            if end.items.is_empty() {
+                end.note("moves after the last bead".into());
+            }
+            self.r.end_code = Some(end);
+        }
         let r = &mut self.r;
+        let ambiguous = &self.parser.ambiguous;
+        if ambiguous.count > 0 {
+            r.findings[Finding::AmbiguousNumber] = ambiguous.clone();
+        }
         let (lo, hi) = (self.lo, self.hi);
         if r.extruding_moves > 0 {
             r.size_mm = [hi[0] - lo[0], hi[1] - lo[1], hi[2].max(0.0)];
@@ -549,8 +1048,10 @@ impl<'a> Checker<'a> {
             }
         }
         self.diags.sort_by_key(|d| d.line);
-        self.diags.truncate(50);
+        r.diagnostics_total = self.diags.len() + self.diags_dropped;
         r.diagnostics = self.diags;
+        r.printer = self.cfg.printer.clone();
+        r.firmware = self.cfg.firmware.name().to_string();
         verdict(r, self.cfg);
         self.r
     }

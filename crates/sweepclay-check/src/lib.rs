@@ -39,6 +39,7 @@ mod blocks;
 mod checker;
 mod geom;
 mod grid;
+pub mod header;
 pub mod parse;
 pub mod replay;
 mod report;
@@ -50,7 +51,7 @@ pub use checker::{check, check_reader, CheckWriter};
 #[doc(hidden)]
 pub use checker::{check_exhaustive, check_pruned};
 pub use parse::Diagnostic;
-pub use report::{Count, Report, SupportStats};
+pub use report::{Count, Finding, Findings, Report, Segment, SupportStats};
 
 /// One xorshift step: the unit tests' reproducible random numbers.
 #[cfg(test)]
@@ -66,8 +67,19 @@ use serde::Serialize;
 /// What the checker assumes about the printer and the clay. Lengths in mm.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct CheckConfig {
-    /// Build volume `[x, y, z]`; the bed spans `0..x`, `0..y`. Default 200³.
+    /// Build volume `[x, y, z]`: the printer's box spans `bed_min` to
+    /// `bed_min + build_volume`. Default 200³.
     pub build_volume: [f64; 3],
+    /// The box's lowest corner in the printer's coordinates: `[0, 0, 0]`
+    /// (the default) for a bed with its origin at a corner, `[-R, -R, 0]`
+    /// for a delta or a WASP with the origin at the bed's centre.
+    pub bed_min: [f64; 3],
+    /// The printer the file is judged for, as the report names it
+    /// (default `generic`).
+    pub printer: String,
+    /// Whose reading of the G-code to replay where firmwares differ.
+    /// Default Marlin.
+    pub firmware: Firmware,
     /// E units per mm³ of clay. Default 0.13.
     pub e_per_mm3: f64,
     /// Radius of the extruder body (nozzle cylinder). Default 5.
@@ -94,6 +106,9 @@ pub struct CheckConfig {
     pub min_layer_mm: f64,
     /// The first bead must start at most this high. Default 3.
     pub first_layer_max_mm: f64,
+    /// No bead of the print may have a point lower than this: below it
+    /// the nozzle drags on the bed. Default 0.3.
+    pub first_layer_min_mm: f64,
     /// Clay deeper than this below a bead does not support it. Default 6.
     pub max_gap_mm: f64,
     /// Clay this little above the nozzle tip is not a collision: a graze
@@ -105,6 +120,9 @@ impl Default for CheckConfig {
     fn default() -> Self {
         CheckConfig {
             build_volume: [200.0, 200.0, 200.0],
+            bed_min: [0.0, 0.0, 0.0],
+            printer: "generic".into(),
+            firmware: Firmware::Marlin,
             e_per_mm3: 0.13,
             nozzle_radius: 5.0,
             nozzle_height: 30.0,
@@ -116,8 +134,142 @@ impl Default for CheckConfig {
             overhang_tolerance_deg: 0.5,
             min_layer_mm: 0.3,
             first_layer_max_mm: 3.0,
+            first_layer_min_mm: 0.3,
             max_gap_mm: 6.0,
             collision_tolerance_mm: 0.2,
         }
+    }
+}
+
+/// The firmwares whose readings of G-code differ where the checker must
+/// choose (docs/CHECKER.md, "Firmwares").
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Firmware {
+    /// Marlin: `G90`/`G91` also switch E; `Z5e-05` is Z 0.00005.
+    #[default]
+    Marlin,
+    /// Klipper: `G90`/`G91` leave E as `M82`/`M83` set it; `Z5e-05` is
+    /// Z5 then E-05.
+    Klipper,
+    /// RepRapFirmware: `G90`/`G91` leave E as `M82`/`M83` set it; `Z5e-05`
+    /// is Z 0.00005.
+    Reprap,
+}
+
+impl Firmware {
+    /// The name used on the command line and in reports.
+    pub fn name(self) -> &'static str {
+        match self {
+            Firmware::Marlin => "marlin",
+            Firmware::Klipper => "klipper",
+            Firmware::Reprap => "reprap",
+        }
+    }
+
+    /// Whether `G90`/`G91` also set absolute/relative E.
+    pub fn g91_moves_e(self) -> bool {
+        self == Firmware::Marlin
+    }
+
+    /// Whether a number's `e`/`E` starts an exponent (`5e-05` is one
+    /// number) rather than the next word.
+    pub fn reads_exponents(self) -> bool {
+        self != Firmware::Klipper
+    }
+}
+
+impl std::str::FromStr for Firmware {
+    type Err = String;
+    fn from_str(s: &str) -> Result<Self, String> {
+        match s.to_ascii_lowercase().as_str() {
+            "marlin" => Ok(Firmware::Marlin),
+            "klipper" => Ok(Firmware::Klipper),
+            "reprap" | "rrf" | "reprapfirmware" => Ok(Firmware::Reprap),
+            _ => Err(format!(
+                "unknown firmware `{s}` (marlin, klipper or reprap)"
+            )),
+        }
+    }
+}
+
+/// An option of [`CheckConfig`] out of its range: which one (the field's
+/// name) and why.
+#[derive(Clone, Debug, PartialEq, thiserror::Error)]
+#[error("`{field}` {reason}")]
+pub struct ConfigError {
+    /// The field of [`CheckConfig`].
+    pub field: &'static str,
+    /// What is wrong with its value.
+    pub reason: String,
+}
+
+impl CheckConfig {
+    /// Checks every value: finite, positive where it must be, fractions in
+    /// [0, 1], angles in (0, 90). A NaN would silently turn every test it
+    /// enters into a pass.
+    pub fn validate(&self) -> Result<(), ConfigError> {
+        let err = |field, reason: String| Err(ConfigError { field, reason });
+        for (field, v) in [
+            (
+                "build_volume",
+                self.build_volume
+                    .iter()
+                    .copied()
+                    .fold(f64::INFINITY, f64::min),
+            ),
+            ("e_per_mm3", self.e_per_mm3),
+            ("nozzle_height", self.nozzle_height),
+            ("width_min", self.width_min),
+            ("width_max", self.width_max),
+            ("min_layer_mm", self.min_layer_mm),
+            ("first_layer_max_mm", self.first_layer_max_mm),
+            ("max_gap_mm", self.max_gap_mm),
+        ] {
+            if !(v.is_finite() && v > 0.0) {
+                return err(field, format!("must be a positive number (got {v})"));
+            }
+        }
+        for (field, v) in [
+            (
+                "bed_min",
+                self.bed_min.iter().copied().fold(0.0, |a, b| a + b),
+            ),
+            ("nozzle_radius", self.nozzle_radius),
+            ("first_layer_min_mm", self.first_layer_min_mm),
+            ("collision_tolerance_mm", self.collision_tolerance_mm),
+            ("overhang_tolerance_deg", self.overhang_tolerance_deg),
+        ] {
+            if !v.is_finite() || (field != "bed_min" && v < 0.0) {
+                return err(field, format!("must be a finite number ≥ 0 (got {v})"));
+            }
+        }
+        if self.width_max < self.width_min {
+            return err(
+                "width_max",
+                format!(
+                    "must be at least width_min {} (got {})",
+                    self.width_min, self.width_max
+                ),
+            );
+        }
+        for (field, v) in [
+            ("overlap_target", self.overlap_target),
+            ("overlap_min", self.overlap_min),
+        ] {
+            if !(0.0..=1.0).contains(&v) {
+                return err(field, format!("must be a fraction from 0 to 1 (got {v})"));
+            }
+        }
+        if !(self.max_overhang_deg > 0.0 && self.max_overhang_deg < 90.0) {
+            return err(
+                "max_overhang_deg",
+                format!(
+                    "must be an angle between 0 and 90 degrees (got {})",
+                    self.max_overhang_deg
+                ),
+            );
+        }
+        Ok(())
     }
 }

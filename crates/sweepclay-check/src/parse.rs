@@ -68,6 +68,22 @@ impl Line {
 #[derive(Debug, Default)]
 pub struct LineParser {
     clean: String,
+    /// Whose reading of an exponent (`Z5e-05`) to follow.
+    pub firmware: crate::Firmware,
+    /// Numbers in exponent form met so far, with the line of the first:
+    /// firmwares read them differently, so each is a failure.
+    pub ambiguous: crate::Count,
+}
+
+/// Whether `s` from byte `i` on starts an exponent: `e` or `E`, then a
+/// digit, or a sign and a digit.
+fn exponent_at(s: &[u8], i: usize) -> bool {
+    matches!(s.get(i), Some(b'e' | b'E'))
+        && match s.get(i + 1) {
+            Some(b'+' | b'-') => s.get(i + 2).is_some_and(u8::is_ascii_digit),
+            Some(c) => c.is_ascii_digit(),
+            None => false,
+        }
 }
 
 /// The char at byte `i` of `s` and its length.
@@ -233,12 +249,37 @@ impl LineParser {
             i = skip_while(s, start, |c| !ends_word(c));
             // Allow "X 10" (space between letter and number).
             let mut num = &s[start..i];
+            let mut num_start = start;
             if num.is_empty() {
                 let s2 = skip_while(s, i, char::is_whitespace);
                 let j = skip_while(s, s2, |c| !ends_word(c));
                 let first = s.as_bytes().get(s2).copied().unwrap_or(b' ');
                 if j > s2 && (first.is_ascii_digit() || matches!(first, b'-' | b'+' | b'.')) {
                     num = &s[s2..j];
+                    num_start = s2;
+                    i = j;
+                }
+            }
+            let digits = num.bytes().any(|b| b.is_ascii_digit())
+                && num
+                    .bytes()
+                    .all(|b| b.is_ascii_digit() || matches!(b, b'.' | b'-' | b'+'));
+            if digits && exponent_at(s.as_bytes(), i) {
+                let j = skip_while(s, i + 2, |c| c.is_ascii_digit());
+                let whole = &s[num_start..j];
+                let marlin = whole.trim().parse::<f64>().unwrap_or(f64::NAN);
+                let exp = &s[i + 1..j];
+                self.ambiguous.add(n, 0.0);
+                diags.push(Diagnostic {
+                    line: n,
+                    message: format!(
+                        "`{letter}{}` reads as {letter}{marlin} in Marlin and RepRapFirmware but as {letter}{} E{exp} in Klipper; write plain decimals",
+                        whole.trim(),
+                        num.trim()
+                    ),
+                });
+                if self.firmware.reads_exponents() {
+                    num = whole;
                     i = j;
                 }
             }
@@ -290,6 +331,9 @@ fn plain_words(raw: &[u8], params: &mut Vec<(char, f64)>) -> bool {
         }
         let (v, end) = number(raw, i);
         let Some(v) = v else { return false };
+        if exponent_at(raw, end) {
+            return false;
+        }
         params.push((char::from(b.to_ascii_uppercase()), v));
         i = end;
     }

@@ -70,6 +70,8 @@ pub struct Replayer {
     scale: f64,
     feed: f64,
     unknown_reported: std::collections::BTreeSet<String>,
+    /// Whose reading of `G90`/`G91` to follow (they switch E in Marlin).
+    pub firmware: crate::Firmware,
 }
 
 impl Default for Replayer {
@@ -82,6 +84,7 @@ impl Default for Replayer {
             scale: 1.0,
             feed: 0.0,
             unknown_reported: Default::default(),
+            firmware: crate::Firmware::Marlin,
         }
     }
 }
@@ -157,11 +160,15 @@ impl Replayer {
             }
             ('G', 90.0) => {
                 self.abs_xyz = true;
-                self.abs_e = true;
+                if self.firmware.g91_moves_e() {
+                    self.abs_e = true;
+                }
             }
             ('G', 91.0) => {
                 self.abs_xyz = false;
-                self.abs_e = false;
+                if self.firmware.g91_moves_e() {
+                    self.abs_e = false;
+                }
             }
             ('G', 92.0) => {
                 if l.params.is_empty() {
@@ -190,7 +197,10 @@ impl Replayer {
             ('G', c) if [29.0, 17.0, 80.0].contains(&c) => {}
             ('T', _) => {}
             (k, c) => {
-                if self.unknown_reported.insert(format!("{k}{c}")) {
+                // One note a command, for the first 64 distinct ones.
+                if self.unknown_reported.len() < 64
+                    && self.unknown_reported.insert(format!("{k}{c}"))
+                {
                     diags.push(Diagnostic {
                         line: l.line,
                         message: format!("unknown command {k}{c} ignored"),

@@ -27,6 +27,175 @@ impl Count {
     }
 }
 
+/// Everything that makes a file not printable in clay, one kind each. The
+/// verdict, the text report, `--json` and the modeler's failure lines all
+/// read this one list.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Hash, Serialize)]
+#[serde(rename_all = "snake_case")]
+pub enum Finding {
+    /// A move without extrusion between two beads of the print.
+    TravelMove,
+    /// E going back between two beads of the print.
+    Retraction,
+    /// G4, M0, M1 or M600 between two beads of the print.
+    Pause,
+    /// E rising with no motion between two beads of the print: a blob.
+    ExtrusionWithoutMotion,
+    /// A move outside the printer's box; worst distance outside (mm).
+    OutOfBounds,
+    /// A print bead with a point below the first-layer minimum: the nozzle
+    /// dragged on or into the bed; worst depth below the minimum (mm).
+    IntoBed,
+    /// The print's first bead too far above the bed; its height (mm).
+    FirstLayerHigh,
+    /// Earlier clay inside the nozzle cylinder; worst height above the tip.
+    NozzleCollision,
+    /// Clay higher than the carriage; worst height above it (mm).
+    CarriageCollision,
+    /// A bead with no clay below it and not on the bed; its height (mm).
+    Unsupported,
+    /// A stretch of beads laid on clay at their own height whose clay has
+    /// no room to go; the clay that has none (mm³).
+    DoubleDeposition,
+    /// A bead overlapping the bead below by less than the minimum; the
+    /// shortfall (fraction of its width).
+    UnderMinOverlap,
+    /// An overhang beyond the limit; the angle (degrees).
+    Overhang,
+    /// A number firmwares read differently (`Z5e-05`).
+    AmbiguousNumber,
+}
+
+impl Finding {
+    /// Every kind, in the order reports list them.
+    pub const ALL: [Finding; 14] = [
+        Finding::TravelMove,
+        Finding::Retraction,
+        Finding::Pause,
+        Finding::ExtrusionWithoutMotion,
+        Finding::OutOfBounds,
+        Finding::IntoBed,
+        Finding::FirstLayerHigh,
+        Finding::NozzleCollision,
+        Finding::CarriageCollision,
+        Finding::Unsupported,
+        Finding::DoubleDeposition,
+        Finding::UnderMinOverlap,
+        Finding::Overhang,
+        Finding::AmbiguousNumber,
+    ];
+
+    /// The row of the text report (with the unit of the worst value).
+    pub fn label(self) -> &'static str {
+        match self {
+            Finding::TravelMove => "travel moves",
+            Finding::Retraction => "retractions",
+            Finding::Pause => "pauses",
+            Finding::ExtrusionWithoutMotion => "extrusion without motion",
+            Finding::OutOfBounds => "out of bounds (mm)",
+            Finding::IntoBed => "beads into the bed (mm)",
+            Finding::FirstLayerHigh => "first layer too high (mm)",
+            Finding::NozzleCollision => "nozzle collisions (mm)",
+            Finding::CarriageCollision => "carriage collisions (mm)",
+            Finding::Unsupported => "unsupported beads",
+            Finding::DoubleDeposition => "clay on clay (mm³)",
+            Finding::UnderMinOverlap => "overlap < minimum",
+            Finding::Overhang => "overhang > limit (deg)",
+            Finding::AmbiguousNumber => "ambiguous numbers",
+        }
+    }
+
+    /// What the verdict says of `n` of them.
+    pub fn failure(self) -> &'static str {
+        match self {
+            Finding::TravelMove => "travel move(s) after the first bead",
+            Finding::Retraction => "retraction(s)",
+            Finding::Pause => "pause(s)",
+            Finding::ExtrusionWithoutMotion => "extrusion(s) without motion",
+            Finding::OutOfBounds => "move(s) outside the build volume",
+            Finding::IntoBed => "bead(s) at or into the bed (the nozzle drags on it)",
+            Finding::FirstLayerHigh => "first layer too far above the bed",
+            Finding::NozzleCollision => "nozzle collision(s) with printed clay",
+            Finding::CarriageCollision => "carriage collision(s) with printed clay",
+            Finding::Unsupported => "bead(s) with no clay below",
+            Finding::DoubleDeposition => "stretch(es) of beads laid on clay at their own height",
+            Finding::UnderMinOverlap => "bead(s) overlapping the bead below by less than half",
+            Finding::Overhang => "overhang(s) beyond the limit",
+            Finding::AmbiguousNumber => "number(s) that firmwares read differently",
+        }
+    }
+}
+
+/// One [`Count`] per [`Finding`]; `--json` writes them as an object keyed
+/// by the finding's snake-case name.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Findings([Count; Finding::ALL.len()]);
+
+impl std::ops::Index<Finding> for Findings {
+    type Output = Count;
+    fn index(&self, f: Finding) -> &Count {
+        &self.0[f as usize]
+    }
+}
+
+impl std::ops::IndexMut<Finding> for Findings {
+    fn index_mut(&mut self, f: Finding) -> &mut Count {
+        &mut self.0[f as usize]
+    }
+}
+
+impl Findings {
+    /// The kinds that occurred, with their counts, in report order.
+    pub fn occurred(&self) -> impl Iterator<Item = (Finding, &Count)> {
+        Finding::ALL
+            .into_iter()
+            .map(move |f| (f, &self[f]))
+            .filter(|(_, c)| c.count > 0)
+    }
+}
+
+impl Serialize for Findings {
+    fn serialize<S: serde::Serializer>(&self, s: S) -> Result<S::Ok, S::Error> {
+        use serde::ser::SerializeMap;
+        let mut m = s.serialize_map(Some(Finding::ALL.len()))?;
+        for f in Finding::ALL {
+            m.serialize_entry(&f, &self[f])?;
+        }
+        m.end()
+    }
+}
+
+/// Start or end code: what comes before the print's first bead or after
+/// its last (DESIGN.md §9: reported, never a reason to fail).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct Segment {
+    /// First and last line of it.
+    pub lines: [usize; 2],
+    /// Moves in it.
+    pub moves: usize,
+    /// Clay it extrudes (ml): primes, purges, a skirt.
+    pub clay_ml: f64,
+    /// What it holds, in words with lines (at most 12).
+    pub items: Vec<String>,
+}
+
+impl Segment {
+    /// Notes `item` (kept while there are fewer than 12).
+    pub(crate) fn note(&mut self, item: String) {
+        if self.items.len() < 12 && !self.items.contains(&item) {
+            self.items.push(item);
+        }
+    }
+
+    /// Widens the line range to hold `line`.
+    pub(crate) fn cover(&mut self, line: usize) {
+        if self.lines[0] == 0 || line < self.lines[0] {
+            self.lines[0] = line;
+        }
+        self.lines[1] = self.lines[1].max(line);
+    }
+}
+
 /// Support of the beads on the clay below.
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct SupportStats {
@@ -36,26 +205,28 @@ pub struct SupportStats {
     pub on_bed: usize,
     /// Vertical steps (turnarounds): extruding moves steeper than 1:2.
     pub steps: usize,
+    /// Beads laid on clay at about their own height (a vase's first turn
+    /// rising from its flat first loop, a seam): pressed into the clay
+    /// below rather than resting a layer above it.
+    pub on_clay: usize,
     /// Smallest overlap fraction and its line.
     pub min_overlap: Option<(f64, usize)>,
     /// Beads by overlap: `<1/2`, `1/2–0.6`, `0.6–target`, `target–0.9`, `≥0.9`.
     pub overlap_histogram: [usize; 5],
-    /// Beads under the hard minimum (fail).
-    pub under_min: Count,
     /// Beads under the target (reported).
     pub under_target: usize,
-    /// Overhang angles beyond the threshold (fail); worst in degrees.
-    pub overhang: Count,
     /// Largest overhang angle (degrees) and its line.
     pub max_overhang_deg: Option<(f64, usize)>,
-    /// Beads with no clay below them and not on the bed (fail).
-    pub unsupported: Count,
-    /// Beads laid where clay already is at that height (fail).
-    pub double_deposition: Count,
     /// Smallest and largest local layer height (mm) with lines.
     pub layer_height: Option<[(f64, usize); 2]>,
     /// Smallest and largest bead width (mm) with lines.
     pub width: Option<[(f64, usize); 2]>,
+    /// Beads wider than `width_max` by more than the tolerance
+    /// (over-squished; a warning). Worst width (mm).
+    pub wide: Count,
+    /// Beads narrower than `width_min` by more than the tolerance (a
+    /// warning). Worst: how much narrower (mm).
+    pub thin: Count,
 }
 
 /// The full report. `printable` is the verdict.
@@ -65,32 +236,30 @@ pub struct Report {
     pub printable: bool,
     /// The reasons it is not (empty when printable).
     pub failures: Vec<String>,
+    /// What deserves a look but prints (over-squished beads, …).
+    pub warnings: Vec<String>,
+    /// The printer the file was judged for, and where that came from.
+    pub printer: String,
+    /// The firmware whose reading of the G-code was replayed.
+    pub firmware: String,
     /// Lines in the file.
     pub lines: usize,
     /// Moves replayed.
     pub moves: usize,
     /// Extruding moves.
     pub extruding_moves: usize,
-    /// Separate extrusion runs (must be 1); first lines of up to 20.
+    /// Separate extrusion runs in the print (must be 1).
     pub extrusion_runs: usize,
-    /// First lines of the runs (at most 20).
+    /// First lines of the print's runs (at most 20).
     pub run_starts: Vec<usize>,
-    /// Moves without extrusion after the first bead.
-    pub travel_moves: Count,
-    /// Moves with negative E.
-    pub retractions: Count,
-    /// Pauses after the first bead.
-    pub pauses: Count,
-    /// Extrusion with no motion.
-    pub extrusion_without_motion: Count,
-    /// Moves outside the build volume; worst distance outside (mm).
-    pub out_of_bounds: Count,
-    /// Height of the first bead.
+    /// Every kind of failure: how many, where first, how bad at worst.
+    pub findings: Findings,
+    /// Height of the print's first bead.
     pub first_layer_z: Option<f64>,
-    /// Clay inside the nozzle cylinder; worst height above the tip (mm).
-    pub nozzle_collisions: Count,
-    /// Clay above the carriage; worst height above the carriage (mm).
-    pub carriage_collisions: Count,
+    /// Start code: before the print's first bead.
+    pub start_code: Option<Segment>,
+    /// End code: after the print's last bead.
+    pub end_code: Option<Segment>,
     /// Support analysis.
     pub support: SupportStats,
     /// Length of the extrusion path (mm).
@@ -103,8 +272,10 @@ pub struct Report {
     pub size_mm: [f64; 3],
     /// Estimated layer count: height over the median layer height.
     pub layers: usize,
-    /// Parse and replay diagnostics (at most 50).
+    /// Parse and replay diagnostics (the first 50).
     pub diagnostics: Vec<Diagnostic>,
+    /// How many diagnostics there were in all.
+    pub diagnostics_total: usize,
 }
 
 fn at(c: &Count) -> String {
@@ -149,20 +320,16 @@ impl Report {
                 }
             ),
         );
-        for (k, c) in [
-            ("travel moves", &self.travel_moves),
-            ("retractions", &self.retractions),
-            ("pauses", &self.pauses),
-            ("extrusion without motion", &self.extrusion_without_motion),
-            ("out of bounds (mm)", &self.out_of_bounds),
-            ("nozzle collisions (mm)", &self.nozzle_collisions),
-            ("carriage collisions (mm)", &self.carriage_collisions),
-            ("unsupported beads", &self.support.unsupported),
-            ("double deposition", &self.support.double_deposition),
-            ("overlap < minimum", &self.support.under_min),
-            ("overhang > limit (deg)", &self.support.overhang),
-        ] {
-            row(&mut s, k, format!("{} {}", c.count, at(c)));
+        for f in Finding::ALL {
+            let c = &self.findings[f];
+            if c.count > 0
+                || !matches!(
+                    f,
+                    Finding::IntoBed | Finding::FirstLayerHigh | Finding::AmbiguousNumber
+                )
+            {
+                row(&mut s, f.label(), format!("{} {}", c.count, at(c)));
+            }
         }
         let sp = &self.support;
         row(
@@ -210,6 +377,17 @@ impl Report {
                 format!("{lo:.2} (line {ll}) .. {hi:.2} mm (line {hl})"),
             );
         }
+        for (k, c) in [
+            ("over-squished beads (mm)", &sp.wide),
+            ("thin beads (mm)", &sp.thin),
+        ] {
+            if c.count > 0 {
+                row(&mut s, k, format!("{} {}", c.count, at(c)));
+            }
+        }
+        if sp.on_clay > 0 {
+            row(&mut s, "beads pressed on clay", format!("{}", sp.on_clay));
+        }
         if let Some(z) = self.first_layer_z {
             row(&mut s, "first bead at z", format!("{z:.3} mm"));
         }
@@ -232,10 +410,43 @@ impl Report {
             "estimated time",
             format!("{:.1} min", self.time_min),
         );
+        for (k, seg) in [
+            ("start code", &self.start_code),
+            ("end code", &self.end_code),
+        ] {
+            if let Some(seg) = seg {
+                row(
+                    &mut s,
+                    k,
+                    format!(
+                        "lines {}-{}: {} moves, {:.2} ml of clay",
+                        seg.lines[0], seg.lines[1], seg.moves, seg.clay_ml
+                    ),
+                );
+                for item in &seg.items {
+                    let _ = writeln!(s, "  {:<26}   {item}", "");
+                }
+            }
+        }
+        row(&mut s, "printer", self.printer.clone());
+        row(&mut s, "firmware", self.firmware.clone());
+        if !self.warnings.is_empty() {
+            let _ = writeln!(s, "\n  warnings:");
+            for w in &self.warnings {
+                let _ = writeln!(s, "    {w}");
+            }
+        }
         if !self.diagnostics.is_empty() {
             let _ = writeln!(s, "\n  notes:");
             for d in &self.diagnostics {
                 let _ = writeln!(s, "    line {}: {}", d.line, d.message);
+            }
+            if self.diagnostics_total > self.diagnostics.len() {
+                let _ = writeln!(
+                    s,
+                    "    … and {} more",
+                    self.diagnostics_total - self.diagnostics.len()
+                );
             }
         }
         s

@@ -22,6 +22,8 @@ pub(crate) struct Candidate {
     pub(crate) at: [f64; 2],
     pub(crate) d: f64,
     pub(crate) width: f64,
+    /// The bead's own layer height.
+    pub(crate) height: f64,
     pub(crate) covers: bool,
 }
 
@@ -74,7 +76,7 @@ pub(crate) enum Class {
     /// Clay below that may support it.
     Below(Candidate),
     /// Clay already at its height under its middle.
-    Double,
+    Double(f64),
     /// Neither: too far, too deep, above it, a step, or behind the nozzle.
     Neither,
 }
@@ -126,6 +128,7 @@ impl Query<'_> {
                     at,
                     d,
                     width: b.width(),
+                    height: f64::from(b.height32),
                     covers: d <= b.width() / 2.0,
                 });
             }
@@ -134,8 +137,12 @@ impl Query<'_> {
             // Clay laid in the last 2 w_max of path is the run's own fresh
             // clay (a corner piles up, it is not laid twice).
             && s_start - b.s_end > 2.0 * cfg.width_max
+            // Under the middle within the bead's length, not past its end:
+            // a loop's last bead ending on its own first bead (a seam) is
+            // not laid on it.
+            && b.spans(mid)
         {
-            return Class::Double;
+            return Class::Double(z);
         }
         Class::Neither
     }
@@ -360,7 +367,7 @@ pub(crate) fn search_support(
     scratch: &mut Scratch,
     q: &Query,
     walk: Walk,
-) -> (Option<Candidate>, bool) {
+) -> (Option<Candidate>, Option<f64>) {
     let (mid, cfg) = (q.mid, q.cfg);
     let (zlo, zhi) = (mid[2] - cfg.max_gap_mm, mid[2] + cfg.min_layer_mm);
     let Scratch { runs, cands } = scratch;
@@ -388,14 +395,14 @@ pub(crate) fn search_support(
         return search_pruned(beads, blocks, runs, q, wider);
     }
     cands.clear();
-    let mut double = false;
+    let mut double: Option<f64> = None;
     let covered = std::cell::Cell::new(false);
     let mut classify = |j: u32| match q.classify(&beads[j as usize], j) {
         Class::Below(c) => {
             covered.set(covered.get() || c.covers);
             cands.push(c);
         }
-        Class::Double => double = true,
+        Class::Double(z) => double = Some(double.map_or(z, |d: f64| d.max(z))),
         Class::Neither => {}
     };
     let mut classify_runs = |runs: &[[u32; 2]]| {
@@ -453,7 +460,7 @@ fn search_pruned(
     runs: &mut Vec<[u32; 2]>,
     q: &Query,
     wider: impl FnOnce(&mut Vec<[u32; 2]>),
-) -> (Option<Candidate>, bool) {
+) -> (Option<Candidate>, Option<f64>) {
     let (mid, cfg) = (q.mid, q.cfg);
     let ml = cfg.min_layer_mm;
     let slack = 1e-6
@@ -474,7 +481,7 @@ fn search_pruned(
             || mid[2] - (f64::from(b.hi[2]) + slack) > cfg.max_gap_mm
     };
     let no_cover = |b: &Bound, lb: f64| off_window(b) || lb > f64::from(b.half_width);
-    let mut double = false;
+    let mut double = None;
     let mut cover = find.nearest(runs, no_cover, |c| c.covers, Some(&mut double));
     if cover.is_none() {
         // The first box's beads come again, and still cover nothing.
@@ -544,7 +551,7 @@ impl Nearest<'_> {
         runs: &[[u32; 2]],
         skip: impl Fn(&Bound, f64) -> bool,
         keep: impl Fn(&Candidate) -> bool,
-        mut double: Option<&mut bool>,
+        mut double: Option<&mut Option<f64>>,
     ) -> Option<Candidate> {
         let (mid, cfg, slack) = (self.q.mid, self.q.cfg, self.slack);
         let ml = cfg.min_layer_mm;
@@ -556,10 +563,10 @@ impl Nearest<'_> {
                     !(best.is_some_and(|c| lb > c.d) || skip(b, lb))
                         || double.as_ref().is_some_and(|found| {
                             // A bead at the new bead's height, under its
-                            // middle.
-                            !**found
-                                && lb < 0.5 * cfg.width_min
-                                && f64::from(b.hi[2]) + slack > mid[2] - ml
+                            // middle, higher than any found so far.
+                            lb < 0.5 * cfg.width_min
+                                && f64::from(b.hi[2]) + slack
+                                    > found.map_or(mid[2] - ml, |z| z.max(mid[2] - ml))
                                 && f64::from(b.lo[2]) - slack < mid[2] + ml
                         })
                 }
@@ -570,9 +577,9 @@ impl Nearest<'_> {
                                 best = Some(c);
                             }
                         }
-                        Class::Double => {
+                        Class::Double(z) => {
                             if let Some(found) = double.as_mut() {
-                                **found = true;
+                                **found = Some(found.map_or(z, |d| d.max(z)));
                             }
                         }
                         Class::Neither => {}
@@ -596,6 +603,7 @@ mod tests {
             at: [x, 0.0],
             d,
             width: 3.0,
+            height: 1.2,
             covers: d <= 1.5,
         }
     }

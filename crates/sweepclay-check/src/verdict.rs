@@ -1,8 +1,15 @@
-//! The verdict: the failures a report holds, in words.
+//! The verdict: the failures and warnings a report holds, in words, from
+//! the one list of [`Finding`]s.
 
-use crate::report::{Count, Report};
+use crate::report::{Count, Finding, Report};
 use crate::CheckConfig;
 
+/// How far outside `[width_min, width_max]` an inferred bead width may be
+/// before it is a warning (a fraction of the limit): widths are read from
+/// the volume, the length and the local layer height, all rounded.
+pub const WIDTH_TOLERANCE: f64 = 0.25;
+
+/// Fills `printable`, `failures` and `warnings` from the counts.
 pub(crate) fn verdict(r: &mut Report, cfg: &CheckConfig) {
     let mut f = Vec::new();
     let line = |c: &Count| {
@@ -16,46 +23,37 @@ pub(crate) fn verdict(r: &mut Report, cfg: &CheckConfig) {
     if r.extrusion_runs > 1 {
         f.push(format!(
             "{} separate extrusion runs, must be 1 (the second starts at line {})",
-            r.extrusion_runs, r.run_starts[1]
+            r.extrusion_runs,
+            r.run_starts.get(1).copied().unwrap_or(0)
         ));
     }
-    for (name, c) in [
-        ("travel move(s) after the first bead", &r.travel_moves),
-        ("retraction(s)", &r.retractions),
-        ("pause(s)", &r.pauses),
-        ("extrusion(s) without motion", &r.extrusion_without_motion),
-        ("move(s) outside the build volume", &r.out_of_bounds),
-        (
-            "nozzle collision(s) with printed clay",
-            &r.nozzle_collisions,
-        ),
-        (
-            "carriage collision(s) with printed clay",
-            &r.carriage_collisions,
-        ),
-        ("bead(s) with no clay below", &r.support.unsupported),
-        (
-            "bead(s) laid on clay at their own height",
-            &r.support.double_deposition,
-        ),
-        (
-            "bead(s) overlapping the bead below by less than half",
-            &r.support.under_min,
-        ),
-        ("overhang(s) beyond the limit", &r.support.overhang),
-    ] {
-        if c.count > 0 {
-            f.push(format!("{} {name}{}", c.count, line(c)));
-        }
-    }
-    if let Some(z) = r.first_layer_z {
-        if z > cfg.first_layer_max_mm {
-            f.push(format!(
-                "the first bead is {z:.2} mm above the bed (at most {} mm)",
+    for (kind, c) in r.findings.occurred() {
+        f.push(match kind {
+            Finding::FirstLayerHigh => format!(
+                "the first layer is at {:.2} mm, too far above the bed (at most {} mm)",
+                c.worst.map_or(0.0, |w| w.0),
                 cfg.first_layer_max_mm
-            ));
-        }
+            ),
+            _ => format!("{} {}{}", c.count, kind.failure(), line(c)),
+        });
+    }
+    let mut w = Vec::new();
+    let sp = &r.support;
+    if let (Some((v, l)), true) = (sp.wide.worst, sp.wide.count > 0) {
+        w.push(format!(
+            "{} over-squished bead(s) wider than {:.1} mm (widest {v:.1} mm at line {l}): they print, pressed flat",
+            sp.wide.count,
+            cfg.width_max * (1.0 + WIDTH_TOLERANCE)
+        ));
+    }
+    if let (Some(first), true) = (sp.thin.first_line, sp.thin.count > 0) {
+        w.push(format!(
+            "{} bead(s) narrower than {:.1} mm (first at line {first}): too little clay for the layer",
+            sp.thin.count,
+            cfg.width_min * (1.0 - WIDTH_TOLERANCE)
+        ));
     }
     r.printable = f.is_empty();
     r.failures = f;
+    r.warnings = w;
 }

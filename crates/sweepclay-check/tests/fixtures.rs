@@ -3,7 +3,7 @@
 //! small writers here so each fixture states exactly what it contains.
 
 use proptest::prelude::*;
-use sweepclay_check::{check, CheckConfig, Report};
+use sweepclay_check::{check, CheckConfig, Finding, Report};
 
 const E: f64 = 0.13; // E per mm³
 const LAYER: f64 = 1.2;
@@ -217,7 +217,7 @@ fn two_walls() -> G {
 fn travel_move_fails() {
     let r = verdict(&two_walls().out);
     fails_for(&r, "travel move", &["extrusion runs"]);
-    assert_eq!(r.travel_moves.count, 3);
+    assert_eq!(r.findings[Finding::TravelMove].count, 3);
     assert_eq!(r.extrusion_runs, 2);
 }
 
@@ -243,9 +243,9 @@ fn retraction_fails() {
         "{}",
         r.render()
     );
-    assert_eq!(r.retractions.count, 1);
+    assert_eq!(r.findings[Finding::Retraction].count, 1);
     assert_eq!(
-        r.retractions.first_line,
+        r.findings[Finding::Retraction].first_line,
         Some(g2.out.lines().position(|l| l.starts_with("G1 E")).unwrap() + 1)
     );
 }
@@ -268,7 +268,7 @@ fn nozzle_below_a_printed_wall_fails() {
     g.run([90.0, 55.0, LAYER], W, LAYER);
     let r = verdict(&g.out);
     only(&r, "nozzle collision");
-    let (worst, _) = r.nozzle_collisions.worst.unwrap();
+    let (worst, _) = r.findings[Finding::NozzleCollision].worst.unwrap();
     assert!(
         (worst - 10.8).abs() < 0.01,
         "wall top 12 mm above a 1.2 mm tip: {worst}"
@@ -285,8 +285,8 @@ fn clay_far_outside_the_bed_is_still_seen() {
     g.run([490.0, 55.0, LAYER], W, LAYER);
     let r = verdict(&g.out);
     fails_for(&r, "nozzle collision", &["outside the build volume"]);
-    assert_eq!(r.support.unsupported.count, 0, "{}", r.render());
-    let (worst, _) = r.nozzle_collisions.worst.unwrap();
+    assert_eq!(r.findings[Finding::Unsupported].count, 0, "{}", r.render());
+    let (worst, _) = r.findings[Finding::NozzleCollision].worst.unwrap();
     assert!((worst - 10.8).abs() < 0.01, "{worst}");
     // A build volume of 1 mm: every bead in the border cells.
     let tiny = CheckConfig {
@@ -295,7 +295,10 @@ fn clay_far_outside_the_bed_is_still_seen() {
     };
     let t = check(&g.out, &tiny);
     assert_eq!(t.support, r.support);
-    assert_eq!(t.nozzle_collisions, r.nozzle_collisions);
+    assert_eq!(
+        t.findings[Finding::NozzleCollision],
+        r.findings[Finding::NozzleCollision]
+    );
     assert_eq!(
         sweepclay_check::check_exhaustive(&g.out, &tiny).support,
         r.support
@@ -316,7 +319,11 @@ fn carriage_over_a_tall_wall_fails() {
     let r = verdict(&g.out);
     fails_for(&r, "carriage collision", &["nozzle collision"]);
     // Probed every r/2 = 2.5 mm along the 40 mm run.
-    assert!(r.carriage_collisions.count >= 15, "{}", r.render());
+    assert!(
+        r.findings[Finding::CarriageCollision].count >= 15,
+        "{}",
+        r.render()
+    );
 }
 
 #[test]
@@ -329,7 +336,7 @@ fn unsupported_overhang_fails() {
     let r = verdict(&g.out);
     assert!(!r.printable);
     assert!(
-        r.support.unsupported.count + r.support.under_min.count >= 30,
+        r.findings[Finding::Unsupported].count + r.findings[Finding::UnderMinOverlap].count >= 30,
         "{}",
         r.render()
     );
@@ -348,7 +355,7 @@ fn out_of_bounds_fails() {
     let g = wall_from(170.0, 210.0, 3);
     let r = verdict(&g.out);
     only(&r, "outside the build volume");
-    assert!((r.out_of_bounds.worst.unwrap().0 - 10.0).abs() < 1e-6);
+    assert!((r.findings[Finding::OutOfBounds].worst.unwrap().0 - 10.0).abs() < 1e-6);
 }
 
 #[test]
@@ -364,12 +371,12 @@ fn double_deposition_fails() {
 fn first_layer_in_the_air_fails() {
     let mut g = G::new([50.0, 50.0, 8.0]);
     g.run([90.0, 50.0, 8.0], W, LAYER);
+    g.bead([90.0, 50.0, 8.0 + LAYER], W, LAYER);
+    g.run([50.0, 50.0, 8.0 + LAYER], W, LAYER);
     let r = verdict(&g.out);
-    assert!(
-        r.failures.iter().any(|f| f.contains("first bead")),
-        "{}",
-        r.render()
-    );
+    // One finding, not a bead with no clay below for every bead of it.
+    only(&r, "first layer is at 8.00 mm");
+    assert_eq!(r.failures.len(), 1, "{}", r.render());
 }
 
 #[test]
@@ -512,4 +519,244 @@ fn reading_line_by_line_gives_the_same_report() {
     assert_eq!(r.lines, 2);
     assert_eq!(r, check(&String::from_utf8_lossy(&bytes), &cfg));
     assert_eq!(r.extruding_moves, 1);
+}
+
+/// A flat loop of radius 30 around (100, 100) at one layer, then a vase's
+/// spiral rising from it one layer a turn: `turns` turns.
+fn vase(turns: usize) -> G {
+    let seg = 90;
+    let mut g = G::new([130.0, 100.0, LAYER]);
+    for i in 1..=seg * (turns + 1) {
+        let a = std::f64::consts::TAU * i as f64 / seg as f64;
+        let z = LAYER + (LAYER * (i as f64 - seg as f64) / seg as f64).max(0.0);
+        g.bead(
+            [100.0 + 30.0 * a.cos(), 100.0 + 30.0 * a.sin(), z],
+            W,
+            LAYER,
+        );
+    }
+    g
+}
+
+#[test]
+fn a_seam_and_a_vase_ramp_at_full_flow_are_normal_printing() {
+    // The flat loop's last bead ends on its first; the spiral's first turn
+    // rises from 0 to one layer over it at full flow (over-squished at
+    // first: a warning, not a failure).
+    let r = verdict(&vase(12).out);
+    assert!(r.printable, "{}", r.render());
+    assert!(r.support.on_clay > 0, "{}", r.render());
+    assert!(r.support.wide.count > 0, "{}", r.render());
+    assert!(
+        r.warnings.iter().any(|w| w.contains("over-squished")),
+        "{:?}",
+        r.warnings
+    );
+}
+
+#[test]
+fn start_and_end_code_are_not_the_print() {
+    // A stationary prime, a purge in the air at Z50, retract, travel,
+    // unretract, a travel carrying a rounding residue of E; after the
+    // print an end retraction, lifting off, homing.
+    let body = vase(6);
+    let mut g = String::from("G21\nG90\nM82\nG28\nG92 E0\nG1 F200 E3 ; prime\nG92 E0\n");
+    g += "G1 X20 Y180 Z50 F3000\n";
+    for k in 1..=20 {
+        g += &format!(
+            "G1 X{:.3} Y180 E{:.5} ; purge in the air\n",
+            20.0 + k as f64,
+            0.4 * k as f64
+        );
+    }
+    g += "G1 E6 ; retract\nG92 E0\nG1 X100 Y30 Z1.2 F3000\nG1 E2 ; unretract\nG92 E0\n";
+    g += "G1 X130 Y100 E0.00001 ; rounding residue over a travel\nG92 E0\n";
+    g += body
+        .out
+        .split_once("G0 F2400")
+        .unwrap()
+        .1
+        .split_once('\n')
+        .unwrap()
+        .1;
+    g += &format!(
+        "G1 E{:.5} ; end retraction\nG1 Z80\nG28 X Y\nM84\n",
+        body.e - 2.0
+    );
+    let r = verdict(&g);
+    assert!(r.printable, "{}", r.render());
+    let start = r.start_code.as_ref().expect("start code");
+    assert!(start.items.iter().any(|i| i.contains("prime")), "{start:?}");
+    assert!(start.items.iter().any(|i| i.contains("air")), "{start:?}");
+    assert!(r
+        .end_code
+        .as_ref()
+        .unwrap()
+        .items
+        .iter()
+        .any(|i| i.contains("end retraction")));
+    // The purge's clay is no obstacle: nothing collides with it at Z50.
+    assert_eq!(r.findings[Finding::NozzleCollision].count, 0);
+}
+
+#[test]
+fn a_skirt_is_start_code_but_a_travel_in_the_print_is_not() {
+    // A skirt loop 10 mm out, travel, then the vase.
+    let mut g = G::new([140.0, 100.0, LAYER]);
+    for i in 1..=90 {
+        let a = std::f64::consts::TAU * i as f64 / 90.0;
+        g.bead(
+            [100.0 + 40.0 * a.cos(), 100.0 + 40.0 * a.sin(), LAYER],
+            W,
+            LAYER,
+        );
+    }
+    let v = vase(8);
+    g.line("G1 X130 Y100 F3000");
+    g.out += v
+        .out
+        .split_once("G0 F2400")
+        .unwrap()
+        .1
+        .split_once('\n')
+        .unwrap()
+        .1;
+    let r = verdict(&g.out);
+    assert!(r.printable, "{}", r.render());
+    assert!(r
+        .start_code
+        .unwrap()
+        .items
+        .iter()
+        .any(|i| i.contains("skirt")));
+    // A lift and travel between two turns of the vase fails.
+    let mut lines: Vec<&str> = v.out.lines().collect();
+    lines.insert(500, "G1 Z30\nG1 X10 Y10\nG1 X100 Y100\n");
+    fails_for(
+        &verdict(&lines.join("\n")),
+        "travel move",
+        &["extrusion runs"],
+    );
+}
+
+#[test]
+fn numbers_in_exponent_form_are_an_error_naming_both_readings() {
+    // A feedrate as Python's str(float) may write it: F1800 to Marlin,
+    // F1.8 then E3 to Klipper.
+    let mut g = wall(4);
+    g.line("G1 F1.8e3");
+    let z = LAYER * 5.0;
+    g.bead([50.0, 50.0, z], W, LAYER);
+    g.run([90.0, 50.0, z], W, LAYER);
+    let r = verdict(&g.out);
+    only(&r, "firmwares read differently");
+    let d = &r.diagnostics[0];
+    assert!(
+        d.message.contains("F1800") && d.message.contains("F1.8 E3 in Klipper"),
+        "{d:?}"
+    );
+}
+
+#[test]
+fn a_centred_bed_is_the_box_from_bed_min() {
+    // The wall moved to x = -20..20 around a centred bed.
+    let text = wall(6)
+        .out
+        .replace("X50.000", "X-20.000")
+        .replace("X90.000", "X20.000");
+    let text = text
+        .lines()
+        .map(|l| {
+            // Shift every X of the 1 mm beads by -70.
+            l.split(' ')
+                .map(
+                    |w| match w.strip_prefix('X').and_then(|v| v.parse::<f64>().ok()) {
+                        Some(x) if x > 21.0 => format!("X{:.3}", x - 70.0),
+                        _ => w.to_string(),
+                    },
+                )
+                .collect::<Vec<_>>()
+                .join(" ")
+        })
+        .collect::<Vec<_>>()
+        .join("\n");
+    let centred = CheckConfig {
+        bed_min: [-100.0, -100.0, 0.0],
+        ..CheckConfig::default()
+    };
+    let r = check(&text, &centred);
+    assert!(r.printable, "{}", r.render());
+    // On a bed whose corner is the origin the same file is off the bed.
+    only(&verdict(&text), "outside the build volume");
+}
+
+#[test]
+fn options_out_of_range_are_refused_by_name() {
+    for (cfg, field) in [
+        (
+            CheckConfig {
+                nozzle_height: f64::NAN,
+                ..CheckConfig::default()
+            },
+            "nozzle_height",
+        ),
+        (
+            CheckConfig {
+                overlap_min: 1.5,
+                ..CheckConfig::default()
+            },
+            "overlap_min",
+        ),
+        (
+            CheckConfig {
+                max_overhang_deg: f64::INFINITY,
+                ..CheckConfig::default()
+            },
+            "max_overhang_deg",
+        ),
+        (
+            CheckConfig {
+                width_min: 7.0,
+                ..CheckConfig::default()
+            },
+            "width_max",
+        ),
+        (
+            CheckConfig {
+                width_min: -1.0,
+                ..CheckConfig::default()
+            },
+            "width_min",
+        ),
+    ] {
+        assert_eq!(cfg.validate().unwrap_err().field, field);
+    }
+    assert!(CheckConfig::default().validate().is_ok());
+}
+
+#[test]
+fn hostile_files_check_in_bounded_time_and_memory() {
+    // One 20 MB line: one diagnostic, not 20 million words.
+    let mut text = wall(3).out;
+    text += &"X".repeat(20 << 20);
+    text += "\n";
+    let r = verdict(&text);
+    assert!(r.printable, "{}", r.render());
+    assert!(r
+        .diagnostics
+        .iter()
+        .any(|d| d.message.contains("longer than")));
+    // The same wall 40 times over at the same place: the pile is refused.
+    let many = wall(10).out.repeat(40);
+    let r = verdict(&many);
+    fails_for(
+        &r,
+        "laid on clay at their own height",
+        &["extrusion runs", "travel move", "collision"],
+    );
+    // Diagnostics are counted, the first 50 kept.
+    let noise = "M999\n".repeat(10) + &"G1 X1..2\n".repeat(500);
+    let r = verdict(&noise);
+    assert_eq!(r.diagnostics.len(), 50);
+    assert!(r.diagnostics_total >= 500, "{}", r.diagnostics_total);
 }

@@ -90,33 +90,54 @@ struct SliceArgs {
 struct CheckArgs {
     /// G-code file to check.
     file: PathBuf,
-    /// Printer preset or printer JSON file (build volume, e_per_mm3, nozzle_radius).
-    #[arg(long, default_value = "generic")]
-    printer: String,
-    /// H: extruder body height above the nozzle tip (mm).
-    #[arg(long, default_value_t = 30.0)]
-    nozzle_height: f64,
-    /// Narrowest expected bead (mm).
-    #[arg(long, default_value_t = 3.0)]
-    width_min: f64,
-    /// Widest expected bead (mm).
-    #[arg(long, default_value_t = 6.0)]
-    width_max: f64,
-    /// Target overlap with the bead below (fraction); beads under it are counted.
-    #[arg(long, default_value_t = 2.0 / 3.0)]
-    overlap: f64,
-    /// Overlap under which a bead fails (fraction).
-    #[arg(long, default_value_t = 0.5)]
-    min_overlap: f64,
-    /// Overhang threshold from vertical (degrees).
-    #[arg(long, default_value_t = 57.0)]
-    max_overhang_deg: f64,
-    /// The first bead must start at most this high (mm).
-    #[arg(long, default_value_t = 3.0)]
-    first_layer_max: f64,
+    /// Printer preset or printer JSON file (build volume, bed_min,
+    /// e_per_mm3, nozzle_radius) [default: the printer in a sweepclay
+    /// file's header, else generic].
+    #[arg(long)]
+    printer: Option<String>,
+    /// Whose reading of the G-code to follow where firmwares differ
+    /// (G90/G91 and E; numbers such as Z5e-05).
+    #[arg(long, default_value = "marlin", value_parser = ["marlin", "klipper", "reprap"])]
+    firmware: String,
+    /// H: extruder body height above the nozzle tip (mm) [default: 30].
+    #[arg(long)]
+    nozzle_height: Option<f64>,
+    /// Narrowest expected bead (mm) [default: 3].
+    #[arg(long)]
+    width_min: Option<f64>,
+    /// Widest expected bead (mm) [default: 6].
+    #[arg(long)]
+    width_max: Option<f64>,
+    /// Target overlap with the bead below (fraction); beads under it are
+    /// counted [default: 0.6667].
+    #[arg(long)]
+    overlap: Option<f64>,
+    /// Overlap under which a bead fails (fraction) [default: 0.5].
+    #[arg(long)]
+    min_overlap: Option<f64>,
+    /// Overhang threshold from vertical (degrees) [default: 57].
+    #[arg(long)]
+    max_overhang_deg: Option<f64>,
+    /// The print's first bead must start at most this high (mm) [default: 3].
+    #[arg(long)]
+    first_layer_max: Option<f64>,
     /// Print the report as JSON.
     #[arg(long)]
     json: bool,
+}
+
+/// The flag that sets a field of the check's configuration, for messages.
+fn check_flag(field: &str) -> String {
+    match field {
+        "nozzle_height" => "--nozzle-height".into(),
+        "width_min" => "--width-min".into(),
+        "width_max" => "--width-max".into(),
+        "overlap_target" => "--overlap".into(),
+        "overlap_min" => "--min-overlap".into(),
+        "max_overhang_deg" => "--max-overhang-deg".into(),
+        "first_layer_max_mm" => "--first-layer-max".into(),
+        other => format!("the printer's `{other}`"),
+    }
 }
 
 fn main() {
@@ -174,6 +195,12 @@ fn slice(a: SliceArgs) -> Result<i32> {
             _ => return Err(e).with_context(|| format!("reading {}", a.design)),
         },
     };
+    if !(0.0..=1.0).contains(&a.min_overlap) {
+        bail!(
+            "--min-overlap: must be a fraction from 0 to 1 (got {})",
+            a.min_overlap
+        );
+    }
     let mut design = Design::from_json(&text).with_context(|| source.clone())?;
     if let Some(p) = &a.printer {
         design.printer = PrinterRef::Inline(load_printer(p)?);
@@ -299,20 +326,51 @@ fn serve(a: ServeArgs) -> Result<i32> {
 }
 
 fn check_cmd(a: CheckArgs) -> Result<i32> {
-    let file =
-        std::fs::File::open(&a.file).with_context(|| format!("reading {}", a.file.display()))?;
-    let p = load_printer(&a.printer)?;
-    let cfg = CheckConfig {
-        nozzle_height: a.nozzle_height,
-        width_min: a.width_min,
-        width_max: a.width_max,
-        overlap_target: a.overlap,
-        overlap_min: a.min_overlap,
-        max_overhang_deg: a.max_overhang_deg,
-        first_layer_max_mm: a.first_layer_max,
-        ..printer_check(&p)
+    let open =
+        || std::fs::File::open(&a.file).with_context(|| format!("reading {}", a.file.display()));
+    let base = match &a.printer {
+        Some(name) => {
+            let p = load_printer(name)?;
+            CheckConfig {
+                printer: format!("{} (--printer)", p.name),
+                ..printer_check(&p)
+            }
+        }
+        None => {
+            // Our own files name their printer and parameters in the header.
+            use std::io::{BufRead, Read};
+            let mut head = String::new();
+            for line in std::io::BufReader::new(open()?.take(1 << 16))
+                .lines()
+                .take(sweepclay_check::header::HEADER_LINES)
+            {
+                let Ok(line) = line else { break };
+                head.push_str(&line);
+                head.push('\n');
+            }
+            sweepclay_check::header::config_from_header(&head, &CheckConfig::default())
+                .unwrap_or_else(|| CheckConfig {
+                    printer:
+                        "generic (assumed: the file names no sweepclay printer; pass --printer)"
+                            .into(),
+                    ..CheckConfig::default()
+                })
+        }
     };
-    let report = check_reader(std::io::BufReader::with_capacity(1 << 16, file), &cfg)
+    let cfg = CheckConfig {
+        firmware: a.firmware.parse().map_err(anyhow::Error::msg)?,
+        nozzle_height: a.nozzle_height.unwrap_or(base.nozzle_height),
+        width_min: a.width_min.unwrap_or(base.width_min),
+        width_max: a.width_max.unwrap_or(base.width_max),
+        overlap_target: a.overlap.unwrap_or(base.overlap_target),
+        overlap_min: a.min_overlap.unwrap_or(base.overlap_min),
+        max_overhang_deg: a.max_overhang_deg.unwrap_or(base.max_overhang_deg),
+        first_layer_max_mm: a.first_layer_max.unwrap_or(base.first_layer_max_mm),
+        ..base
+    };
+    cfg.validate()
+        .map_err(|e| anyhow::anyhow!("{}: {}", check_flag(e.field), e.reason))?;
+    let report = check_reader(std::io::BufReader::with_capacity(1 << 16, open()?), &cfg)
         .with_context(|| format!("reading {}", a.file.display()))?;
     if a.json {
         println!("{}", serde_json::to_string_pretty(&report)?);

@@ -263,8 +263,46 @@ fn check_reports_and_exit_codes() {
         .stdout
         .clone();
     let v: serde_json::Value = serde_json::from_slice(&out).unwrap();
-    assert_eq!(v["retractions"]["count"], 1);
-    assert_eq!(v["retractions"]["first_line"], 6);
+    assert_eq!(v["findings"]["retraction"]["count"], 1);
+    assert_eq!(v["findings"]["retraction"]["first_line"], 6);
+    assert!(v["printer"].as_str().unwrap().contains("assumed"), "{v}");
+    // Options out of range name their flag, exit 2.
+    for (flag, value) in [
+        ("--nozzle-height", "NaN"),
+        ("--min-overlap", "1.5"),
+        ("--max-overhang-deg", "inf"),
+        ("--width-min", "-3"),
+    ] {
+        sweepclay(tmp.path())
+            .args(["check", "bad.gcode", &format!("{flag}={value}")])
+            .assert()
+            .code(2)
+            .stderr(predicate::str::contains(flag));
+    }
+    sweepclay(tmp.path())
+        .args(["slice", "t4", "--min-overlap", "NaN"])
+        .assert()
+        .code(2)
+        .stderr(predicate::str::contains("--min-overlap"));
+    // Our own files are checked for the printer their header names.
+    sweepclay(tmp.path())
+        .args([
+            "slice",
+            "t4",
+            "--printer",
+            "cerambot-mini",
+            "-o",
+            "t4.gcode",
+        ])
+        .assert()
+        .success();
+    sweepclay(tmp.path())
+        .args(["check", "t4.gcode"])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains(
+            "cerambot-mini (from the file's header)",
+        ));
     sweepclay(tmp.path())
         .args(["check", "nothing.gcode"])
         .assert()

@@ -55,9 +55,9 @@ pub fn emit<W: Write>(s: &Sliced, out: &mut W) -> io::Result<Vec<usize>> {
     )?;
     writeln!(
         out,
-        "; printer_params: build_volume={}x{}x{} origin={},{} e_per_mm3={} relative_e={} nozzle_radius={}",
-        pr.build_volume[0], pr.build_volume[1], pr.build_volume[2], o[0], o[1], pr.e_per_mm3,
-        pr.relative_e, pr.nozzle_radius
+        "; printer_params: build_volume={}x{}x{} bed_min={},{},{} origin={},{} e_per_mm3={} relative_e={} nozzle_radius={}",
+        pr.build_volume[0], pr.build_volume[1], pr.build_volume[2], pr.bed_min[0], pr.bed_min[1],
+        pr.bed_min[2], o[0], o[1], pr.e_per_mm3, pr.relative_e, pr.nozzle_radius
     )?;
     writeln!(
         out,

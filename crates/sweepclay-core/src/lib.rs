@@ -115,13 +115,14 @@ pub fn finish(corrected: Corrected) -> Result<Sliced> {
     let pr = &corrected.surface.printer;
     for axis in 0..3 {
         let (lo, hi) = (stats.bounds_mm[0][axis], stats.bounds_mm[1][axis]);
-        if lo < -1e-9 || hi > pr.build_volume[axis] + 1e-9 {
+        let min = pr.bed_min[axis];
+        if lo < min - 1e-9 || hi > min + pr.build_volume[axis] + 1e-9 {
             return Err(Error::DoesNotFit {
                 printer: pr.name.clone(),
                 axis: ['x', 'y', 'z'][axis],
                 min: lo,
                 max: hi,
-                limit: pr.build_volume[axis],
+                limit: min + pr.build_volume[axis],
             });
         }
     }

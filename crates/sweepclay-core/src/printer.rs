@@ -13,8 +13,13 @@ use serde::{Deserialize, Serialize};
 pub struct Printer {
     /// Profile name, written into the G-code header.
     pub name: String,
-    /// Build volume `[x, y, z]` in mm; the bed spans `0..x`, `0..y`.
+    /// Build volume `[x, y, z]` in mm: the printable box spans `bed_min`
+    /// to `bed_min + build_volume`.
     pub build_volume: [f64; 3],
+    /// The box's lowest corner in the printer's coordinates (mm): `[0, 0,
+    /// 0]` by default; a delta or a WASP with its origin at the bed's
+    /// centre is `[-R, -R, 0]`.
+    pub bed_min: [f64; 3],
     /// Where the design's centre `o` lands on the bed, `[x, y]` in mm.
     pub origin: [f64; 2],
     /// Extrusion calibration: E units per mm³ of clay. Default 0.13.
@@ -37,6 +42,7 @@ impl Default for Printer {
         Printer {
             name: "generic".into(),
             build_volume: [200.0, 200.0, 200.0],
+            bed_min: [0.0, 0.0, 0.0],
             origin: [100.0, 100.0],
             e_per_mm3: 0.13,
             relative_e: false,
@@ -82,6 +88,14 @@ impl Printer {
                 return Err(Error::invalid(
                     format!("{key}.build_volume[{i}]"),
                     format!("must be a positive number of mm (got {v})"),
+                ));
+            }
+        }
+        for (i, v) in self.bed_min.iter().enumerate() {
+            if !v.is_finite() {
+                return Err(Error::invalid(
+                    format!("{key}.bed_min[{i}]"),
+                    format!("must be a finite number of mm (got {v})"),
                 ));
             }
         }

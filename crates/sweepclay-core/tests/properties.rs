@@ -205,7 +205,10 @@ fn prints_in_clay(d: &Design) -> Result<(), TestCaseError> {
     let r = common::check_sliced(&sliced);
     prop_assert!(r.printable, "{}\ndesign:\n{}", r.render(), d.to_json());
     prop_assert_eq!(r.extrusion_runs, 1);
-    prop_assert_eq!(r.support.under_min.count, 0);
+    prop_assert_eq!(
+        r.findings[sweepclay_check::Finding::UnderMinOverlap].count,
+        0
+    );
     Ok(())
 }
 

@@ -12,6 +12,8 @@ use sweepclay_core::{gcode, Params, Printer, Sliced};
 pub fn printer_check(p: &Printer) -> CheckConfig {
     CheckConfig {
         build_volume: p.build_volume,
+        bed_min: p.bed_min,
+        printer: p.name.clone(),
         e_per_mm3: p.e_per_mm3,
         nozzle_radius: p.nozzle_radius,
         ..CheckConfig::default()
@@ -103,23 +105,11 @@ pub fn verify(s: &Sliced, min_overlap: f64) -> Verified {
 
 /// The first line of each kind of failure in a report.
 pub fn failure_lines(r: &Report) -> Vec<usize> {
-    let sp = &r.support;
-    let mut v: Vec<usize> = [
-        &r.travel_moves,
-        &r.retractions,
-        &r.pauses,
-        &r.extrusion_without_motion,
-        &r.out_of_bounds,
-        &r.nozzle_collisions,
-        &r.carriage_collisions,
-        &sp.unsupported,
-        &sp.double_deposition,
-        &sp.under_min,
-        &sp.overhang,
-    ]
-    .iter()
-    .filter_map(|c| c.first_line)
-    .collect();
+    let mut v: Vec<usize> = r
+        .findings
+        .occurred()
+        .filter_map(|(_, c)| c.first_line)
+        .collect();
     v.sort_unstable();
     v.dedup();
     v

@@ -1,0 +1,137 @@
+//! The corpus of real-world clay G-code (`tests/corpus/`, made by
+//! `scripts/corpus/make.py` with CuraEngine, PrusaSlicer, Slic3r,
+//! FullControl and a plain Python loop): every valid file is printable,
+//! every hand-made fault fails for its fault, and each report matches its
+//! snapshot (`NAME.report.txt`, read by a person; `UPDATE_SNAPSHOTS=1`
+//! rewrites them).
+
+use std::path::{Path, PathBuf};
+use sweepclay_check::{check, CheckConfig, Report};
+
+fn corpus() -> PathBuf {
+    Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/corpus")
+}
+
+/// The printer a file was made for, from the corpus's printer files.
+fn printer(file: &str) -> CheckConfig {
+    let name = if file.starts_with("fullcontrol") {
+        "wasp-2040.json"
+    } else {
+        "clay-200.json"
+    };
+    let text = std::fs::read_to_string(corpus().join(name)).unwrap();
+    let v: serde_json::Value = serde_json::from_str(&text).unwrap();
+    let three = |k: &str, d: [f64; 3]| {
+        v.get(k)
+            .map_or(d, |a| [0, 1, 2].map(|i| a[i].as_f64().expect("a number")))
+    };
+    CheckConfig {
+        printer: v["name"].as_str().unwrap().to_string(),
+        build_volume: three("build_volume", [200.0; 3]),
+        bed_min: three("bed_min", [0.0; 3]),
+        e_per_mm3: v["e_per_mm3"].as_f64().unwrap(),
+        nozzle_radius: v["nozzle_radius"].as_f64().unwrap(),
+        ..CheckConfig::default()
+    }
+}
+
+fn report(file: &str) -> Report {
+    let text = std::fs::read_to_string(corpus().join(file)).unwrap();
+    check(&text, &printer(file))
+}
+
+/// The report matches its snapshot (or rewrites it with
+/// `UPDATE_SNAPSHOTS=1`).
+fn snapshot(file: &str, r: &Report) {
+    let path = corpus().join(file.replace(".gcode", ".report.txt"));
+    let got = r.render();
+    if std::env::var_os("UPDATE_SNAPSHOTS").is_some() {
+        std::fs::write(&path, &got).unwrap();
+        return;
+    }
+    let want = std::fs::read_to_string(&path).unwrap_or_else(|_| {
+        panic!(
+            "no snapshot {}: run with UPDATE_SNAPSHOTS=1",
+            path.display()
+        )
+    });
+    assert_eq!(
+        got, want,
+        "{file}: the report changed (UPDATE_SNAPSHOTS=1 rewrites it)"
+    );
+}
+
+const VALID: [&str; 10] = [
+    "cura-vase.gcode",
+    "cura-ripple.gcode",
+    "prusa-vase.gcode",
+    "prusa-ripple.gcode",
+    "slic3r-vase.gcode",
+    "slic3r-ripple.gcode",
+    "fullcontrol-vase.gcode",
+    "fullcontrol-wall.gcode",
+    "python-vase.gcode",
+    "python-wall.gcode",
+];
+
+#[test]
+fn real_slicer_files_are_printable_and_their_start_and_end_code_listed() {
+    for file in VALID {
+        let r = report(file);
+        assert!(r.printable, "{file}:\n{}", r.render());
+        assert_eq!(r.extrusion_runs, 1, "{file}");
+        // Every file here homes, primes or retracts before the print and
+        // retracts or lifts off after it.
+        assert!(r.start_code.is_some(), "{file}:\n{}", r.render());
+        assert!(r.end_code.is_some(), "{file}:\n{}", r.render());
+        snapshot(file, &r);
+    }
+}
+
+#[test]
+fn each_hand_made_fault_fails_for_its_fault() {
+    for (file, what, allowed) in [
+        (
+            "fault-travel.gcode",
+            "travel move",
+            &["extrusion runs", "no clay below"][..],
+        ),
+        ("fault-pause.gcode", "pause", &["extrusion runs"][..]),
+        (
+            "fault-retraction.gcode",
+            "retraction",
+            &["extrusion runs", "without motion"][..],
+        ),
+        (
+            "fault-bed-drag.gcode",
+            "into the bed",
+            &["overlapping the bead below"][..],
+        ),
+        (
+            "fault-overhang.gcode",
+            "overhang",
+            &["overlapping the bead below"][..],
+        ),
+        (
+            "fault-twice.gcode",
+            "laid on clay at their own height",
+            &[][..],
+        ),
+    ] {
+        let r = report(file);
+        assert!(!r.printable, "{file} passed:\n{}", r.render());
+        assert!(
+            r.failures.iter().any(|f| f.contains(what)),
+            "{file}: expected `{what}`:\n{}",
+            r.render()
+        );
+        for f in &r.failures {
+            assert!(
+                f.contains(what) || allowed.iter().any(|a| f.contains(a)),
+                "{file}: unexpected `{f}`:\n{}",
+                r.render()
+            );
+        }
+        snapshot(file, &r);
+    }
+}

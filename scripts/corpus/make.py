@@ -1,0 +1,343 @@
+#!/usr/bin/env python3
+"""Regenerates the checker's corpus of real-world clay G-code.
+
+Small clay designs (a bulging vase and a ripple vase as STL meshes, an open
+wall) are sliced by the tools potters use today, with clay settings
+(1.25 mm layers, 3 mm beads):
+
+- CuraEngine (Debian `cura-engine`, spiralize; its setting definitions come
+  from Debian's `cura` package, unpacked, never installed),
+- PrusaSlicer and Slic3r (Debian `prusa-slicer`, `slic3r`, spiral vase),
+- FullControl (PyPI `fullcontrol`, its WASP 2040 Clay profile),
+- a plain Python loop, as people script clay G-code by hand.
+
+Then hand-made edits of the valid files, each with one real fault. Writes
+`crates/sweepclay-check/tests/corpus/*.gcode` (each at most 200 KB) and
+`printers/*.json`; `tests/corpus.rs` holds each file's verdict and report
+snapshot. Run from anywhere: `python3 scripts/corpus/make.py`.
+"""
+
+import glob
+import math
+import os
+import shutil
+import subprocess
+import sys
+import tempfile
+
+ROOT = os.path.dirname(os.path.dirname(os.path.dirname(os.path.abspath(__file__))))
+OUT = os.path.join(ROOT, "crates", "sweepclay-check", "tests", "corpus")
+LAYER = 1.25  # mm, clay layers
+WIDTH = 3.0  # mm, clay beads
+# A "filament" diameter that makes E count 0.13 units per mm³ of clay (the
+# calibration of the paper's sample G-code): 4 / (pi d^2) = 0.13.
+FEED_DIA = 3.13
+MAX_BYTES = 200_000
+
+
+def vase_r(z, t):
+    """The bulging vase: 50 mm tall, radius 20 mm with a 6 mm bulge."""
+    return 20 + 6 * math.sin(math.pi * z / 50)
+
+
+def ripple_r(z, t):
+    """The ripple vase: eight lobes of 2.5 mm, 45 mm tall."""
+    return 18 + 2.5 * math.cos(8 * t) + 3 * math.sin(math.pi * z / 45)
+
+
+def write_stl(path, rfun, height, nz, nt):
+    """A closed solid of revolution (side, bottom and top caps), ASCII STL."""
+    rings = []
+    for k in range(nz + 1):
+        z = height * k / nz
+        ring = []
+        for j in range(nt):
+            t = 2 * math.pi * j / nt
+            r = rfun(z, t)
+            ring.append((r * math.cos(t), r * math.sin(t), z))
+        rings.append(ring)
+    tris = []
+    for k in range(nz):
+        a, b = rings[k], rings[k + 1]
+        for j in range(nt):
+            j2 = (j + 1) % nt
+            tris += [(a[j], a[j2], b[j2]), (a[j], b[j2], b[j])]
+    c0, c1 = (0.0, 0.0, 0.0), (0.0, 0.0, height)
+    for j in range(nt):
+        j2 = (j + 1) % nt
+        tris += [(c0, rings[0][j2], rings[0][j]), (c1, rings[-1][j], rings[-1][j2])]
+    with open(path, "w") as f:
+        f.write("solid m\n")
+        for t in tris:
+            f.write(" facet normal 0 0 0\n  outer loop\n")
+            for p in t:
+                f.write("   vertex %.4f %.4f %.4f\n" % p)
+            f.write("  endloop\n endfacet\n")
+        f.write("endsolid m\n")
+
+
+def run(cmd):
+    print("  $", " ".join(cmd[:3]), "...", file=sys.stderr)
+    subprocess.run(cmd, check=True, stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+
+
+def cura_definitions(tmp):
+    """fdmprinter.def.json from Debian's `cura` package (downloaded and
+    unpacked into `tmp`; CuraEngine needs it and Debian ships it there)."""
+    found = glob.glob("/usr/share/cura/resources/definitions/fdmprinter.def.json")
+    if found:
+        return os.path.dirname(found[0])
+    subprocess.run(["apt-get", "download", "cura"], cwd=tmp, check=True,
+                   stdout=subprocess.DEVNULL, stderr=subprocess.DEVNULL)
+    deb = glob.glob(os.path.join(tmp, "cura_*.deb"))[0]
+    subprocess.run(["dpkg-deb", "-x", deb, os.path.join(tmp, "cura")], check=True)
+    return os.path.join(tmp, "cura", "usr", "share", "cura", "resources", "definitions")
+
+
+def cura(stl, out, defs):
+    clay = [
+        "magic_spiralize=true", f"layer_height={LAYER}", f"layer_height_0={LAYER}",
+        f"line_width={WIDTH}", f"machine_nozzle_size={WIDTH}",
+        f"material_diameter={FEED_DIA}", "bottom_layers=0", "top_layers=0",
+        "wall_line_count=1", "infill_sparse_density=0", "adhesion_type=skirt",
+        "skirt_line_count=1", "skirt_gap=6", "speed_print=30", "speed_wall_0=30",
+        "machine_width=200", "machine_depth=200", "machine_height=200",
+        "retraction_amount=2", "smooth_spiralized_contours=true",
+        "meshfix_maximum_resolution=1.5",
+        # CuraEngine's command line takes the definitions' default values,
+        # not their formulas: the settings derived from the above, stated.
+        f"wall_line_width_0={WIDTH}", f"wall_line_width_x={WIDTH}",
+        f"skirt_brim_line_width={WIDTH}", f"skin_line_width={WIDTH}",
+        f"infill_line_width={WIDTH}", "top_thickness=0", "bottom_thickness=0",
+        "top_bottom_thickness=0", "initial_bottom_layers=0", "infill_line_distance=0",
+        "roofing_layer_count=0", "speed_layer_0=30", "speed_print_layer_0=30",
+        "speed_travel=60", "retraction_hop_enabled=false",
+    ]
+    cmd = ["CuraEngine", "slice", "-j", os.path.join(defs, "fdmprinter.def.json")]
+    for s in clay:
+        cmd += ["-s", s]
+    cmd += ["-e0"]
+    for s in clay:
+        cmd += ["-s", s]
+    cmd += ["-l", stl]
+    for s in clay:
+        cmd += ["-s", s]
+    cmd += ["-o", out]
+    run(cmd)
+
+
+PRUSA_START = (
+    "G28 ; home all axes\\nG1 Z5 F5000 ; lift nozzle\\nG21\\nG90\\nM82\\n"
+    "G92 E0\\nG1 X20 Y10 Z1.25 F3000 ; to the purge line\\n"
+    "G1 X60 Y10 E15 F1000 ; purge line on the bed, off the part\\nG92 E0\\n"
+)
+
+
+def prusa(tool, stl, out, tmp):
+    cmd = [
+        tool, "--export-gcode" if tool == "prusa-slicer" else "--gcode-comments",
+        "--spiral-vase", "--perimeters", "1", "--layer-height", str(LAYER),
+        "--first-layer-height", str(LAYER), "--nozzle-diameter", str(WIDTH),
+        "--extrusion-width", str(WIDTH), "--first-layer-extrusion-width", str(WIDTH),
+        "--filament-diameter", str(FEED_DIA), "--bottom-solid-layers", "0",
+        "--top-solid-layers", "0", "--skirts", "0", "--fill-density", "0",
+        "--center" if tool == "prusa-slicer" else "--print-center", "100,100", "--bed-shape", "0x0,200x0,200x200,0x200",
+        "--perimeter-speed", "30", "--first-layer-speed", "30",
+        "--retract-length", "2", "-o", out, stl,
+    ]
+    if tool == "prusa-slicer":
+        cmd[1:1] = ["--max-print-height", "200", "--start-gcode", PRUSA_START.replace("\\n", "\n")]
+    else:
+        # Slic3r: its own start code, plus a stationary prime as clay
+        # printers do it (an ini file: its command line mangles newlines).
+        ini = os.path.join(tmp, "slic3r.ini")
+        with open(ini, "w") as f:
+            f.write("start_gcode = G28 ; home\\nG1 Z5 F5000\\nG92 E0\\nG1 F200 E3 ; prime\\nG92 E0\n")
+        cmd[1:1] = ["--load", ini]
+    run(cmd)
+
+
+def fullcontrol_files():
+    import fullcontrol as fc
+
+    def vase_steps(rfun, height):
+        steps = []
+        seg = 64
+        turns = int(round(height / LAYER)) - 1
+        for i in range(seg * turns + 1):
+            t = 2 * math.pi * i / seg
+            z = LAYER + LAYER * i / seg
+            steps.append(fc.Point(x=rfun(z, t) * math.cos(t), y=rfun(z, t) * math.sin(t), z=z))
+        return steps
+
+    def wall_steps():
+        # An open wall, 60 mm long, zig-zag as the paper prints it.
+        steps = []
+        for k in range(24):
+            z = LAYER * (k + 1)
+            xs = (-30, 30) if k % 2 == 0 else (30, -30)
+            for j in range(31):
+                x = xs[0] + (xs[1] - xs[0]) * j / 30
+                steps.append(fc.Point(x=x, y=6 * math.sin(x / 8), z=z))
+        return steps
+
+    settings = {"extrusion_width": WIDTH, "extrusion_height": LAYER, "print_speed": 1200}
+    for name, steps in [("fullcontrol-vase", vase_steps(vase_r, 50)),
+                        ("fullcontrol-wall", wall_steps())]:
+        text = fc.transform(steps, "gcode", fc.GcodeControls(printer_name="wasp2040clay",
+                                                               initialization_data=settings),
+                            show_tips=False)
+        with open(os.path.join(OUT, name + ".gcode"), "w") as f:
+            f.write(text)
+
+
+def python_loop_files():
+    """Clay G-code as people script it: a spiral vase and a zig-zag wall,
+    relative E, plain string formatting."""
+    def header(lines):
+        lines += ["; a plain Python loop", "G21", "G90", "M83", "G28", "G1 Z10 F3000"]
+
+    e_mm3 = 4 / (math.pi * FEED_DIA ** 2)
+    # Spiral vase around (100, 100): flat first loop, then rising turns.
+    lines = []
+    header(lines)
+    seg = 72
+    r = 22.0
+    lines.append(f"G1 X{100 + r:.3f} Y100.000 Z{LAYER:.3f} F3000")
+    prev = (100 + r, 100.0, LAYER)
+    for i in range(1, seg * 36 + 1):
+        t = 2 * math.pi * i / seg
+        z = LAYER + max(0.0, LAYER * (i - seg) / seg)
+        p = (100 + r * math.cos(t), 100 + r * math.sin(t), z)
+        d = math.dist(p, prev)
+        lines.append(f"G1 X{p[0]:.3f} Y{p[1]:.3f} Z{p[2]:.3f} E{d * WIDTH * LAYER * e_mm3:.5f} F1500")
+        prev = p
+    lines += ["G1 E-1.5 F1200 ; end retraction", "G1 Z80 F3000", "G28 X Y", "M84"]
+    with open(os.path.join(OUT, "python-vase.gcode"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+    # Zig-zag wall along y = 100 from x = 60 to 140, 2 mm beads.
+    lines = []
+    header(lines)
+    lines.append(f"G1 X60.000 Y100.000 Z{LAYER:.3f} F3000")
+    for k in range(30):
+        z = LAYER * (k + 1)
+        if k > 0:
+            # Step up at the turn: the clay of the end of the new layer.
+            lines.append(f"G1 Z{z:.3f} E{0.5 * WIDTH * LAYER * WIDTH * e_mm3:.5f} F600")
+        a, b = (60.0, 140.0) if k % 2 == 0 else (140.0, 60.0)
+        for j in range(1, 41):
+            x = a + (b - a) * j / 40
+            lines.append(f"G1 X{x:.3f} Y100.000 E{2.0 * WIDTH * LAYER * e_mm3:.5f} F1500")
+    lines += ["G1 E-1.5 F1200 ; end retraction", "G1 Z80 F3000", "M84"]
+    with open(os.path.join(OUT, "python-wall.gcode"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+
+
+def edits():
+    """Hand-made faults, one each, in copies of valid files."""
+    def load(name):
+        with open(os.path.join(OUT, name + ".gcode")) as f:
+            return f.read().split("\n")
+
+    def save(name, lines):
+        with open(os.path.join(OUT, "fault-" + name + ".gcode"), "w") as f:
+            f.write("\n".join(lines))
+
+    def z_of(line):
+        for w in line.split(";")[0].split():
+            if w.startswith("Z"):
+                return float(w[1:])
+        return None
+
+    def mid_index(lines, z):
+        """The first extruding G1 line at or above height z."""
+        cur = 0.0
+        for i, l in enumerate(lines):
+            zz = z_of(l)
+            if zz is not None:
+                cur = zz
+            if cur >= z and l.startswith("G1") and " E" in l and " X" in l:
+                return i
+        raise ValueError(z)
+
+    # A travel in the middle: lift, move away and back, lower (Prusa vase).
+    p = load("prusa-vase")
+    i = mid_index(p, 25.0)
+    p[i:i] = ["G1 Z35 F3000 ; travel away", "G1 X150 Y150", "G1 X100 Y100", "G1 Z25.0"]
+    save("travel", p)
+    # A pause in the middle (Cura vase).
+    c = load("cura-vase")
+    i = mid_index(c, 20.0)
+    c[i:i] = ["M0 ; pause for a photo"]
+    save("pause", c)
+    # A retraction in the print (python vase, relative E).
+    v = load("python-vase")
+    i = mid_index(v, 15.0)
+    v[i:i] = ["G1 E-2.0 F1200 ; retract", "G1 E2.0 F1200 ; unretract"]
+    save("retraction", v)
+    # A bead from Z=0: the python wall's first pass dragged on the bed.
+    w = load("python-wall")
+    w = [l.replace(f"Z{LAYER:.3f} F3000", "Z0.000 F3000") if l.startswith("G1 X60") else l for l in w]
+    save("bed-drag", w)
+    # An overhang: the python wall's upper half shifted 4 mm sideways.
+    w = load("python-wall")
+    out = []
+    for l in w:
+        zz = z_of(l)
+        out.append(l)
+    shifted = []
+    cur = 0.0
+    for l in w:
+        zz = z_of(l)
+        if zz is not None:
+            cur = zz
+        if cur > 20 and l.startswith("G1 X"):
+            l = l.replace("Y100.000", "Y104.000")
+        shifted.append(l)
+    save("overhang", shifted)
+    # A pass printed twice: after the python wall's 10th pass, back over it
+    # and forth again at its height (then on as before).
+    w = load("python-wall")
+    e_mm3 = 4 / (math.pi * FEED_DIA ** 2)
+    steps = [i for i, l in enumerate(w) if l.startswith("G1 Z")]
+    end = steps[9] + 41  # the step up to pass 10 and its 40 beads
+    z = 10 * LAYER
+    again = []
+    for a, b in [(60.0, 140.0), (140.0, 60.0)]:
+        for j in range(1, 41):
+            x = a + (b - a) * j / 40
+            again.append(f"G1 X{x:.3f} Y100.000 Z{z:.3f} E{2.0 * WIDTH * LAYER * e_mm3:.5f} F1500")
+    w[end:end] = again
+    save("twice", w)
+
+
+def main():
+    os.makedirs(OUT, exist_ok=True)
+    for f in glob.glob(os.path.join(OUT, "*.gcode")):
+        os.remove(f)
+    with tempfile.TemporaryDirectory() as tmp:
+        vase = os.path.join(tmp, "vase.stl")
+        ripple = os.path.join(tmp, "ripple.stl")
+        write_stl(vase, vase_r, 50, 40, 48)
+        write_stl(ripple, ripple_r, 45, 36, 64)
+        defs = cura_definitions(tmp)
+        cura(vase, os.path.join(OUT, "cura-vase.gcode"), defs)
+        cura(ripple, os.path.join(OUT, "cura-ripple.gcode"), defs)
+        prusa("prusa-slicer", vase, os.path.join(OUT, "prusa-vase.gcode"), tmp)
+        prusa("prusa-slicer", ripple, os.path.join(OUT, "prusa-ripple.gcode"), tmp)
+        prusa("slic3r", vase, os.path.join(OUT, "slic3r-vase.gcode"), tmp)
+        prusa("slic3r", ripple, os.path.join(OUT, "slic3r-ripple.gcode"), tmp)
+    fullcontrol_files()
+    python_loop_files()
+    edits()
+    big = False
+    for f in sorted(glob.glob(os.path.join(OUT, "*.gcode"))):
+        size = os.path.getsize(f)
+        print(f"{os.path.basename(f):28} {size:>8} bytes")
+        big = big or size > MAX_BYTES
+    if big:
+        sys.exit(f"a file is over {MAX_BYTES} bytes")
+
+
+if __name__ == "__main__":
+    main()
