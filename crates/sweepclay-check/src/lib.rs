@@ -1,6 +1,6 @@
 //! # sweepclay-check
 //!
-//! An independent clay-printability verifier for G-code (DESIGN.md §9). It
+//! An independent clay-printability verifier for G-code (docs/CHECKER.md). It
 //! shares no code with the sweepclay pipeline, so it cannot share its bugs:
 //! it reads any G-code, replays the deposition bead by bead, and says
 //! whether the file prints in clay:

@@ -166,7 +166,7 @@ impl Serialize for Findings {
 }
 
 /// Start or end code: what comes before the print's first bead or after
-/// its last (DESIGN.md §9: reported, never a reason to fail).
+/// its last (docs/CHECKER.md: reported, never a reason to fail).
 #[derive(Clone, Debug, Default, PartialEq, Serialize)]
 pub struct Segment {
     /// First and last line of it.

@@ -27,7 +27,7 @@ struct Cli {
 
 #[derive(Subcommand, Debug)]
 enum Command {
-    /// Slice a design file (JSON, DESIGN.md §3) into clay G-code.
+    /// Slice a design file (JSON, docs/FORMATS.md) into clay G-code.
     ///
     /// Runs the pipeline (sample, correct, zig-zag path, adaptive
     /// extrusion), checks the result with `sweepclay check`, and writes the

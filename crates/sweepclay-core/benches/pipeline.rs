@@ -1,4 +1,4 @@
-//! The pipeline's stages, each on its own (paper §4–5; DESIGN.md §10):
+//! The pipeline's stages, each on its own (paper §4–5; docs/PERFORMANCE.md):
 //! on the six bundled examples, and on a scaling series of one design
 //! (`examples::scaled`) from 10 thousand to 10 million samples; and the
 //! G-code writer next to a bare fixed-point formatting loop over the same

@@ -1,5 +1,5 @@
 //! Stage 2: sampled surface → corrected surface (paper §4 "Support-free
-//! correction" and "Self-intersection detection and treatment"; DESIGN.md §5).
+//! correction" and "Self-intersection detection and treatment"; docs/ALGORITHMS.md §4).
 //!
 //! - Support-free: each transition curve is walked upward; a step whose
 //!   horizontal offset exceeds s_max(Δz) is shortened to s_max and every

@@ -1,5 +1,5 @@
 //! The three kinds of design curve, validated and turned into the sampled
-//! forms the surface needs (paper §4, DESIGN.md §3–4):
+//! forms the surface needs (paper §4, docs/FORMATS.md, docs/ALGORITHMS.md §1–2):
 //!
 //! - [`Profile`]: C_s or C_t as a table of horizontal offset against
 //!   normalised height t ∈ [0, 1] (z strictly increasing along the curve);

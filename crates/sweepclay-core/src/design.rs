@@ -1,4 +1,4 @@
-//! The design file (DESIGN.md §3, format version 1): two profile curves, a
+//! The design file (docs/FORMATS.md, format version 1): two profile curves, a
 //! trajectory, an optional interpolation curve, parameters and a printer.
 //!
 //! Parsing rejects unknown keys (typos are caught) and reports the line and
@@ -60,7 +60,7 @@ pub struct TrajectorySpec {
     pub closed: bool,
 }
 
-/// Slicing parameters (DESIGN.md §3). Lengths in mm, angles in degrees,
+/// Slicing parameters (docs/FORMATS.md). Lengths in mm, angles in degrees,
 /// feedrate in mm/min. Defaults are the paper's (§5–6).
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields, default)]
@@ -135,8 +135,8 @@ impl Params {
         Ok(())
     }
 
-    /// The largest horizontal step between two samples `dz` apart (DESIGN.md
-    /// §5): the overhang limit and the offset the widest bead still covers
+    /// The largest horizontal step between two samples `dz` apart
+    /// (docs/ALGORITHMS.md §4): the overhang limit and the offset the widest bead still covers
     /// with the target overlap.
     pub fn max_offset(&self, dz: f64) -> f64 {
         let by_angle = dz * self.max_overhang_deg.to_radians().tan();

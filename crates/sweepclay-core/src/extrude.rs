@@ -1,5 +1,5 @@
-//! Stage 4: toolpath → extrusion plan (paper §5.3, Algorithm 3; DESIGN.md
-//! §7).
+//! Stage 4: toolpath → extrusion plan (paper §5.3, Algorithm 3;
+//! docs/ALGORITHMS.md §6).
 //!
 //! Every bead starts at w_min. Walking bottom-up in print order, a point at
 //! horizontal offset s from the point below needs w = s / (1 − overlap),

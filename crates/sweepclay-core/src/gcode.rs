@@ -1,4 +1,4 @@
-//! Stage 5: extrusion plan → G-code text (DESIGN.md §8).
+//! Stage 5: extrusion plan → G-code text (docs/FORMATS.md).
 //!
 //! One function, [`emit`], owns every number format: coordinates with 3
 //! decimals, E with 5, `;WIDTH:`/`;HEIGHT:` comments (the convention

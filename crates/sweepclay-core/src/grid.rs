@@ -1,4 +1,4 @@
-//! Uniform hash grids for neighbour queries in linear time (DESIGN.md §5:
+//! Uniform hash grids for neighbour queries in linear time (docs/ALGORITHMS.md §4:
 //! "do the detection with a spatial grid, not quadratic").
 
 use rustc_hash::FxHashMap;

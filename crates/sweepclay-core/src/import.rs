@@ -1,6 +1,6 @@
 //! Trajectories from other tools: the first open curve of an SVG file, or a
 //! CSV of points, as the polyline `trajectory.points` of a design
-//! (DESIGN.md §3). Pure: text in, points out.
+//! (docs/FORMATS.md). Pure: text in, points out.
 //!
 //! SVG: the first `path`, `polyline`, `polygon` or `line` outside `<defs>`,
 //! with the `transform`s of the element and its ancestors applied. Curves

@@ -1,5 +1,5 @@
 //! Layering: which heights each transition curve is visited at, and by
-//! which pass (paper §5.2, Algorithm 2; DESIGN.md §6). The full derivation
+//! which pass (paper §5.2, Algorithm 2; docs/ALGORITHMS.md §3). The full derivation
 //! and the proofs of the invariants are in `docs/ALGORITHMS.md`.
 //!
 //! Columns (transition curves) are ordered from the short end (index 0) to

@@ -6,7 +6,7 @@
 //! Adjacent transition curves are zipped into a strip of triangles by
 //! always advancing along the curve whose next sample is lower, so the
 //! samples themselves are the vertices (no resampling). Each column is
-//! triangulated bottom up, as the samples are stored (DESIGN.md §4).
+//! triangulated bottom up, as the samples are stored (docs/ALGORITHMS.md §2).
 
 use crate::surface::Surface;
 use crate::toolpath::PointKind;

@@ -1,7 +1,7 @@
 //! Printer profiles: where the design lands on the bed, how big the bed is,
 //! how extrusion volume becomes E, and how big the extruder body is.
 //!
-//! DESIGN.md §3: `printer` is a preset name or an inline object whose missing
+//! docs/FORMATS.md: `printer` is a preset name or an inline object whose missing
 //! keys take the `generic` values.
 
 use crate::error::{Error, Result};

@@ -1,5 +1,5 @@
 //! Stage 1: design → sampled sweeping surface (paper §4 "Sample points
-//! generation", DESIGN.md §4).
+//! generation", docs/ALGORITHMS.md §2).
 //!
 //! Ψ is resampled by arc length into columns p_i; each column carries the
 //! transition curve T_i between the two profiles, λ_i = f(u_i), evaluated

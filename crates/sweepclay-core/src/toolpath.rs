@@ -1,5 +1,5 @@
 //! Stage 3: corrected surface → toolpath (paper §5.2, Algorithm 2, Fig. 7;
-//! DESIGN.md §6).
+//! docs/ALGORITHMS.md §3).
 //!
 //! One continuous boustrophedon over the surface's samples: pass k visits,
 //! in order, the columns the [`LayerPlan`](crate::layers::LayerPlan) gives

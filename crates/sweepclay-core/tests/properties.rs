@@ -1,5 +1,5 @@
 //! Property tests: random valid designs through the whole pipeline, with the
-//! independent checker (`sweepclay-check`) as the oracle for DESIGN.md §6–9,
+//! independent checker (`sweepclay-check`) as the oracle for docs/ALGORITHMS.md §3–7 and docs/CHECKER.md,
 //! plus the invariants of the toolpath checked directly. Random invalid
 //! input must give an error, never a panic.
 
@@ -112,7 +112,7 @@ fn design(s: &Spec) -> Design {
     Design::from_json(&v.to_string()).expect("generated designs parse")
 }
 
-/// Slices `d` and checks every invariant of DESIGN.md §6–9, directly and
+/// Slices `d` and checks every invariant of docs/ALGORITHMS.md §3–7 and docs/CHECKER.md, directly and
 /// with the independent checker. A design whose trajectory folds within a
 /// bead width is refused, which is correct.
 fn prints_in_clay(d: &Design) -> Result<(), TestCaseError> {

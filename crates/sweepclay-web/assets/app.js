@@ -1,4 +1,4 @@
-// The modeler page: the design (DESIGN.md §3) is the one state; the editors
+// The modeler page: the design (docs/FORMATS.md) is the one state; the editors
 // and the parameters change it, every change is recorded for undo, saved to
 // the browser, and re-sliced by the server; the preview, the statistics and
 // the checker's verdict follow.

@@ -1,4 +1,4 @@
-//! The whole job, design → verified G-code (DESIGN.md §10): slice, write
+//! The whole job, design → verified G-code (docs/PERFORMANCE.md): slice, write
 //! the G-code and check it in the same pass (`verify_into`, output
 //! discarded), on the six examples and on the scaling series of
 //! `examples::scaled` (10 thousand to 10 million samples).

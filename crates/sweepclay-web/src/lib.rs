@@ -5,7 +5,7 @@
 //! draw the two profile curves, the trajectory and the interpolation curve,
 //! and see at once the surface, the toolpath and the statistics of what
 //! will print. It is a thin shell over the library: the same design file
-//! (DESIGN.md §3), the same pipeline (`sweepclay-core`) and the same
+//! (docs/FORMATS.md), the same pipeline (`sweepclay-core`) and the same
 //! checker (`sweepclay-check`).
 //!
 //! | route | body | answer |

@@ -1,4 +1,4 @@
-//! Sliced design → G-code → independent check (DESIGN.md §9): what `slice`
+//! Sliced design → G-code → independent check (docs/CHECKER.md): what `slice`
 //! and the modeler's download both run before they hand out a file, and the
 //! way back from a failing G-code line to the place in the design.
 
