@@ -161,12 +161,6 @@ impl std::io::Write for CheckWriter<'_> {
     }
 }
 
-/// A finding whose occurrences only count if a bead follows them (travel,
-/// retractions, pauses, blobs and collisions between two beads, not after
-/// the last: that is the end code).
-#[derive(Clone, Copy)]
-struct Deferred(Finding);
-
 /// A finding held back while the checker does not yet know whether it is
 /// in the print or in the start code: `run` is the run it belongs to, or,
 /// with `gap`, the run it comes before.
@@ -203,15 +197,27 @@ struct LeadRun {
 /// runs so far did is held here.
 #[derive(Default)]
 struct Lead {
-    /// Decided: `print_run` is the print's first run.
-    decided: bool,
-    print_run: usize,
+    /// The print's first run, once known.
+    print_run: Option<usize>,
     runs: Vec<LeadRun>,
     held: Vec<Held>,
     /// Beads of the air purges (their clay falls off; it is no obstacle).
     air: Vec<u32>,
     /// What the start code holds, once decided.
     start: Segment,
+}
+
+/// What a bead was found to rest on.
+#[derive(Clone, Copy, PartialEq)]
+enum Rest {
+    /// An earlier bead (its index).
+    Bead(u32),
+    /// Clay at its own height (it is pressed onto it).
+    Clay,
+    /// The bed.
+    Bed,
+    /// Nothing, far from the bed: a purge in the air, or a fault.
+    Air,
 }
 
 /// A stretch of consecutive beads laid on clay at their own height: their
@@ -241,15 +247,20 @@ struct Checker<'a> {
     in_run: bool,
     /// Runs begun so far (start code included).
     runs: usize,
-    pending: Vec<(Deferred, usize, f64)>,
+    /// Findings that only count if a bead follows them (travel,
+    /// retractions, pauses, blobs and collisions between two beads; after
+    /// the last they are the end code), with their line and value.
+    pending: Vec<(Finding, usize, f64)>,
     lead: Lead,
     /// Moves and line of the last bead, for the end code.
     last_bead: (usize, usize),
     /// Cross-section (mm²) under which a move whose E rises is a travel
     /// carrying a rounding residue of E, not a bead.
     min_area: f64,
-    /// Beads are still analysed for support and collisions (see
+    /// Failures recorded so far (held ones included), and whether beads
+    /// are still analysed for support and collisions (see
     /// [`MAX_FAILURES`]).
+    failures: usize,
     deep: bool,
     stretch: Stretch,
     /// The last judged bead was a stub, and its overlap.
@@ -303,6 +314,7 @@ impl<'a> Checker<'a> {
             lead: Lead::default(),
             last_bead: (0, 0),
             min_area: 0.01 * cfg.width_min * cfg.min_layer_mm,
+            failures: 0,
             deep: true,
             stretch: Stretch::default(),
             prev_stub: false,
@@ -384,7 +396,7 @@ impl<'a> Checker<'a> {
         self.trim_diagnostics();
         match event {
             Some(Event::Pause(line)) => {
-                self.pending.push((Deferred(Finding::Pause), line, 0.0));
+                self.pending.push(((Finding::Pause), line, 0.0));
                 self.in_run = false;
             }
             Some(Event::Move(m)) => {
@@ -405,7 +417,8 @@ impl<'a> Checker<'a> {
     /// Records a finding: at once in the print, held back while it is not
     /// yet known whether the print has begun.
     fn record(&mut self, kind: Finding, line: usize, v: f64, gap: bool) {
-        if self.lead.decided {
+        self.failures += 1;
+        if self.lead.print_run.is_some() {
             self.r.findings[kind].add(line, v);
             return;
         }
@@ -413,7 +426,8 @@ impl<'a> Checker<'a> {
             // So much before anything rests on anything: all of it is the
             // print.
             self.decide(0);
-            return self.record(kind, line, v, gap);
+            self.r.findings[kind].add(line, v);
+            return;
         }
         let run = if gap {
             self.runs
@@ -433,7 +447,7 @@ impl<'a> Checker<'a> {
         if extruding {
             self.record(kind, line, v, false);
         } else {
-            self.pending.push((Deferred(kind), line, v));
+            self.pending.push((kind, line, v));
         }
     }
 
@@ -441,15 +455,13 @@ impl<'a> Checker<'a> {
     /// in the gap before it) is start code, the rest counts.
     fn decide(&mut self, k: usize) {
         let lead = &mut self.lead;
-        if lead.decided {
+        if lead.print_run.is_some() {
             return;
         }
-        lead.decided = true;
-        lead.print_run = k;
+        lead.print_run = Some(k);
         let cfg = self.cfg;
         let first = lead.runs.get(k);
         let first_z = first.map(|r| r.z);
-        let first_line = first.map_or(usize::MAX, |r| r.line);
         let high = first_z.filter(|&z| z > cfg.first_layer_max_mm);
         let start = &mut lead.start;
         for h in std::mem::take(&mut lead.held) {
@@ -495,19 +507,14 @@ impl<'a> Checker<'a> {
                 run.beads, run.line, run.last_line
             ));
         }
+        // The start code runs from its first item to the print's first
+        // bead (the report leaves it out if it holds nothing).
         if let Some(run) = first {
             start.moves = run.moves_before;
             if run.moves_before > 0 {
                 start.note("homing and moves to the start".into());
             }
-            if start.lines[0] == 0 {
-                start.lines[0] = 1;
-            }
-        }
-        if start.items.is_empty() {
-            lead.start = Segment::default();
-        } else if first_line != usize::MAX {
-            start.lines[1] = first_line.saturating_sub(1);
+            start.lines = [start.lines[0].max(1), run.line.saturating_sub(1)];
         }
         // Clay purged into the air falls off: it is no obstacle to the
         // print (a height no question reaches).
@@ -544,19 +551,18 @@ impl<'a> Checker<'a> {
         // Continuity.
         self.r.moves += 1;
         if m.de < -EPS_E {
-            self.pending
-                .push((Deferred(Finding::Retraction), m.line, -m.de));
+            self.pending.push(((Finding::Retraction), m.line, -m.de));
             self.in_run = false;
         } else if is_extruding && len == 0.0 {
             self.pending
-                .push((Deferred(Finding::ExtrusionWithoutMotion), m.line, m.de));
+                .push(((Finding::ExtrusionWithoutMotion), m.line, m.de));
             self.in_run = false;
         } else if bead {
             self.started = true;
             self.r.extruding_moves += 1;
             // Whatever happened since the last bead was between beads: in
             // the gap before the run this bead begins or goes on.
-            for (Deferred(kind), line, v) in std::mem::take(&mut self.pending) {
+            for (kind, line, v) in std::mem::take(&mut self.pending) {
                 self.record(kind, line, v, true);
             }
             if !self.in_run {
@@ -565,8 +571,7 @@ impl<'a> Checker<'a> {
             self.in_run = true;
         } else if len > 0.0 {
             if self.started {
-                self.pending
-                    .push((Deferred(Finding::TravelMove), m.line, len));
+                self.pending.push(((Finding::TravelMove), m.line, len));
             }
             self.in_run = false;
         }
@@ -576,6 +581,7 @@ impl<'a> Checker<'a> {
                 .zip(cfg.build_volume)
                 .fold(0.0f64, |o, (&v, lim)| larger(larger(o, -v), v - lim));
         if out > 1e-3 {
+            self.failures += 1;
             self.r.findings[Finding::OutOfBounds].add(m.line, out);
         }
 
@@ -588,7 +594,7 @@ impl<'a> Checker<'a> {
         if !self.started {
             return;
         }
-        if self.deep && self.failures() > MAX_FAILURES {
+        if self.deep && self.failures > MAX_FAILURES {
             self.deep = false;
             self.diagnose(Diagnostic {
                 line: m.line,
@@ -605,28 +611,14 @@ impl<'a> Checker<'a> {
         }
     }
 
-    /// Failures so far, held ones included.
-    fn failures(&self) -> usize {
-        self.r
-            .findings
-            .occurred()
-            .map(|(_, c)| c.count)
-            .sum::<usize>()
-            + self.lead.held.len()
-    }
-
     /// A bead begins a new extrusion run.
     fn new_run(&mut self, m: &Move) {
         self.runs += 1;
-        if self.lead.decided {
-            if self.r.run_starts.len() < 20 {
-                self.r.run_starts.push(m.line);
-            }
-            return;
-        }
         if self.lead.runs.len() >= MAX_LEAD_RUNS {
             // Run after run and nothing laid on any: all of it counts.
             self.decide(0);
+        }
+        if self.lead.print_run.is_some() {
             if self.r.run_starts.len() < 20 {
                 self.r.run_starts.push(m.line);
             }
@@ -710,7 +702,7 @@ impl<'a> Checker<'a> {
         let s = self.s;
         let volume = m.de / cfg.e_per_mm3;
         self.last_bead = (self.r.moves, m.line);
-        if !self.lead.decided {
+        if self.lead.print_run.is_none() {
             if let Some(run) = self.lead.runs.last_mut() {
                 run.beads += 1;
                 run.clay_mm3 += volume;
@@ -726,8 +718,8 @@ impl<'a> Checker<'a> {
                 false,
             );
         }
-        let mut found: Option<(Option<u32>, Option<f64>, bool)> = None;
-        let self_decided = self.lead.decided;
+        // What it rests on, if its support was sought.
+        let mut rest = None;
         let Checker {
             r,
             beads,
@@ -749,6 +741,7 @@ impl<'a> Checker<'a> {
             deep,
             prev_stub,
             prev_overlap,
+            lead,
             ..
         } = self;
         let mut held: Vec<(Finding, f64)> = Vec::new();
@@ -841,7 +834,12 @@ impl<'a> Checker<'a> {
                     width = cfg.width_max;
                 }
             }
-            found = Some((support.map(|c| c.id), own, near_bed));
+            rest = Some(match support {
+                _ if on_clay => Rest::Clay,
+                Some(c) => Rest::Bead(c.id),
+                None if near_bed => Rest::Bed,
+                None => Rest::Air,
+            });
             let (dz, overlap, offset, below_h) = match support {
                 _ if on_clay => (f64::NAN, f64::NAN, 0.0, 0.0),
                 Some(c) => {
@@ -955,8 +953,8 @@ impl<'a> Checker<'a> {
         recent.push(id, heading, s, low, turn);
         // A purge in the air before the print is no clay the carriage can
         // hit (its clay falls off).
-        let air = !self_decided && matches!(found, Some((None, None, false)));
-        if !air {
+        let purge = rest == Some(Rest::Air) && lead.print_run.is_none();
+        if !purge {
             *top_z = top_z.max(m.from[2].max(m.to[2]));
         }
         beads.push(bead);
@@ -966,37 +964,30 @@ impl<'a> Checker<'a> {
         for (kind, v) in held {
             self.record(kind, m.line, v, false);
         }
-        let Some((support, _own, near_bed)) = found else {
-            return;
-        };
-        if self.lead.decided {
+        if self.lead.print_run.is_some() {
             return;
         }
-        match support {
+        let lead = &mut self.lead;
+        match (rest, lead.runs.last_mut()) {
             // Clay laid on an earlier run's bead: that run is the print's.
-            Some(j) => {
-                let k = self.lead.runs.partition_point(|r| r.first_bead <= j);
+            (Some(Rest::Bead(j)), _) => {
+                let k = lead.runs.partition_point(|r| r.first_bead <= j);
                 self.decide(k.saturating_sub(1));
             }
-            None if !near_bed && !on_clay => {
-                if let Some(run) = self.lead.runs.last_mut() {
-                    run.air += 1;
-                }
-                if self.lead.air.len() < MAX_HELD {
-                    self.lead.air.push(id);
+            (Some(Rest::Air), Some(run)) => {
+                run.air += 1;
+                if lead.air.len() < MAX_HELD {
+                    lead.air.push(id);
                 }
             }
-            None => {
-                if let Some(run) = self.lead.runs.last_mut() {
-                    run.on_bed += usize::from(near_bed);
-                }
-            }
+            (Some(Rest::Bed), Some(run)) => run.on_bed += 1,
+            _ => {}
         }
     }
 
     fn finish(mut self) -> Report {
         self.close_stretch();
-        if !self.lead.decided {
+        if self.lead.print_run.is_none() {
             // Nothing rests on anything (a single layer): the print begins
             // at the first run that is not a purge in the air.
             let runs = &self.lead.runs;
@@ -1005,7 +996,7 @@ impl<'a> Checker<'a> {
         }
         let start = std::mem::take(&mut self.lead.start);
         self.r.start_code = (!start.items.is_empty()).then_some(start);
-        self.r.extrusion_runs = self.runs.saturating_sub(self.lead.print_run);
+        self.r.extrusion_runs = self.runs.saturating_sub(self.lead.print_run.unwrap_or(0));
         // What follows the last bead is the end code.
         let (moves_at, line_at) = self.last_bead;
         if self.started && (self.r.moves > moves_at || !self.pending.is_empty()) {
@@ -1014,7 +1005,7 @@ impl<'a> Checker<'a> {
                 moves: self.r.moves - moves_at,
                 ..Segment::default()
             };
-            for (Deferred(kind), line, _) in &self.pending {
+            for (kind, line, _) in &self.pending {
                 end.note(match kind {
                     Finding::Retraction => format!("end retraction (line {line})"),
                     Finding::TravelMove => "lifting off and travel".into(),

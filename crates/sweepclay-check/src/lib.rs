@@ -210,14 +210,17 @@ impl CheckConfig {
     /// enters into a pass.
     pub fn validate(&self) -> Result<(), ConfigError> {
         let err = |field, reason: String| Err(ConfigError { field, reason });
-        for (field, v) in [
-            (
+        let bad = |v: &[f64; 3], ok: fn(f64) -> bool| v.iter().copied().find(|&x| !ok(x));
+        if let Some(v) = bad(&self.build_volume, |x| x.is_finite() && x > 0.0) {
+            return err(
                 "build_volume",
-                self.build_volume
-                    .iter()
-                    .copied()
-                    .fold(f64::INFINITY, f64::min),
-            ),
+                format!("must be positive numbers (got {v})"),
+            );
+        }
+        if let Some(v) = bad(&self.bed_min, f64::is_finite) {
+            return err("bed_min", format!("must be finite numbers (got {v})"));
+        }
+        for (field, v) in [
             ("e_per_mm3", self.e_per_mm3),
             ("nozzle_height", self.nozzle_height),
             ("width_min", self.width_min),
@@ -231,16 +234,12 @@ impl CheckConfig {
             }
         }
         for (field, v) in [
-            (
-                "bed_min",
-                self.bed_min.iter().copied().fold(0.0, |a, b| a + b),
-            ),
             ("nozzle_radius", self.nozzle_radius),
             ("first_layer_min_mm", self.first_layer_min_mm),
             ("collision_tolerance_mm", self.collision_tolerance_mm),
             ("overhang_tolerance_deg", self.overhang_tolerance_deg),
         ] {
-            if !v.is_finite() || (field != "bed_min" && v < 0.0) {
+            if !(v.is_finite() && v >= 0.0) {
                 return err(field, format!("must be a finite number ≥ 0 (got {v})"));
             }
         }

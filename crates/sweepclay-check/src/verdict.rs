@@ -39,14 +39,14 @@ pub(crate) fn verdict(r: &mut Report, cfg: &CheckConfig) {
     }
     let mut w = Vec::new();
     let sp = &r.support;
-    if let (Some((v, l)), true) = (sp.wide.worst, sp.wide.count > 0) {
+    if let Some((v, l)) = sp.wide.worst {
         w.push(format!(
             "{} over-squished bead(s) wider than {:.1} mm (widest {v:.1} mm at line {l}): they print, pressed flat",
             sp.wide.count,
             cfg.width_max * (1.0 + WIDTH_TOLERANCE)
         ));
     }
-    if let (Some(first), true) = (sp.thin.first_line, sp.thin.count > 0) {
+    if let Some(first) = sp.thin.first_line {
         w.push(format!(
             "{} bead(s) narrower than {:.1} mm (first at line {first}): too little clay for the layer",
             sp.thin.count,

@@ -96,9 +96,9 @@ struct CheckArgs {
     #[arg(long)]
     printer: Option<String>,
     /// Whose reading of the G-code to follow where firmwares differ
-    /// (G90/G91 and E; numbers such as Z5e-05).
-    #[arg(long, default_value = "marlin", value_parser = ["marlin", "klipper", "reprap"])]
-    firmware: String,
+    /// (G90/G91 and E; numbers such as Z5e-05): marlin, klipper or reprap.
+    #[arg(long, default_value = "marlin")]
+    firmware: sweepclay_check::Firmware,
     /// H: extruder body height above the nozzle tip (mm) [default: 30].
     #[arg(long)]
     nozzle_height: Option<f64>,
@@ -358,7 +358,7 @@ fn check_cmd(a: CheckArgs) -> Result<i32> {
         }
     };
     let cfg = CheckConfig {
-        firmware: a.firmware.parse().map_err(anyhow::Error::msg)?,
+        firmware: a.firmware,
         nozzle_height: a.nozzle_height.unwrap_or(base.nozzle_height),
         width_min: a.width_min.unwrap_or(base.width_min),
         width_max: a.width_max.unwrap_or(base.width_max),
