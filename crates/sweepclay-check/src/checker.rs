@@ -690,6 +690,9 @@ impl<'a> Checker<'a> {
     /// Ends a stretch of beads on clay at their own height: a failure if
     /// it is longer than 2 w_max and most of its clay had no room.
     fn close_stretch(&mut self) {
+        if self.stretch.length == 0.0 {
+            return;
+        }
         let st = std::mem::take(&mut self.stretch);
         if st.length > 2.0 * self.cfg.width_max && st.excess > 0.75 * st.volume {
             self.record(Finding::DoubleDeposition, st.first_line, st.excess, false);
@@ -940,11 +943,7 @@ impl<'a> Checker<'a> {
             s,
             step,
         );
-        bead.height32 = if height.is_finite() {
-            height as f32
-        } else {
-            0.0
-        };
+        bead.set_height(height);
         if *deep {
             grid.insert(&bead, id);
         }

@@ -5,12 +5,14 @@
 /// Length of a plan vector. Not `f64::hypot`: that guards against
 /// overflow at a cost this hot loop cannot pay, and an overflow to
 /// infinity only makes a distance compare as far.
+#[inline]
 pub(crate) fn len2(dx: f64, dy: f64) -> f64 {
     (dx * dx + dy * dy).sqrt()
 }
 
 /// `floor(v / size)`, clamped to ±10⁸ (NaN to 0). Not `f64::floor`, which
 /// without SSE 4.1 is a library call this hot path cannot pay.
+#[inline]
 pub(crate) fn cell(v: f64, size: f64) -> i32 {
     let q = (v / size).clamp(-1e8, 1e8);
     let t = q as i32;
@@ -46,6 +48,7 @@ pub(crate) fn smaller<T: PartialOrd>(a: T, b: T) -> T {
 
 /// Plan distance from `p` to a rectangle `[x0, y0, x1, y1]` (0 inside; 0
 /// for a NaN `p`).
+#[inline]
 pub(crate) fn rect_distance(r: [f64; 4], p: [f64; 2]) -> f64 {
     let dx = (r[0] - p[0]).max(p[0] - r[2]).max(0.0);
     let dy = (r[1] - p[1]).max(p[1] - r[3]).max(0.0);
@@ -54,6 +57,7 @@ pub(crate) fn rect_distance(r: [f64; 4], p: [f64; 2]) -> f64 {
 
 /// Overlap of a bead of width `wa` with one of width `wb` whose centre is
 /// `s` to the side, as a fraction of `wa`.
+#[inline]
 pub(crate) fn overlap_fraction(wa: f64, wb: f64, s: f64) -> f64 {
     let lo = (-wa / 2.0).max(s - wb / 2.0);
     let hi = (wa / 2.0).min(s + wb / 2.0);
@@ -77,6 +81,7 @@ pub(crate) fn minmax(slot: &mut Option<[(f64, usize); 2]>, v: f64, line: usize) 
 /// An upper bound of `acos c` for `c ≥ 0.5` (a turn under 60°):
 /// `√(2(1 − c)) (1 + (1 − c)/6)`, at most 3.5 % over and cheaper than
 /// `acos`; π below.
+#[inline]
 pub(crate) fn turn_bound(c: f64) -> f64 {
     if c >= 0.5 {
         let v = (1.0 - c).max(0.0);

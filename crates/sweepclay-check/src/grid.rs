@@ -81,6 +81,7 @@ impl BeadGrid {
     /// The cells a bead spans: plan x and y ranges and z range, or
     /// `None` for a move so long (other slicers) that indexing it would
     /// exhaust memory.
+    #[inline]
     pub(crate) fn span(b: &Bead) -> Option<Span> {
         let (from, to) = (b.from(), b.to());
         let x = [
@@ -101,10 +102,12 @@ impl BeadGrid {
 
     /// A cell range on axis `a` as indices into the grid (inclusive),
     /// clamped into it.
+    #[inline]
     pub(crate) fn clamp(&self, a: usize, r: [i32; 2]) -> [usize; 2] {
         r.map(|v| (v.saturating_add(MARGIN_CELLS)).clamp(0, self.dims[a] - 1) as usize)
     }
 
+    #[inline]
     pub(crate) fn insert(&mut self, b: &Bead, id: u32) {
         let Some((xs, ys, zs)) = Self::span(b) else {
             return;

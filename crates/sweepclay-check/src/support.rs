@@ -30,6 +30,7 @@ pub(crate) struct Candidate {
 impl Candidate {
     /// Order by distance, ties (the shared end of two beads) to the
     /// earlier bead.
+    #[inline]
     pub(crate) fn nearer(&self, o: &Candidate) -> std::cmp::Ordering {
         self.d.total_cmp(&o.d).then(self.id.cmp(&o.id))
     }
@@ -128,7 +129,7 @@ impl Query<'_> {
                     at,
                     d,
                     width: b.width(),
-                    height: f64::from(b.height32),
+                    height: b.height(),
                     covers: d <= b.width() / 2.0,
                 });
             }
@@ -151,6 +152,7 @@ impl Query<'_> {
     /// the new bead: `classify` puts none of them in `Below`. Oldest first,
     /// since clay below in the last stretch of path (the end of the pass
     /// before a reversal) is usually its oldest part.
+    #[inline]
     pub(crate) fn none_below(&self, beads: &[Bead], first: usize) -> bool {
         beads
             .iter()
@@ -178,6 +180,7 @@ impl Recent {
     /// length `l` starting at path distance `s_start`, or a little more
     /// ([`turn_bound`]; only sums under 60° matter in `clear_of`, and more
     /// turning only sends a bead to the full search).
+    #[inline]
     pub(crate) fn turn(&self, d: [f64; 2], l: f64, s_start: f64) -> f64 {
         match self.last {
             Some((u, s)) if l > 1e-9 && (s - s_start).abs() < 1e-9 => {
@@ -190,6 +193,7 @@ impl Recent {
     /// Bead `id` (plan direction `heading` if it has one, ending at path
     /// distance `s_end`, lowest point `low`, turned into by `turn`) joins
     /// the window.
+    #[inline]
     pub(crate) fn push(
         &mut self,
         id: u32,
@@ -208,6 +212,7 @@ impl Recent {
     }
 
     /// Bead `id`, the oldest in the window, leaves it.
+    #[inline]
     pub(crate) fn settle(&mut self, id: u32) {
         if self.low.front().is_some_and(|r| r.0 == id) {
             self.low.pop_front();
@@ -220,6 +225,7 @@ impl Recent {
         }
     }
 
+    #[inline]
     pub(crate) fn low(&self) -> f64 {
         self.low.front().map_or(f64::INFINITY, |r| f64::from(r.1))
     }
@@ -233,6 +239,7 @@ impl Recent {
     /// length. So, if `m` is longer than 0.45 mm in plan (or all are less
     /// than 0.5 mm below its start), `classify` puts each behind the
     /// nozzle.
+    #[inline]
     pub(crate) fn clear_of(
         &self,
         m: &Move,
@@ -609,7 +616,7 @@ mod tests {
     }
 
     #[test]
-    pub(crate) fn climbs_a_leaning_stack_to_its_top() {
+    fn climbs_a_leaning_stack_to_its_top() {
         // Layers 1.2 mm apart, each 0.8 mm further out (a 34° lean); the
         // lowest is nearest the new bead's middle.
         let c = [
@@ -622,7 +629,7 @@ mod tests {
     }
 
     #[test]
-    pub(crate) fn does_not_slide_along_a_tilted_ridge() {
+    fn does_not_slide_along_a_tilted_ridge() {
         // One pass rising 0.3 mm per mm: the bead below is the nearest.
         let c = [
             cand(5.0, 0.0, 0.1),
@@ -634,7 +641,7 @@ mod tests {
     }
 
     #[test]
-    pub(crate) fn bed_when_nothing_covers_and_low() {
+    fn bed_when_nothing_covers_and_low() {
         let c = [cand(1.2, 5.0, 5.0)];
         assert!(pick_support(&c, 0.3, true).is_none());
         assert_eq!(pick_support(&c, 0.3, false).unwrap().z, 1.2, "an overhang");
@@ -642,7 +649,7 @@ mod tests {
     }
 
     #[test]
-    pub(crate) fn merged_runs_hold_each_bead_of_the_runs_once() {
+    fn merged_runs_hold_each_bead_of_the_runs_once() {
         let mut state = 3u64;
         for case in 0..500 {
             let n = case % 40;

@@ -59,6 +59,7 @@ impl TopGrid {
     }
 
     /// Cell index along axis `a`, clamped into the rectangle.
+    #[inline]
     pub(crate) fn index(&self, v: f64, a: usize) -> usize {
         // `as` truncates toward zero and saturates (NaN to 0), which is the
         // floor for every cell index but the first; to `i32`, which is a
@@ -68,6 +69,7 @@ impl TopGrid {
     }
 
     /// Cell ranges `[x0, x1], [y0, y1]` (inclusive) of a plan box.
+    #[inline]
     pub(crate) fn range(&self, lo: [f64; 2], hi: [f64; 2]) -> ([usize; 2], [usize; 2]) {
         (
             [self.index(lo[0], 0), self.index(hi[0], 0)],
@@ -91,6 +93,7 @@ impl TopGrid {
 
     /// The blocks of 4 × 4 cells that hold cells `xs`, `ys` (inclusive):
     /// a range of `coarse` a row.
+    #[inline]
     pub(crate) fn blocks(
         &self,
         (xs, ys): ([usize; 2], [usize; 2]),
@@ -101,6 +104,7 @@ impl TopGrid {
 
     /// The highest top in cells `xs`, `ys` (inclusive) or a little beyond:
     /// the blocks of 4 × 4 cells that hold them.
+    #[inline]
     pub(crate) fn block_max(&self, cells: ([usize; 2], [usize; 2])) -> f32 {
         let mut m = f32::NEG_INFINITY;
         for row in self.blocks(cells) {
@@ -114,6 +118,7 @@ impl TopGrid {
     /// Raises the cells a bead's centreline passes through to its top:
     /// the cells of its plan bounding box, or for a long slanting move
     /// (other slicers) the cells around points every half cell along it.
+    #[inline]
     pub(crate) fn raise(&mut self, b: &Bead) {
         let (f, t) = (b.from(), b.to());
         let top = b.top32();
@@ -169,6 +174,7 @@ impl TopGrid {
     /// The part of `lo..hi` on axis `a` inside cell `g` (its upper edge
     /// excluded); a border cell also holds the clay beyond the border, so
     /// its side is not cut there.
+    #[inline]
     pub(crate) fn clip(&self, g: usize, a: usize, lo: f64, hi: f64) -> (f64, f64) {
         let edge = self.origin[a] + g as f64 * self.cell;
         (
@@ -182,6 +188,7 @@ impl TopGrid {
     }
 
     /// The cell's plan rectangle `[x0, y0, x1, y1]`.
+    #[inline]
     pub(crate) fn rect(&self, x: usize, y: usize) -> [f64; 4] {
         let x0 = self.origin[0] + x as f64 * self.cell;
         let y0 = self.origin[1] + y as f64 * self.cell;
@@ -194,7 +201,7 @@ mod tests {
     use super::*;
 
     #[test]
-    pub(crate) fn column_top_blocks_bound_their_cells() {
+    fn column_top_blocks_bound_their_cells() {
         // Beads of every length and direction raise a 2 mm grid over a
         // 200 mm bed; each cell must be as high as the beads through it,
         // each block must hold its cells' highest top, and a box's cells
