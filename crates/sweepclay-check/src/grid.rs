@@ -142,8 +142,8 @@ impl BeadGrid {
     /// in path order): they count in the highest settled top at once, in
     /// the column tops only when a query reads them. A print laid bottom
     /// up keeps its settled clay below the nozzle's tip, so its probes
-    /// never read the columns, which saves a raise a bead (7 % of the
-    /// instructions of a check).
+    /// never read the columns, which saves a raise a bead
+    /// (docs/PERFORMANCE.md, "The checker's micro-choices").
     pub(crate) fn settle(&mut self, beads: &[Bead], done: impl Fn(&Bead) -> bool) {
         let top = &mut self.settled_top;
         settle(beads, &mut self.settled, done, |_, b| {

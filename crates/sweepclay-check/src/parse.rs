@@ -353,8 +353,8 @@ fn number(s: &[u8], mut i: usize) -> (Option<f64>, usize) {
         i += 1;
     }
     let start = i;
-    // The index of the `.`; `usize::MAX` when there is none (an `Option`
-    // costs 0.7 % more instructions a check, callgrind on the 44k text).
+    // The index of the `.`; `usize::MAX` when there is none (cheaper than
+    // an `Option`: docs/PERFORMANCE.md, "The checker's micro-choices").
     let mut dot = usize::MAX;
     let mut m = 0u64;
     while let Some(&c) = s.get(i) {

@@ -94,9 +94,8 @@ pub(crate) struct Query<'a> {
 impl Query<'_> {
     /// Judges earlier bead `b` (index `j`) against the new bead.
     /// Inlined into each of its callers (the shortcut, both searches):
-    /// called from four places the compiler stops inlining it, which
-    /// cost 5 % more instructions a check at 1M samples (callgrind:
-    /// 3,953 M against 3,752 M; 44k: 166 M against 160 M).
+    /// called from four places the compiler stops inlining it, at a
+    /// measured cost (docs/PERFORMANCE.md, "The checker's micro-choices").
     #[inline(always)]
     pub(crate) fn classify(&self, b: &Bead, j: u32) -> Class {
         let Query {

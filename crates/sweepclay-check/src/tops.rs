@@ -130,11 +130,10 @@ impl TopGrid {
         // Most beads: three cells a side or fewer, so two blocks a side at
         // most. Their cells and blocks without the loops of raise_box: the
         // first and last of each side (some perhaps the same), and, for a
-        // third cell, the middle one. Check of the 44k text 12.39–12.47 ms
-        // against 12.78–12.96 with loops over the cells and blocks (min of
-        // 40, alternated); raising nine fixed cells for every bead instead
-        // chained each store to the next load where beads lie in one cell
-        // (1M: 1–2 % slower).
+        // third cell, the middle one. Faster than the loops, and than nine
+        // fixed cells, which chain each store to the next load where beads
+        // lie in one cell (docs/PERFORMANCE.md, "The checker's
+        // micro-choices").
         if xs[1] - xs[0] <= 2 && ys[1] - ys[0] <= 2 {
             let nx = self.n[0];
             for (x, y) in [

@@ -16,7 +16,7 @@
 //! | `POST /api/verify` | design JSON | [`api::Verdict`]: the checker's verdict on its G-code |
 //! | `POST /api/gcode` | design JSON | the verified G-code, or 422 with the failures and where they are |
 //! | `POST /api/stl` | design JSON | binary STL of the surface thickened to the bead width |
-//! | `POST /api/check` | G-code text | the checker's report on any G-code (query: `printer`) |
+//! | `POST /api/check` | G-code text | the checker's report on any G-code (query: `printer`; default: the header's, else `generic`) |
 //! | `POST /api/import/svg`, `/api/import/csv` | file text | trajectory points |
 //!
 //! Errors are JSON `{"error": "...", "key": "..."}` with a 4xx status.
@@ -37,6 +37,7 @@ use axum::{Json, Router};
 use serde::Deserialize;
 use std::collections::HashMap;
 use std::sync::Arc;
+use sweepclay_check::CheckConfig;
 use sweepclay_core::printer::PRESETS;
 use sweepclay_core::{examples, Params, Printer};
 
@@ -303,20 +304,29 @@ async fn check(
             format!("unknown query key `{k}` (only `printer`)"),
         ));
     }
-    let name = q.printer.unwrap_or_else(|| "generic".into());
-    let printer = Printer::preset(&name).ok_or_else(|| {
-        ApiError::new(
-            422,
-            format!("printer: `{name}` is not a preset ({})", PRESETS.join(", ")),
-        )
-        .with_key("printer")
-    })?;
+    let printer = match &q.printer {
+        Some(name) => Some(Printer::preset(name).ok_or_else(|| {
+            ApiError::new(
+                422,
+                format!("printer: `{name}` is not a preset ({})", PRESETS.join(", ")),
+            )
+            .with_key("printer")
+        })?),
+        None => None,
+    };
     let text = text(body)?;
     blocking(move || {
-        Ok(sweepclay_check::check(
-            &text,
-            &verify::printer_check(&printer),
-        ))
+        // Without `printer`, a sweepclay file is checked for the printer
+        // its header names, any other for `generic` (as the CLI does).
+        let cfg = match printer {
+            Some(p) => verify::printer_check(&p),
+            None => sweepclay_check::header::config_from_header(&text, &CheckConfig::default())
+                .unwrap_or_else(|| CheckConfig {
+                    printer: "generic (assumed: pass ?printer=)".into(),
+                    ..CheckConfig::default()
+                }),
+        };
+        Ok(sweepclay_check::check(&text, &cfg))
     })
     .await
     .map(Json)

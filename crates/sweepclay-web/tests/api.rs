@@ -1,7 +1,7 @@
 //! The JSON API over a real server on a free loopback port.
 
 use serde_json::Value;
-use sweepclay_core::examples;
+use sweepclay_core::{examples, Design};
 use sweepclay_web::api::Limits;
 
 /// Starts the server on 127.0.0.1:0 in the background; returns its base URL.
@@ -223,4 +223,27 @@ async fn imports_and_checks() {
     );
     let r = post(&format!("{base}/api/check?printer=nope"), gcode).await;
     assert_eq!(r.status(), 422);
+    // Without `printer`: a sweepclay file for the printer its header
+    // names, any other for `generic`, and the report says which.
+    let r = post(&format!("{base}/api/check"), gcode).await;
+    let v: Value = r.json().await.unwrap();
+    assert!(v["printer"].as_str().unwrap().contains("assumed"), "{v}");
+    let mut d = Design::from_json(examples::example("t4").unwrap()).unwrap();
+    d.printer = sweepclay_core::PrinterRef::Preset("cerambot-mini".into());
+    let ours = sweepclay_web::verify::verify(&sweepclay_core::slice(&d).unwrap(), 0.5).gcode;
+    let r = post(&format!("{base}/api/check"), ours).await;
+    let v: Value = r.json().await.unwrap();
+    assert_eq!(v["printable"], true, "{v}");
+    assert!(
+        v["printer"]
+            .as_str()
+            .unwrap()
+            .starts_with("cerambot-mini (from the file's header)"),
+        "{v}"
+    );
+    // A 60 MB line is one diagnostic, not 60 million words.
+    let r = post(&format!("{base}/api/check"), "X".repeat(60 << 20)).await;
+    assert_eq!(r.status(), 200);
+    let v: Value = r.json().await.unwrap();
+    assert_eq!(v["diagnostics_total"], 1, "{v}");
 }
