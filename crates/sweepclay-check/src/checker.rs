@@ -4,6 +4,7 @@
 
 use crate::bead::Bead;
 use crate::blocks::Blocks;
+use crate::collide;
 use crate::geom::{larger, len2, minmax, overlap_fraction, smaller};
 use crate::grid::{settle, BeadGrid};
 use crate::parse::{Diagnostic, Line, LineParser};
@@ -637,53 +638,20 @@ impl<'a> Checker<'a> {
         });
     }
 
-    /// Collisions at points every r/2 mm of path (at most 200 a move).
+    /// Collisions along a move ([`collide::probe`]): counted at once for a
+    /// bead, held back for a travel (they count only if a bead follows).
     fn probe(&mut self, m: &Move, len: f64, s_start: f64, is_extruding: bool) {
-        let cfg = self.cfg;
-        let recent_nozzle = cfg.nozzle_radius + cfg.width_max;
-        let reach = cfg.nozzle_radius + cfg.width_max / 2.0;
-        let every = (cfg.nozzle_radius / 2.0).max(0.5);
-        // Path distances are ≥ 0, where truncation is the floor (and no
-        // library call).
-        let floor = |v: f64| (v as i64) as f64;
-        let (first, last) = (floor(s_start / every) + 1.0, floor(self.s / every));
-        let probes = (last - first + 1.0).clamp(0.0, 200.0) as usize;
-        for k in 0..probes {
-            let t = if probes < 200 {
-                ((first + k as f64) * every - s_start) / len
-            } else {
-                (k + 1) as f64 / probes as f64
-            };
-            let p = [
-                m.from[0] + t * (m.to[0] - m.from[0]),
-                m.from[1] + t * (m.to[1] - m.from[1]),
-                m.from[2] + t * (m.to[2] - m.from[2]),
-            ];
-            let sp = s_start + t * len;
-            // Beads the nozzle has left behind count for collisions.
-            self.grid
-                .settle(&self.beads, |b| b.s_end <= sp - recent_nozzle);
-            if self.top_z > p[2] + cfg.nozzle_height + cfg.collision_tolerance_mm {
-                let v = self.top_z - p[2] - cfg.nozzle_height;
-                self.defer_or_add(is_extruding, Finding::CarriageCollision, m.line, v);
-            }
-            let mut worst: f64 = 0.0;
-            let zlo = p[2] + cfg.collision_tolerance_mm;
-            let beads = &self.beads;
-            self.grid
-                .settled_near(beads, p, reach, zlo, p[2] + cfg.nozzle_height, |id| {
-                    let b = &beads[id as usize];
-                    if b.s_end > sp - recent_nozzle {
-                        return;
-                    }
-                    let (d, z, _) = b.closest(p);
-                    if z > zlo && d < cfg.nozzle_radius + b.width() / 2.0 {
-                        worst = worst.max(z - p[2]);
-                    }
-                });
-            if worst > 0.0 {
-                self.defer_or_add(is_extruding, Finding::NozzleCollision, m.line, worst);
-            }
+        let mut hits = Vec::new();
+        collide::probe(
+            &mut self.grid,
+            &self.beads,
+            self.top_z,
+            self.cfg,
+            (m, len, s_start, self.s),
+            |kind, v| hits.push((kind, v)),
+        );
+        for (kind, v) in hits {
+            self.defer_or_add(is_extruding, kind, m.line, v);
         }
     }
 

@@ -37,6 +37,7 @@
 mod bead;
 mod blocks;
 mod checker;
+mod collide;
 mod geom;
 mod grid;
 pub mod header;
