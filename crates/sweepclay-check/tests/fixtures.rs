@@ -542,6 +542,43 @@ fn a_seam_and_a_vase_ramp_at_full_flow_are_normal_printing() {
 }
 
 #[test]
+fn a_tapered_last_turn_with_reduced_flow_is_normal_printing() {
+    // Cura's smooth spiral end: the last turn stays at the rim's height
+    // while its flow falls to nothing.
+    let mut g = vase(10);
+    let top = g.at[2];
+    for i in 1..=90 {
+        let a = std::f64::consts::TAU * i as f64 / 90.0;
+        let flow = 1.0 - i as f64 / 90.0;
+        g.bead(
+            [100.0 + 30.0 * a.cos(), 100.0 + 30.0 * a.sin(), top],
+            W,
+            LAYER * flow.max(0.01),
+        );
+    }
+    let r = verdict(&g.out);
+    assert!(r.printable, "{}", r.render());
+}
+
+#[test]
+fn a_first_bead_from_the_bed_fails_as_dragged() {
+    // The first pass laid at Z=0: the nozzle drags on the bed.
+    let mut g = G::new([50.0, 50.0, 0.0]);
+    g.run([90.0, 50.0, 0.0], W, LAYER);
+    for k in 1..=3 {
+        let z = LAYER * k as f64;
+        let (a, b) = if k % 2 == 1 { (90.0, 50.0) } else { (50.0, 90.0) };
+        g.bead([a, 50.0, z], W, LAYER);
+        g.run([b, 50.0, z], W, LAYER);
+    }
+    let r = verdict(&g.out);
+    fails_for(&r, "into the bed", &["overlapping the bead below"]);
+    // Beads into the bed have no layer height or width to report.
+    let [(lo, _), _] = r.support.layer_height.unwrap();
+    assert!(lo > 0.0, "{}", r.render());
+}
+
+#[test]
 fn start_and_end_code_are_not_the_print() {
     // A stationary prime, a purge in the air at Z50, retract, travel,
     // unretract, a travel carrying a rounding residue of E; after the
