@@ -567,7 +567,11 @@ fn a_first_bead_from_the_bed_fails_as_dragged() {
     g.run([90.0, 50.0, 0.0], W, LAYER);
     for k in 1..=3 {
         let z = LAYER * k as f64;
-        let (a, b) = if k % 2 == 1 { (90.0, 50.0) } else { (50.0, 90.0) };
+        let (a, b) = if k % 2 == 1 {
+            (90.0, 50.0)
+        } else {
+            (50.0, 90.0)
+        };
         g.bead([a, 50.0, z], W, LAYER);
         g.run([b, 50.0, z], W, LAYER);
     }

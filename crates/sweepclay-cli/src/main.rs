@@ -15,11 +15,19 @@ use sweepclay_web::verify::{printer_check, verify_into};
 #[global_allocator]
 static ALLOC: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
+/// The version and the commit the binary was built from (`build.rs`).
+const VERSION: &str = concat!(
+    env!("CARGO_PKG_VERSION"),
+    " (commit ",
+    env!("SWEEPCLAY_COMMIT"),
+    ")"
+);
+
 /// Clay 3D printing of sweeping surfaces: design file → one continuous,
 /// collision-free, self-supporting G-code path, and a checker that says
 /// whether any G-code file prints in clay.
 #[derive(Parser, Debug)]
-#[command(name = "sweepclay", version, about, long_about = None)]
+#[command(name = "sweepclay", version = VERSION, about, long_about = None)]
 struct Cli {
     #[command(subcommand)]
     command: Command,
@@ -304,6 +312,10 @@ fn slice(a: SliceArgs) -> Result<i32> {
 fn serve(a: ServeArgs) -> Result<i32> {
     let rt = tokio::runtime::Runtime::new().context("starting the async runtime")?;
     rt.block_on(async {
+        eprintln!(
+            "sweepclay {VERSION}: starting the modeler on {}:{} ...",
+            a.host, a.port
+        );
         let listener = tokio::net::TcpListener::bind((a.host.as_str(), a.port))
             .await
             .with_context(|| format!("listening on {}:{}", a.host, a.port))?;
