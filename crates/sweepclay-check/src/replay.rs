@@ -237,6 +237,29 @@ mod tests {
     }
 
     #[test]
+    fn g91_switches_e_in_marlin_only() {
+        let text = "M82\nG1 X10 E1\nG91\nG1 X5 E1\n";
+        let mut d = vec![];
+        let lines = parse(text, &mut d);
+        let mut de = |fw| {
+            let mut r = Replayer {
+                firmware: fw,
+                ..Replayer::default()
+            };
+            let ev: Vec<_> = lines.iter().filter_map(|l| r.feed(l, &mut d)).collect();
+            match ev[1] {
+                Event::Move(m) => (m.to[0], m.de),
+                Event::Pause(_) => unreachable!(),
+            }
+        };
+        // Marlin: G91 makes E relative too (E1 is one more); Klipper and
+        // RepRapFirmware: E stays absolute (E1 is where it already is).
+        assert_eq!(de(crate::Firmware::Marlin), (15.0, 1.0));
+        assert_eq!(de(crate::Firmware::Klipper), (15.0, 0.0));
+        assert_eq!(de(crate::Firmware::Reprap), (15.0, 0.0));
+    }
+
+    #[test]
     fn g92_and_inches() {
         let m = moves("G1 X1 E5\nG92 E0\nG1 X2 E1\nG20\nG1 X1\n");
         assert_eq!(m[1].de, 1.0);

@@ -561,6 +561,21 @@ fn a_tapered_last_turn_with_reduced_flow_is_normal_printing() {
 }
 
 #[test]
+fn a_thin_finishing_pass_offset_sideways_is_no_steep_overhang() {
+    // A wall, then a last pass 0.4 mm up and 1.2 mm to the side: atan(1.2
+    // / 0.4) is 72°, but the pass leans over the height of the bead it
+    // rests on (atan(1.2 / 1.2) = 45°).
+    let mut g = wall(6);
+    let z = LAYER * 6.0 + 0.4;
+    g.bead([50.0, 51.2, z], W, 0.4);
+    g.run([90.0, 51.2, z], W, 0.4);
+    let r = verdict(&g.out);
+    assert!(r.printable, "{}", r.render());
+    let (angle, _) = r.support.max_overhang_deg.unwrap();
+    assert!(angle > 40.0 && angle < 50.0, "{angle}\n{}", r.render());
+}
+
+#[test]
 fn a_first_bead_from_the_bed_fails_as_dragged() {
     // The first pass laid at Z=0: the nozzle drags on the bed.
     let mut g = G::new([50.0, 50.0, 0.0]);
