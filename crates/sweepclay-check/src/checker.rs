@@ -400,15 +400,16 @@ impl<'a> Checker<'a> {
                 self.pending.push(((Finding::Pause), line, 0.0));
                 self.in_run = false;
             }
-            Some(Event::Move(m)) => {
+            Some(Event::Move(mut m)) => {
                 // Into the box's own frame: its lowest corner at 0.
                 let b = self.cfg.bed_min;
-                let shift = |p: [f64; 3]| [p[0] - b[0], p[1] - b[1], p[2] - b[2]];
-                let m = Move {
-                    from: shift(m.from),
-                    to: shift(m.to),
-                    ..m
-                };
+                if b != [0.0; 3] {
+                    for p in [&mut m.from, &mut m.to] {
+                        for (v, o) in p.iter_mut().zip(b) {
+                            *v -= o;
+                        }
+                    }
+                }
                 self.step(&m)
             }
             None => {}
@@ -715,7 +716,14 @@ impl<'a> Checker<'a> {
             lead,
             ..
         } = self;
-        let mut held: Vec<(Finding, f64)> = Vec::new();
+        // Its failures, recorded once the borrows below end (at most one
+        // each of: no clay below, too little overlap, overhang).
+        let mut held = [(Finding::Unsupported, 0.0); 3];
+        let mut n_held = 0;
+        let mut hold = |kind, v| {
+            held[n_held] = (kind, v);
+            n_held += 1;
+        };
         r.path_length_mm += len;
         r.volume_ml += volume / 1000.0;
         for p in [m.from, m.to] {
@@ -835,7 +843,7 @@ impl<'a> Checker<'a> {
                     (mid[2], 1.0, 0.0, 0.0)
                 }
                 None => {
-                    held.push((Finding::Unsupported, mid[2]));
+                    hold(Finding::Unsupported, mid[2]);
                     (f64::NAN, f64::NAN, 0.0, 0.0)
                 }
             };
@@ -877,7 +885,7 @@ impl<'a> Checker<'a> {
                 *prev_stub = stub;
                 *prev_overlap = overlap;
                 if overlap < cfg.overlap_min - 1e-9 {
-                    held.push((Finding::UnderMinOverlap, cfg.overlap_min - overlap));
+                    hold(Finding::UnderMinOverlap, cfg.overlap_min - overlap);
                 }
                 if overlap < cfg.overlap_target - 1e-6 {
                     r.support.under_target += 1;
@@ -895,7 +903,7 @@ impl<'a> Checker<'a> {
                         r.support.max_overhang_deg = Some((angle, m.line));
                     }
                     if angle > cfg.max_overhang_deg + cfg.overhang_tolerance_deg {
-                        held.push((Finding::Overhang, angle));
+                        hold(Finding::Overhang, angle);
                     }
                 }
             }
@@ -928,7 +936,7 @@ impl<'a> Checker<'a> {
         if !on_clay && !step {
             self.close_stretch();
         }
-        for (kind, v) in held {
+        for &(kind, v) in &held[..n_held] {
             self.record(kind, m.line, v, false);
         }
         if self.lead.print_run.is_some() {

@@ -269,6 +269,7 @@ impl Recent {
 ///
 /// `beads[..settled]` are in `tops`. The cost does not depend on how
 /// finely the path is sampled.
+#[inline]
 pub(crate) fn follow_support(
     beads: &[Bead],
     settled: usize,
