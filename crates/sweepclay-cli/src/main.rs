@@ -15,6 +15,9 @@ use sweepclay_web::verify::{printer_check, verify_into};
 #[global_allocator]
 static ALLOC: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
+/// The most surface samples `slice` and `serve` take by default.
+const DEFAULT_MAX_SAMPLES: u64 = 1_500_000;
+
 /// The version and the commit the binary was built from (`build.rs`).
 const VERSION: &str = concat!(
     env!("CARGO_PKG_VERSION"),
@@ -62,7 +65,7 @@ struct ServeArgs {
     #[arg(long, default_value_t = 8080)]
     port: u16,
     /// Refuse designs with more surface samples than this (estimated).
-    #[arg(long, default_value_t = 1_500_000)]
+    #[arg(long, default_value_t = DEFAULT_MAX_SAMPLES)]
     max_samples: u64,
 }
 
@@ -89,6 +92,10 @@ struct SliceArgs {
     /// Write the file even if the printability check fails.
     #[arg(long)]
     force: bool,
+    /// Refuse designs with more surface samples than this (estimated
+    /// before slicing; the same default as `serve`).
+    #[arg(long, default_value_t = DEFAULT_MAX_SAMPLES)]
+    max_samples: u64,
     /// Print the summary as JSON.
     #[arg(long)]
     json: bool,
@@ -160,7 +167,50 @@ fn main() {
     std::process::exit(code);
 }
 
+/// Prints a line to stdout. A reader that has gone (`| head`) is not an
+/// error: the command goes on with its work (writing its files) and says
+/// nothing more; any other failure to write is.
+fn say(args: std::fmt::Arguments) -> Result<()> {
+    use std::sync::atomic::{AtomicBool, Ordering};
+    static GONE: AtomicBool = AtomicBool::new(false);
+    if GONE.load(Ordering::Relaxed) {
+        return Ok(());
+    }
+    match std::io::stdout().lock().write_fmt(args) {
+        Err(e) if e.kind() == std::io::ErrorKind::BrokenPipe => {
+            GONE.store(true, Ordering::Relaxed);
+            Ok(())
+        }
+        r => r.context("writing to standard output"),
+    }
+}
+
+/// `println!` through [`say`], in a function returning [`Result`].
+macro_rules! say {
+    ($($t:tt)*) => { say(format_args!("{}\n", format_args!($($t)*)))? };
+}
+
+/// Temporary files not yet renamed into place: removed if the command is
+/// interrupted (Ctrl+C, SIGTERM), so no hidden partial file is left.
+static LIVE: std::sync::Mutex<Vec<PathBuf>> = std::sync::Mutex::new(Vec::new());
+
+/// Removes the live temporary files when the command is interrupted.
+fn clean_up_on_signal() {
+    let _ = ctrlc::set_handler(|| {
+        if let Ok(live) = LIVE.lock() {
+            for p in live.iter() {
+                let _ = std::fs::remove_file(p);
+            }
+        }
+        eprintln!("interrupted: nothing written");
+        std::process::exit(130);
+    });
+}
+
 fn run(cli: Cli) -> Result<i32> {
+    if matches!(cli.command, Command::Slice(_) | Command::Examples { .. }) {
+        clean_up_on_signal();
+    }
     match cli.command {
         Command::Slice(a) => slice(a),
         Command::Check(a) => check_cmd(a),
@@ -170,7 +220,7 @@ fn run(cli: Cli) -> Result<i32> {
             for (name, text) in examples::EXAMPLES {
                 let path = dir.join(name);
                 write_atomic(&path, text.as_bytes())?;
-                println!("wrote {}", path.display());
+                say!("wrote {}", path.display());
             }
             Ok(0)
         }
@@ -224,6 +274,10 @@ fn slice(a: SliceArgs) -> Result<i32> {
             .with_context(|| format!("--set {k}: `{v}` is not a number"))?;
         design.params.set(k, v)?;
     }
+    // Refused before anything is sampled, as the server refuses it.
+    design
+        .check_size(a.max_samples as f64)
+        .with_context(|| source.clone())?;
     let sliced = sweepclay_core::slice(&design).with_context(|| source.clone())?;
     let out = a.output.clone().unwrap_or_else(|| {
         let stem = Path::new(&a.design)
@@ -235,6 +289,7 @@ fn slice(a: SliceArgs) -> Result<i32> {
     // The G-code streams into a temporary file beside the output and
     // through the checker in one pass; it becomes the output only if it
     // passes (or with --force).
+    let out = output_target(&out)?;
     let tmp = temp_beside(&out)?;
     let (report, locations) = verify_into(
         &sliced,
@@ -252,41 +307,44 @@ fn slice(a: SliceArgs) -> Result<i32> {
             "output": out, "stats": st, "corrections": sliced.corrected.report,
             "check": report, "written": report.printable || a.force,
         });
-        println!("{}", serde_json::to_string_pretty(&v)?);
+        say!("{}", serde_json::to_string_pretty(&v)?);
     } else {
         let name = &sliced.corrected.surface.name;
-        println!(
+        say!(
             "{} → {}",
             if name.is_empty() { &source } else { name },
             out.display()
         );
-        println!("  printer            {}", printer.name);
-        println!(
+        say!("  printer            {}", printer.name);
+        say!(
             "  size               {:.1} × {:.1} × {:.1} mm",
-            st.size_mm[0], st.size_mm[1], st.size_mm[2]
+            st.size_mm[0],
+            st.size_mm[1],
+            st.size_mm[2]
         );
-        println!(
+        say!(
             "  sample points      {} on {} transition curves",
-            st.sample_points, st.curves
+            st.sample_points,
+            st.curves
         );
-        println!(
+        say!(
             "  passes             {} ({} stage{}, {} returning turns)",
             st.passes,
             st.stages,
             if st.stages == 1 { "" } else { "s" },
             st.returning_points
         );
-        println!("  path length        {:.1} m", st.path_length_mm / 1000.0);
-        println!("  clay volume        {:.1} ml", st.volume_ml);
-        println!("  estimated time     {:.1} min", st.time_min);
+        say!("  path length        {:.1} m", st.path_length_mm / 1000.0);
+        say!("  clay volume        {:.1} ml", st.volume_ml);
+        say!("  estimated time     {:.1} min", st.time_min);
         let corr = sliced.corrected.report.summary();
         if corr.is_empty() {
-            println!("  corrections        none");
+            say!("  corrections        none");
         }
         for c in corr {
-            println!("  correction         {c}");
+            say!("  correction         {c}");
         }
-        println!(
+        say!(
             "  check              {}",
             if report.printable {
                 "printable".to_string()
@@ -295,7 +353,7 @@ fn slice(a: SliceArgs) -> Result<i32> {
             }
         );
         for at in &locations {
-            println!("  where              {at}");
+            say!("  where              {at}");
         }
     }
     if !report.printable && !a.force {
@@ -325,7 +383,7 @@ fn serve(a: ServeArgs) -> Result<i32> {
         } else {
             addr.ip().to_string()
         };
-        println!(
+        say!(
             "sweepclay modeler: http://{host}:{}/  (Ctrl+C to stop)",
             addr.port()
         );
@@ -385,22 +443,51 @@ fn check_cmd(a: CheckArgs) -> Result<i32> {
     let report = check_reader(std::io::BufReader::with_capacity(1 << 16, open()?), &cfg)
         .with_context(|| format!("reading {}", a.file.display()))?;
     if a.json {
-        println!("{}", serde_json::to_string_pretty(&report)?);
+        say!("{}", serde_json::to_string_pretty(&report)?);
     } else {
-        print!("{}", report.render());
+        say(format_args!("{}", report.render()))?;
     }
     Ok(if report.printable { 0 } else { 1 })
 }
 
+/// The file an output path names: itself if missing, its target if it is
+/// a symbolic link to a regular file; anything that is not a regular file
+/// (a directory, a device, a FIFO) is refused, never replaced.
+fn output_target(path: &Path) -> Result<PathBuf> {
+    match std::fs::metadata(path) {
+        Ok(m) if m.is_file() => {
+            std::fs::canonicalize(path).with_context(|| format!("resolving {}", path.display()))
+        }
+        Ok(_) => bail!(
+            "{}: not a regular file (a directory, device or FIFO); refusing to replace it",
+            path.display()
+        ),
+        Err(e) if e.kind() == std::io::ErrorKind::NotFound => {
+            if std::fs::symlink_metadata(path).is_ok() {
+                bail!(
+                    "{}: a symbolic link to nothing; refusing to follow it",
+                    path.display()
+                );
+            }
+            Ok(path.to_path_buf())
+        }
+        Err(e) => Err(e).with_context(|| format!("checking {}", path.display())),
+    }
+}
+
 /// An empty temporary file in the directory of `path`, to be renamed over
-/// it by [`persist`] (deleted if dropped).
+/// it by [`persist`] (deleted if dropped or if the command is interrupted).
 fn temp_beside(path: &Path) -> Result<tempfile::NamedTempFile> {
     let dir = path
         .parent()
         .filter(|d| !d.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
-    tempfile::NamedTempFile::new_in(dir)
-        .with_context(|| format!("creating a temporary file in {}", dir.display()))
+    let tmp = tempfile::NamedTempFile::new_in(dir)
+        .with_context(|| format!("creating a temporary file in {}", dir.display()))?;
+    if let Ok(mut live) = LIVE.lock() {
+        live.push(tmp.path().to_path_buf());
+    }
+    Ok(tmp)
 }
 
 /// Makes a finished temporary file `path`: an ordinary file (temporary
@@ -414,14 +501,20 @@ fn persist(tmp: tempfile::NamedTempFile, path: &Path) -> Result<()> {
             .set_permissions(std::fs::Permissions::from_mode(0o644))?;
     }
     tmp.as_file().sync_all()?;
-    tmp.persist(path)
-        .with_context(|| format!("writing {}", path.display()))?;
-    Ok(())
+    let name = tmp.path().to_path_buf();
+    let done = tmp
+        .persist(path)
+        .with_context(|| format!("writing {}", path.display()));
+    if let Ok(mut live) = LIVE.lock() {
+        live.retain(|p| *p != name);
+    }
+    done.map(|_| ())
 }
 
 /// Writes through a temporary file in the same directory and renames it.
 fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
-    let mut tmp = temp_beside(path)?;
+    let path = output_target(path)?;
+    let mut tmp = temp_beside(&path)?;
     tmp.write_all(bytes)?;
-    persist(tmp, path)
+    persist(tmp, &path)
 }

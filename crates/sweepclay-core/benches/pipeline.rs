@@ -5,7 +5,8 @@
 //! numbers (its floor).
 //!
 //! `cargo bench -p sweepclay-core` (all), or with a filter:
-//! `cargo bench -p sweepclay-core -- stages/t1`, `-- scaling`, `-- gcode_floor`.
+//! `cargo bench -p sweepclay-core -- stages/t1`, `-- scaling`, `-- gcode_floor`,
+//! `-- bspline` (B-spline evaluation from 10 to 100,000 control points).
 //! `SWEEPCLAY_BENCH_MAX=1000000` stops the scaling series at 1 million.
 
 use criterion::{criterion_group, criterion_main, BatchSize, BenchmarkId, Criterion, Throughput};
@@ -149,5 +150,30 @@ fn gcode_floor(c: &mut Criterion) {
     g.finish();
 }
 
-criterion_group!(benches, examples_bench, gcode_floor, scaling_bench);
+/// B-spline evaluation from 10 to 100,000 control points, 20 points a
+/// span: the time a point must not grow with the number of points
+/// (throughput in points).
+fn bspline_bench(c: &mut Criterion) {
+    let mut g = c.benchmark_group("bspline");
+    for n in [10usize, 1_000, 100_000] {
+        let pts: Vec<[f64; 2]> = (0..n)
+            .map(|i| [i as f64, ((i * 7919) % 13) as f64])
+            .collect();
+        let curve = sweepclay_core::bspline::BSpline::clamped(pts).expect("two points or more");
+        let evals = 20 * curve.spans();
+        g.throughput(Throughput::Elements(evals as u64));
+        g.bench_function(BenchmarkId::new("flatten", n), |b| {
+            b.iter(|| curve.flatten(black_box(20)))
+        });
+    }
+    g.finish();
+}
+
+criterion_group!(
+    benches,
+    examples_bench,
+    gcode_floor,
+    scaling_bench,
+    bspline_bench
+);
 criterion_main!(benches);

@@ -223,6 +223,55 @@ impl Design {
         serde_json::to_string_pretty(self).expect("a design always serialises")
     }
 
+    /// Refuses, before anything is sampled, a design whose estimated sample
+    /// count ([`Design::estimated_samples`]) is over `max_samples`
+    /// ([`Error::TooLarge`]), or that cannot fit its printer: the surface
+    /// starts and ends at Ψ's first and last points on the bed and is as
+    /// tall there as the profiles, so if those leave the build volume the
+    /// whole does ([`Error::DoesNotFit`], as slicing would say).
+    pub fn check_size(&self, max_samples: f64) -> crate::Result<()> {
+        let estimate = self.estimated_samples();
+        if estimate > max_samples {
+            return Err(Error::TooLarge {
+                estimate,
+                limit: max_samples,
+            });
+        }
+        let pr = self.printer.resolve()?;
+        let t = &self.trajectory;
+        let pts = t
+            .control_points
+            .as_deref()
+            .or(t.points.as_deref())
+            .unwrap_or(&[]);
+        let top = |c: &CurveSpec| c.control_points.last().map_or(0.0, |p| p[1]);
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        let ends = pts.first().into_iter().chain(pts.last());
+        for p in ends {
+            for a in 0..2 {
+                lo[a] = lo[a].min(pr.origin[a] + p[a]);
+                hi[a] = hi[a].max(pr.origin[a] + p[a]);
+            }
+        }
+        lo[2] = 0.0;
+        hi[2] = top(&self.profile_start).max(top(&self.profile_end));
+        for a in 0..3 {
+            let (min, max) = (pr.bed_min[a], pr.bed_min[a] + pr.build_volume[a]);
+            if lo[a] < min - 1e-9 || hi[a] > max + 1e-9 {
+                return Err(Error::DoesNotFit {
+                    printer: pr.name.clone(),
+                    axis: ['x', 'y', 'z'][a],
+                    min: lo[a],
+                    max: hi[a],
+                    low: min,
+                    limit: max,
+                });
+            }
+        }
+        Ok(())
+    }
+
     /// An upper bound on the number of surface samples, computed from the
     /// control polygons without sampling anything: (polygon length of Ψ /
     /// spacing + 1) × (tallest profile / layer height + 1). A server can

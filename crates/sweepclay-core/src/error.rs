@@ -36,7 +36,7 @@ pub enum Error {
     #[error("layering: {0}")]
     Layering(String),
     /// The printed object would leave the printer's build volume.
-    #[error("the design does not fit printer `{printer}`: {axis} spans {min:.1}..{max:.1} mm but the build volume is 0..{limit:.1} mm")]
+    #[error("the design does not fit printer `{printer}`: {axis} spans {min:.1}..{max:.1} mm but the build volume is {low:.1}..{limit:.1} mm")]
     DoesNotFit {
         /// Printer name.
         printer: String,
@@ -46,7 +46,18 @@ pub enum Error {
         min: f64,
         /// Highest coordinate on the bed, bead edge included.
         max: f64,
-        /// Build volume size along the axis.
+        /// The build volume's lowest coordinate along the axis (`bed_min`).
+        low: f64,
+        /// The build volume's highest coordinate along the axis.
+        limit: f64,
+    },
+    /// The design has more surface samples than the caller allows
+    /// (estimated from its control polygons before anything is sampled).
+    #[error("params.spacing / params.layer_height: the design would have about {:.1} million samples, over the limit of {:.1} million; raise the spacing or the layer height", .estimate / 1e6, .limit / 1e6)]
+    TooLarge {
+        /// The estimate ([`crate::Design::estimated_samples`]).
+        estimate: f64,
+        /// The limit.
         limit: f64,
     },
 }

@@ -74,16 +74,25 @@ pub fn emit<W: Write>(s: &Sliced, out: &mut W) -> io::Result<Vec<usize>> {
     for line in s.corrected.report.summary() {
         writeln!(out, "; correction: {line}")?;
     }
-    writeln!(out, "G21 ; millimetres")?;
-    writeln!(out, "G90 ; absolute coordinates")?;
-    if pr.relative_e {
-        writeln!(out, "M83 ; relative extrusion")?;
-    } else {
-        writeln!(out, "M82 ; absolute extrusion")?;
-    }
+    let modes = |out: &mut Lines<W>| -> io::Result<()> {
+        writeln!(out, "G21 ; millimetres")?;
+        writeln!(out, "G90 ; absolute coordinates")?;
+        if pr.relative_e {
+            writeln!(out, "M83 ; relative extrusion")
+        } else {
+            writeln!(out, "M82 ; absolute extrusion")
+        }
+    };
+    modes(out)?;
     out.write_all(pr.start_gcode.as_bytes())?;
-    if !pr.start_gcode.is_empty() && !pr.start_gcode.ends_with('\n') {
-        writeln!(out)?;
+    if !pr.start_gcode.is_empty() {
+        if !pr.start_gcode.ends_with('\n') {
+            writeln!(out)?;
+        }
+        // The start code may leave any mode behind (a G91, an E): the moves
+        // need theirs.
+        modes(out)?;
+        writeln!(out, "G92 E0")?;
     }
     let before = out.count;
     let points = &s.toolpath.points;

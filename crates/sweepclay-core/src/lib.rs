@@ -122,6 +122,7 @@ pub fn finish(corrected: Corrected) -> Result<Sliced> {
                 axis: ['x', 'y', 'z'][axis],
                 min: lo,
                 max: hi,
+                low: min,
                 limit: min + pr.build_volume[axis],
             });
         }

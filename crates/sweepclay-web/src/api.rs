@@ -57,6 +57,7 @@ impl From<Error> for ApiError {
         let (status, key) = match &e {
             Error::Parse { .. } => (400, None),
             Error::Invalid { key, .. } => (422, Some(key.clone())),
+            Error::TooLarge { .. } => (413, Some("params.spacing".into())),
             _ => (422, None),
         };
         ApiError {
@@ -82,18 +83,7 @@ impl Default for Limits {
 /// Parses a design and refuses one whose sample count is over the limit.
 pub fn parse_design(text: &str, limits: &Limits) -> Result<Design, ApiError> {
     let d = Design::from_json(text)?;
-    let est = d.estimated_samples();
-    if est > limits.max_samples {
-        return Err(ApiError::new(
-            413,
-            format!(
-                "params.spacing / params.layer_height: the design would have about {:.1} million samples, over this server's limit of {:.1} million; raise the spacing or the layer height",
-                est / 1e6,
-                limits.max_samples / 1e6
-            ),
-        )
-        .with_key("params.spacing"));
-    }
+    d.check_size(limits.max_samples)?;
     Ok(d)
 }
 
