@@ -443,6 +443,7 @@ mod tests {
             control_points: None,
             points: Some(vec![[0.0, 10.0], [30.0, 10.0], [30.0, 50.0]]),
             closed: false,
+            offset: Default::default(),
         };
         let t = Trajectory::new(&spec, 1.0).unwrap();
         assert!((t.length - 70.0).abs() < 1e-9);
@@ -465,6 +466,7 @@ mod tests {
                 [20.0, 0.0],
             ]),
             closed: false,
+            offset: Default::default(),
         };
         let e = Trajectory::new(&spec, 1.1).unwrap_err();
         assert!(e.to_string().contains("crosses itself"), "{e}");

@@ -58,6 +58,30 @@ pub struct TrajectorySpec {
     /// Reserved for closed trajectories (vases); must be `false` for now.
     #[serde(default)]
     pub closed: bool,
+    /// The frame of the profiles' horizontal offset (default radial).
+    #[serde(default, skip_serializing_if = "Offset::is_radial")]
+    pub offset: Offset,
+}
+
+/// The direction in which a profile's horizontal offset x moves a point
+/// of Ψ (docs/ALGORITHMS.md §2).
+#[derive(Clone, Copy, Debug, Default, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Offset {
+    /// Away from the centre `o`, d_i = (p_i − o)/|p_i − o| (the paper's
+    /// revolution about the z axis): Ψ must keep 1 mm from `o`.
+    #[default]
+    Radial,
+    /// Perpendicular to Ψ in the plane, to the left of the direction of
+    /// travel: what a wall drawn anywhere, also through `o`, needs.
+    Normal,
+}
+
+impl Offset {
+    /// Whether this is the default, radial frame.
+    pub fn is_radial(&self) -> bool {
+        *self == Offset::Radial
+    }
 }
 
 /// Slicing parameters (docs/FORMATS.md). Lengths in mm, angles in degrees,

@@ -165,6 +165,35 @@ fn finish(pts: Vec<[f64; 2]>, key: &str) -> Result<Vec<[f64; 2]>> {
     Ok(resample(&out, MAX_POINTS))
 }
 
+/// The offset frame an imported open path needs: `Normal` with a note
+/// saying so when it passes within `near` mm of the centre `o` (where a
+/// radial offset is undefined or flips: a wall drawn through the middle
+/// of a sheet, a centred S-curve), else the default `Radial`.
+pub fn offset_for(pts: &[[f64; 2]], near: f64) -> (crate::Offset, Option<String>) {
+    let from_o = pts
+        .windows(2)
+        .map(|w| {
+            let (a, b) = (w[0], w[1]);
+            let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
+            let l2 = dx * dx + dy * dy;
+            let t = if l2 > 0.0 {
+                (-(a[0] * dx + a[1] * dy) / l2).clamp(0.0, 1.0)
+            } else {
+                0.0
+            };
+            (a[0] + t * dx).hypot(a[1] + t * dy)
+        })
+        .fold(f64::INFINITY, f64::min);
+    if from_o < near {
+        let note = format!(
+            "the path passes {from_o:.1} mm from the centre o, so its profiles are offset perpendicular to it (\"offset\": \"normal\")"
+        );
+        (crate::Offset::Normal, Some(note))
+    } else {
+        (crate::Offset::Radial, None)
+    }
+}
+
 /// Moves the points so that the centre of their bounding box is at `o`.
 pub fn centre(pts: &mut [[f64; 2]]) {
     let (mut lo, mut hi) = ([f64::MAX; 2], [f64::MIN; 2]);
@@ -407,6 +436,15 @@ mod tests {
         let e = csv_trajectory("0,0\n5\n").unwrap_err().to_string();
         assert!(e.starts_with("csv line 2: expected `x, y`"), "{e}");
         assert!(csv_trajectory("").is_err());
+    }
+
+    #[test]
+    fn a_path_through_the_centre_gets_normal_offsets() {
+        let (o, note) = offset_for(&[[-40.0, -1.0], [40.0, 1.0]], 10.0);
+        assert_eq!(o, crate::Offset::Normal);
+        assert!(note.unwrap().contains("0.0 mm from the centre"));
+        let (o, note) = offset_for(&[[-40.0, 30.0], [0.0, 50.0], [40.0, 30.0]], 10.0);
+        assert_eq!((o, note), (crate::Offset::Radial, None));
     }
 
     #[test]

@@ -52,7 +52,7 @@ pub mod surface;
 pub mod toolpath;
 
 pub use correct::{Corrected, CorrectionReport};
-pub use design::{Design, Params};
+pub use design::{Design, Offset, Params};
 pub use error::{Error, Result};
 pub use extrude::Extrusion;
 pub use printer::{Printer, PrinterRef};

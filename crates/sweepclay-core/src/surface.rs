@@ -7,7 +7,7 @@
 //! sample *is* a path point, as in the paper.
 
 use crate::curves::{Interpolation, Profile, Trajectory};
-use crate::design::{Design, Params};
+use crate::design::{Design, Offset, Params};
 use crate::error::{Error, Result};
 use crate::layers::LayerPlan;
 use crate::printer::Printer;
@@ -118,6 +118,21 @@ impl Surface {
     }
 }
 
+/// The unit normal of the polyline `pts` at point `i`, to the left of the
+/// direction of travel: from the chord of its neighbours (one-sided at the
+/// ends), so a straight wall has one normal and a bend turns it smoothly.
+fn normal(pts: &[[f64; 2]], i: usize) -> [f64; 2] {
+    let a = pts[i.saturating_sub(1)];
+    let b = pts[(i + 1).min(pts.len() - 1)];
+    let (tx, ty) = (b[0] - a[0], b[1] - a[1]);
+    let l = tx.hypot(ty);
+    if l > 0.0 {
+        [-ty / l, tx / l]
+    } else {
+        [0.0, 1.0]
+    }
+}
+
 /// Samples the design's surface. Validates every part of the design first.
 pub fn sample_surface(design: &Design) -> Result<Surface> {
     let params = design.params.clone();
@@ -141,21 +156,27 @@ pub fn sample_surface(design: &Design) -> Result<Surface> {
     let n = traj.points.len();
     let mut columns = Vec::with_capacity(n);
     for (i, &p) in traj.points.iter().enumerate() {
-        let r = p[0].hypot(p[1]);
         let u = i as f64 / (n - 1) as f64;
-        if r < 1.0 {
-            return Err(Error::invalid(
-                "trajectory",
-                format!(
-                    "passes within 1 mm of the centre o at ({:.2}, {:.2}), u = {u:.3}; the radial direction is undefined there",
-                    p[0], p[1]
-                ),
-            ));
-        }
+        let dir = match design.trajectory.offset {
+            Offset::Radial => {
+                let r = p[0].hypot(p[1]);
+                if r < 1.0 {
+                    return Err(Error::invalid(
+                        "trajectory",
+                        format!(
+                            "passes within 1 mm of the centre o at ({:.2}, {:.2}), u = {u:.3}, where the radial direction is undefined; set \"offset\": \"normal\" in the trajectory to offset the profiles perpendicular to it instead, or move the curve away from o",
+                            p[0], p[1]
+                        ),
+                    ));
+                }
+                [p[0] / r, p[1] / r]
+            }
+            Offset::Normal => normal(&traj.points, i),
+        };
         let lambda = interp.eval(u);
         columns.push(Column {
             p,
-            dir: [p[0] / r, p[1] / r],
+            dir,
             u,
             lambda,
             height: (1.0 - lambda) * start.height + lambda * end.height,
@@ -291,6 +312,51 @@ mod tests {
         d.trajectory.points = Some(vec![[-30.0, 0.0], [30.0, 0.0]]);
         let e = sample_surface(&d).unwrap_err().to_string();
         assert!(e.contains("within 1 mm of the centre"), "{e}");
+    }
+
+    #[test]
+    fn a_straight_wall_through_the_centre_with_normal_offset_is_a_flat_wall() {
+        // 60 mm through o, vertical profiles 20 mm: a flat wall, every
+        // sample on the line y = 0, as long and as tall as drawn; the
+        // radial error names the way out.
+        let mut d = cylinder(20.0, 20.0);
+        d.trajectory.points = Some(vec![[-30.0, 0.0], [30.0, 0.0]]);
+        let e = sample_surface(&d).unwrap_err().to_string();
+        assert!(e.contains(r#""offset": "normal""#), "{e}");
+        d.trajectory.offset = Offset::Normal;
+        let s = sample_surface(&d).unwrap();
+        let (mut xmin, mut xmax, mut zmax) = (f64::MAX, f64::MIN, 0.0f64);
+        for (c, col) in s.columns.iter().enumerate() {
+            assert_eq!(col.dir, [0.0, 1.0], "normal to the left of +x");
+            for i in col.samples() {
+                let p = s.position(c, i);
+                assert!(p[1].abs() < 1e-12, "off the wall: {p:?}");
+                xmin = xmin.min(p[0]);
+                xmax = xmax.max(p[0]);
+                zmax = zmax.max(p[2]);
+            }
+        }
+        assert!(
+            (xmin + 30.0).abs() < 1e-9 && (xmax - 30.0).abs() < 1e-9,
+            "{xmin}..{xmax}"
+        );
+        assert!((zmax - 20.0).abs() < 1e-9, "{zmax}");
+    }
+
+    #[test]
+    fn a_normal_offset_moves_a_wall_sideways_by_the_profile_offset() {
+        // The profiles lean 5 mm over 20: at the top the wall stands 5 mm
+        // to the left of Ψ (+y for a wall drawn along +x).
+        let mut d = cylinder(20.0, 20.0);
+        d.trajectory.points = Some(vec![[-30.0, 0.0], [30.0, 0.0]]);
+        d.trajectory.offset = Offset::Normal;
+        d.profile_start.control_points = vec![[0.0, 0.0], [5.0, 20.0]];
+        d.profile_end.control_points = vec![[0.0, 0.0], [5.0, 20.0]];
+        d.params.max_overhang_deg = 60.0;
+        let s = sample_surface(&d).unwrap();
+        let col = &s.columns[s.columns.len() / 2];
+        let top = s.position(s.columns.len() / 2, col.samples().end - 1);
+        assert!((top[1] - 5.0).abs() < 1e-9, "{top:?}");
     }
 
     #[test]

@@ -282,6 +282,33 @@ proptest! {
     }
 
     #[test]
+    fn walls_through_the_centre_with_normal_offsets_print_in_clay(
+        zs in 8.0..50.0f64, zt in 8.0..50.0f64,
+        half in 30.0..80.0f64, angle in -180.0..180.0f64,
+        amp in prop::collection::vec(-20.0..20.0f64, 3..6),
+        (xs, xt) in (-5.0..5.0f64, -5.0..5.0f64),
+    ) {
+        // A straight wall or a wave centred on o, in any direction, with
+        // profiles offset perpendicular to it.
+        let n = amp.len() + 2;
+        let (c, s) = (angle.to_radians().cos(), angle.to_radians().sin());
+        let cp: Vec<[f64; 2]> = (0..n).map(|i| {
+            let t = -half + 2.0 * half * i as f64 / (n - 1) as f64;
+            let w = if i == 0 || i == n - 1 { 0.0 } else { amp[i - 1] };
+            [t * c - w * s, t * s + w * c]
+        }).collect();
+        prop_assume!((zs - zt).abs() < half);
+        let v = serde_json::json!({
+            "sweepclay": 1, "name": "wall through o",
+            "profile_start": { "control_points": [[0.0, 0.0], [xs, zs / 2.0], [0.0, zs]] },
+            "profile_end": { "control_points": [[0.0, 0.0], [xt, zt / 2.0], [0.0, zt]] },
+            "trajectory": { "control_points": cp, "offset": "normal" },
+            "printer": { "name": "wide", "build_volume": [200.0, 200.0, 200.0], "origin": [100.0, 100.0] },
+        });
+        prints_in_clay(&Design::from_json(&v.to_string()).unwrap())?;
+    }
+
+    #[test]
     fn arbitrary_text_never_panics(s in ".{0,400}") {
         let _ = Design::from_json(&s);
     }

@@ -80,6 +80,7 @@ function setDesign(d, { record = true, fit = false } = {}) {
     ed.refresh();
   }
   fillParams();
+  $('offset').value = d.trajectory.offset === 'normal' ? 'normal' : 'radial';
   updateUndo();
   requestSlice(fit);
 }
@@ -176,6 +177,10 @@ const editors = [
 state.editors = editors;
 
 $('snap').addEventListener('change', (e) => editors.forEach((ed) => { ed.snapOn = e.target.checked; }));
+$('offset').addEventListener('change', (e) => edit((d) => {
+  if (e.target.value === 'normal') d.trajectory.offset = 'normal';
+  else delete d.trajectory.offset;
+}, true));
 
 // ---------------------------------------------------------------- slicing
 
@@ -332,8 +337,20 @@ function setVerdict(v) {
 
 function setBusy(on) {
   const s = $('status');
-  if (on && !s.querySelector('.error')) s.innerHTML = '<span class="busy">slicing…</span>';
+  if (on && !s.querySelector('.error') && !s.querySelector('.busy')) {
+    s.insertAdjacentHTML('afterbegin', '<span class="busy">slicing…</span>');
+  }
   if (!on) s.querySelector('.busy')?.remove();
+}
+
+/// A passing remark in the status line (not an error).
+function showNote(msg) {
+  const s = $('status');
+  s.querySelector('.note')?.remove();
+  const div = document.createElement('div');
+  div.className = 'note';
+  div.textContent = msg;
+  s.appendChild(div);
 }
 
 function showError(msg, key) {
@@ -485,7 +502,11 @@ $('import-file').addEventListener('change', async () => {
     showError(`${name}: ${body.error}`);
     return;
   }
-  edit((d) => { d.trajectory = { points: body.points }; }, true);
+  edit((d) => {
+    d.trajectory = { points: body.points };
+    if (body.offset === 'normal') d.trajectory.offset = 'normal';
+  }, true);
+  if (body.note) showNote(`${name}: ${body.note}`);
   editors[2].fitted = false;
   editors[2].fit();
   editors[2].refresh();

@@ -367,6 +367,12 @@ pub struct Imported {
     pub points: Vec<[f64; 2]>,
     /// Arc length (mm).
     pub length_mm: f64,
+    /// The offset frame the path needs (`normal` when it passes near the
+    /// centre `o`).
+    pub offset: sweepclay_core::Offset,
+    /// What the page should tell the user about that choice.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
 }
 
 /// Imports a trajectory; `format` is `svg` or `csv`.
@@ -386,7 +392,15 @@ pub fn import(format: &str, text: &str) -> Result<Imported, ApiError> {
         *p = p.map(|x| (x * 1000.0).round() / 1000.0);
     }
     let length_mm = sweepclay_core::bspline::polyline_length(&points);
-    Ok(Imported { points, length_mm })
+    // Near o a radial offset flips from side to side: 10 mm, about two of
+    // the widest beads.
+    let (offset, note) = sweepclay_core::import::offset_for(&points, 10.0);
+    Ok(Imported {
+        points,
+        length_mm,
+        offset,
+        note,
+    })
 }
 
 #[cfg(test)]

@@ -327,6 +327,54 @@ async fn draw_preview_and_download_verified_gcode() {
     let report = sweepclay_check::check(&text, &sweepclay_web::verify::printer_check(&printer));
     assert!(report.printable, "{:?}", report.failures);
     assert!(report.extruding_moves as f64 > grown - 2.0);
+
+    // Import a wave drawn through the middle of the sheet: the page picks
+    // the offset across the path and says so; it slices printable. Back
+    // to offsets from the centre, the error names the way out.
+    let svg = tmp.path().join("wave.svg");
+    std::fs::write(
+        &svg,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="120mm" height="60mm" viewBox="0 0 120 60"><path d="M 0 30 C 30 0, 30 0, 60 30 S 90 60, 120 30"/></svg>"#,
+    )
+    .unwrap();
+    c.find(fantoccini::Locator::Id("import-file"))
+        .await
+        .unwrap()
+        .send_keys(svg.to_str().unwrap())
+        .await
+        .unwrap();
+    wait_js(
+        &c,
+        "return window.sweepclay.design.trajectory.offset === 'normal' && document.getElementById('offset').value === 'normal'",
+        "the imported wave with offsets across the path",
+    )
+    .await;
+    let note = wait_js(
+        &c,
+        "return document.querySelector('#status .note')?.textContent || null",
+        "the note on the offset",
+    )
+    .await;
+    assert!(note.as_str().unwrap().contains("perpendicular"), "{note}");
+    wait_js(
+        &c,
+        "return !window.sweepclay.inFlight && !window.sweepclay.pending && document.getElementById('verdict').dataset.printable === 'true'",
+        "the verdict on the imported wave",
+    )
+    .await;
+    c.execute("const s = document.getElementById('offset'); s.value = 'radial'; s.dispatchEvent(new Event('change'));", vec![])
+        .await
+        .unwrap();
+    let err = wait_js(
+        &c,
+        "return document.querySelector('#status .error')?.textContent || null",
+        "the error for a radial wave through o",
+    )
+    .await;
+    assert!(
+        err.as_str().unwrap().contains("\"offset\": \"normal\""),
+        "{err}"
+    );
     assert_eq!(js(&c, "return window.sweepclayErrors").await, json!([]));
     c.close().await.unwrap();
 }
