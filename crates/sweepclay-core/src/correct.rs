@@ -52,6 +52,10 @@ pub struct SupportFix {
     pub max_shift_mm: f64,
     /// Number of points whose step was shortened.
     pub steps_shortened: u32,
+    /// How many of them the bead overlap limited (w_max · (1 − overlap):
+    /// the widest bead could not have covered the step with the target
+    /// overlap) rather than the overhang angle.
+    pub by_overlap: u32,
 }
 
 /// The self-intersection found and how it was removed.
@@ -91,8 +95,17 @@ impl CorrectionReport {
                 .iter()
                 .max_by(|a, b| a.max_shift_mm.total_cmp(&b.max_shift_mm))
                 .expect("non-empty");
+            let steps: u32 = self.support.iter().map(|f| f.steps_shortened).sum();
+            let by_overlap: u32 = self.support.iter().map(|f| f.by_overlap).sum();
+            let why = match (steps - by_overlap, by_overlap) {
+                (_, 0) => "the overhang limit".to_string(),
+                (0, _) => "the bead overlap (the widest bead covers no more with the target overlap)".to_string(),
+                (a, o) => format!(
+                    "the overhang limit ({a} steps) and the bead overlap ({o} steps: the widest bead covers no more with the target overlap)"
+                ),
+            };
             out.push(format!(
-                "support-free: {} curve(s) corrected; largest move {:.2} mm on {} at z = {:.1} mm",
+                "support-free: {} curve(s) corrected for {why}; largest move {:.2} mm on {} at z = {:.1} mm",
                 self.support.len(),
                 worst.max_shift_mm,
                 worst.curve,
@@ -187,7 +200,7 @@ fn support_free(s: &mut Surface) -> Vec<SupportFix> {
         for i in range.start + 1..range.end {
             let design = s.samples[i];
             let mut xi = design.xi + carry;
-            let limit = s.params.max_offset(design.z - prev.z);
+            let (limit, by_angle) = s.params.offset_limit(design.z - prev.z);
             let step = xi - prev.xi;
             if step.abs() > limit + 1e-12 {
                 let clamped = prev.xi + limit.copysign(step);
@@ -205,8 +218,10 @@ fn support_free(s: &mut Surface) -> Vec<SupportFix> {
                     z_mm: design.z,
                     max_shift_mm: 0.0,
                     steps_shortened: 0,
+                    by_overlap: 0,
                 });
                 f.steps_shortened += 1;
+                f.by_overlap += u32::from(!by_angle);
             }
             if let Some(f) = fix.as_mut() {
                 f.max_shift_mm = f.max_shift_mm.max(carry.abs());
@@ -389,6 +404,42 @@ mod tests {
         }
         let summary = c.report.summary().join("\n");
         assert!(summary.contains("support-free"), "{summary}");
+    }
+
+    #[test]
+    fn the_overhang_angle_and_the_bead_overlap_are_separate_reasons() {
+        // A 50° lean: within 57° at any layer height, so at 1.25 mm layers
+        // nothing is corrected; at 2 mm layers a step is 2.38 mm, more than
+        // the widest bead covers with 2/3 overlap (6 · 1/3 = 2 mm): the
+        // bead overlap, not the angle, shortens it, and the report says so.
+        let lean = 40.0 * 50f64.to_radians().tan();
+        let mut d = design(
+            &format!("[[0,0],[{lean},40]]"),
+            &format!("[[0,0],[{lean},40]]"),
+            r#"{"points":[[-40,40],[40,40]]}"#,
+        );
+        let c = correct(&sample_surface(&d).unwrap()).unwrap();
+        assert!(c.report.support.is_empty(), "{:?}", c.report.summary());
+        d.params.layer_height = 2.0;
+        d.params.max_layer_height = 4.0;
+        let c = correct(&sample_surface(&d).unwrap()).unwrap();
+        let f = &c.report.support[0];
+        assert!(
+            f.steps_shortened > 0 && f.by_overlap == f.steps_shortened,
+            "{f:?}"
+        );
+        let summary = c.report.summary().join("\n");
+        assert!(summary.contains("for the bead overlap"), "{summary}");
+        // A 70° lean at 1.25 mm layers: the angle.
+        let lean = 40.0 * 70f64.to_radians().tan();
+        let d = design(
+            &format!("[[0,0],[{lean},40]]"),
+            "[[0,0],[0,40]]",
+            r#"{"points":[[-40,40],[40,40]]}"#,
+        );
+        let c = correct(&sample_surface(&d).unwrap()).unwrap();
+        assert_eq!(c.report.support[0].by_overlap, 0);
+        assert!(c.report.summary()[0].contains("for the overhang limit"));
     }
 
     #[test]

@@ -163,9 +163,21 @@ impl Params {
     /// (docs/ALGORITHMS.md §4): the overhang limit and the offset the widest bead still covers
     /// with the target overlap.
     pub fn max_offset(&self, dz: f64) -> f64 {
+        self.offset_limit(dz).0
+    }
+
+    /// [`Params::max_offset`] and which of its two limits binds: the
+    /// overhang angle (`true`: dz · tan θ_max) or the bead overlap
+    /// (`false`: w_max · (1 − overlap), the offset the widest bead still
+    /// covers with the target overlap, whatever the layer height).
+    pub fn offset_limit(&self, dz: f64) -> (f64, bool) {
         let by_angle = dz * self.max_overhang_deg.to_radians().tan();
         let by_width = self.width_max * (1.0 - self.overlap);
-        by_angle.min(by_width)
+        if by_angle <= by_width {
+            (by_angle, true)
+        } else {
+            (by_width, false)
+        }
     }
 
     /// The keys `--set` accepts, in file order.
