@@ -334,6 +334,14 @@ fn slice(a: SliceArgs) -> Result<i32> {
             if st.stages == 1 { "" } else { "s" },
             st.returning_points
         );
+        say!(
+            "  layer heights      {} (layer_height {})",
+            st.layers.summary(),
+            sliced.corrected.surface.params.layer_height
+        );
+        if let Some(why) = &st.layers.thicker_because {
+            say!("                     thicker than asked because {why}");
+        }
         say!("  path length        {:.1} m", st.path_length_mm / 1000.0);
         say!("  clay volume        {:.1} ml", st.volume_ml);
         say!("  estimated time     {:.1} min", st.time_min);

@@ -68,6 +68,10 @@ pub fn emit<W: Write>(s: &Sliced, out: &mut W) -> io::Result<Vec<usize>> {
     writeln!(out, "; passes: {}", st.passes)?;
     writeln!(out, "; stages: {}", st.stages)?;
     writeln!(out, "; returning_points: {}", st.returning_points)?;
+    writeln!(out, "; layer_heights: {}", st.layers.summary())?;
+    if let Some(why) = &st.layers.thicker_because {
+        writeln!(out, "; layer_heights_thicker_because: {}", one_line(why))?;
+    }
     writeln!(out, "; path_length_mm: {:.1}", st.path_length_mm)?;
     writeln!(out, "; clay_volume_ml: {:.2}", st.volume_ml)?;
     writeln!(out, "; estimated_time_min: {:.1}", st.time_min)?;

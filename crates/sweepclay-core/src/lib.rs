@@ -84,6 +84,87 @@ pub struct Stats {
     pub time_min: f64,
     /// Bed coordinates of the bounding box: `[[xmin, ymin, zmin], [xmax, ymax, zmax]]`.
     pub bounds_mm: [[f64; 3]; 2],
+    /// The layer heights the path really uses.
+    pub layers: LayerStats,
+}
+
+/// The layer heights a sliced design uses, per stage (docs/ALGORITHMS.md
+/// §3), and why, where they are thicker than `layer_height`.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct LayerStats {
+    /// Thinnest and thickest layer of the lower (or only) stage (mm); the
+    /// last layer under a column's top edge, which may be thinner, left
+    /// out of the thinnest.
+    pub lower_mm: [f64; 2],
+    /// The same for the upper stage of a two-stage path.
+    pub upper_mm: Option<[f64; 2]>,
+    /// Why some layers are thicker than `layer_height`, if they are.
+    pub thicker_because: Option<String>,
+}
+
+impl LayerStats {
+    /// One line for summaries: "1.25–2.31 mm (upper stage 1.25–1.30 mm)".
+    pub fn summary(&self) -> String {
+        let [lo, hi] = self.lower_mm;
+        match self.upper_mm {
+            Some([ulo, uhi]) => {
+                format!("{lo:.2}–{hi:.2} mm lower stage, {ulo:.2}–{uhi:.2} mm upper stage")
+            }
+            None => format!("{lo:.2}–{hi:.2} mm"),
+        }
+    }
+}
+
+/// The layer heights of the corrected surface: each column's samples are
+/// its passes' heights, bottom up.
+fn layer_stats(c: &Corrected) -> LayerStats {
+    let s = &c.surface;
+    let plan = &s.plan;
+    let mut lower = [f64::INFINITY, 0.0f64];
+    let mut upper = [f64::INFINITY, 0.0f64];
+    for col in &s.columns {
+        let r = col.samples();
+        let mut prev = 0.0;
+        for (k, i) in r.clone().enumerate() {
+            let z = s.samples[i].z;
+            let dz = z - prev;
+            prev = z;
+            let slot = if (k as u32) < plan.lower_passes {
+                &mut lower
+            } else {
+                &mut upper
+            };
+            slot[1] = slot[1].max(dz);
+            if i + 1 < r.end {
+                slot[0] = slot[0].min(dz);
+            }
+        }
+    }
+    let fix = |v: [f64; 2]| [if v[0].is_finite() { v[0] } else { v[1] }, v[1]];
+    let lower_mm = fix(lower);
+    let upper_mm = (upper[1] > 0.0).then(|| fix(upper));
+    let asked = s.params.layer_height;
+    let thickest = lower_mm[1].max(upper_mm.map_or(0.0, |u| u[1]));
+    let thicker_because = (thickest > asked * 1.005).then(|| {
+        let short = (s.columns.iter().map(|c| c.height).fold(f64::INFINITY, f64::min) / asked)
+            .floor();
+        if f64::from(plan.lower_passes) < short {
+            format!(
+                "the extruder body ({} mm radius) limits how steeply a tilted pass may climb past clay already laid (the slope condition): {} tilted passes where the short end alone has room for {short}, so each column's layers are its height over {}",
+                s.printer.nozzle_radius, plan.lower_passes, plan.lower_passes
+            )
+        } else {
+            format!(
+                "the passes tilt between the two ends: each column is printed in the same {} passes, so a column's layers are its height over {}, thicker where it is taller",
+                plan.lower_passes, plan.lower_passes
+            )
+        }
+    });
+    LayerStats {
+        lower_mm,
+        upper_mm,
+        thicker_because,
+    }
 }
 
 /// Everything the pipeline computed for one design.
@@ -162,5 +243,42 @@ fn stats(c: &Corrected, t: &Toolpath, e: &Extrusion) -> Stats {
         volume_ml: e.total_volume / 1000.0,
         time_min: e.path_length / c.surface.params.feedrate + travel / pr.travel_feedrate,
         bounds_mm: [lo, hi],
+        layers: layer_stats(c),
+    }
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn wall(zs: f64, zt: f64) -> Design {
+        Design::from_json(&format!(
+            r#"{{"sweepclay":1,"profile_start":{{"control_points":[[0,0],[0,{zs}]]}},
+                "profile_end":{{"control_points":[[0,0],[0,{zt}]]}},
+                "trajectory":{{"control_points":[[-60,40],[0,70],[60,40]]}}}}"#
+        ))
+        .unwrap()
+    }
+
+    #[test]
+    fn layer_heights_are_reported_as_used_and_why_when_thicker() {
+        // Both ends 50 mm: 40 flat layers of exactly 1.25 mm, no reason.
+        let s = slice(&wall(50.0, 50.0)).unwrap();
+        let l = &s.stats.layers;
+        assert!(
+            (l.lower_mm[0] - 1.25).abs() < 1e-9 && (l.lower_mm[1] - 1.25).abs() < 1e-9,
+            "{l:?}"
+        );
+        assert_eq!(l.upper_mm, None);
+        assert_eq!(l.thicker_because, None);
+        // 30 and 40 mm: 24 tilted passes, the tall end's layers 40/24.
+        let s = slice(&wall(30.0, 40.0)).unwrap();
+        let l = &s.stats.layers;
+        assert!((l.lower_mm[1] - 40.0 / 24.0).abs() < 1e-6, "{l:?}");
+        assert!(
+            l.thicker_because.as_ref().unwrap().contains("over 24"),
+            "{l:?}"
+        );
+        assert!(gcode::to_string(&s).contains("; layer_heights: 1.25–1.67 mm"));
     }
 }
