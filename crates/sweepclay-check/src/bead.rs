@@ -17,6 +17,9 @@ pub(crate) struct Bead {
     /// Its layer height, the gap to the clay it rests on (0 if none), in
     /// µm: two bytes, so a bead stays 40 bytes.
     height_um: u16,
+    /// The path turns into it by more than 10° in plan, or it is a step:
+    /// near such beads a pass may fold back (see `support::alone`).
+    pub(crate) bent: bool,
 }
 
 impl Bead {
@@ -28,6 +31,7 @@ impl Bead {
             s_end,
             step,
             height_um: 0,
+            bent: false,
         }
     }
 

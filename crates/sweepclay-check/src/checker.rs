@@ -18,6 +18,9 @@ use crate::CheckConfig;
 
 const EPS_E: f64 = 1e-7;
 
+/// A turn into a bead over this (10°) marks it bent (`Bead::bent`).
+const BENT_RAD: f64 = std::f64::consts::PI / 18.0;
+
 /// Lines longer than this (bytes) are not G-code any firmware reads (Marlin
 /// takes 96): one diagnostic, and the line is skipped.
 pub const MAX_LINE: usize = 4096;
@@ -268,6 +271,9 @@ struct Checker<'a> {
     prev_stub: bool,
     prev_overlap: f64,
     beads: Vec<Bead>,
+    /// `bent_before[k + 1]`: how many of beads `0..=k` are bent (a
+    /// prefix count, so "any bent bead in this stretch?" is two loads).
+    bent_before: Vec<u32>,
     grid: BeadGrid,
     /// Bounds of blocks of consecutive beads, for the full search.
     blocks: Blocks,
@@ -321,6 +327,7 @@ impl<'a> Checker<'a> {
             prev_stub: false,
             prev_overlap: 0.0,
             beads: Vec::new(),
+            bent_before: vec![0],
             grid: BeadGrid::new(cfg),
             blocks: Blocks::default(),
             scratch: Scratch::default(),
@@ -350,6 +357,7 @@ impl<'a> Checker<'a> {
     fn reserve(&mut self, moves: usize) {
         // A failed reservation only leaves the growing to `push`.
         let _ = self.beads.try_reserve_exact(moves);
+        let _ = self.bent_before.try_reserve_exact(moves);
         let _ = self.layer_heights.try_reserve_exact(moves);
         self.blocks.reserve(moves);
     }
@@ -714,6 +722,7 @@ impl<'a> Checker<'a> {
             prev_stub,
             prev_overlap,
             lead,
+            bent_before,
             ..
         } = self;
         // Its failures, recorded once the borrows below end (at most one
@@ -779,7 +788,9 @@ impl<'a> Checker<'a> {
                         && (recent.clear_of(m, mid, cfg.min_layer_mm, turn, xy)
                             || q.none_below(&beads[*support_settled..], *support_settled))
                 })
-                .and_then(|j| follow_support(beads, *support_settled, support_tops, j, &q));
+                .and_then(|j| {
+                    follow_support(beads, bent_before, *support_settled, support_tops, j, &q)
+                });
             r.support.beads += 1;
             let (support, own) = if fast.is_some() {
                 (fast, None)
@@ -920,6 +931,7 @@ impl<'a> Checker<'a> {
             step,
         );
         bead.set_height(height);
+        bead.bent = step || turn > BENT_RAD;
         if *deep {
             grid.insert(&bead, id);
         }
@@ -932,6 +944,7 @@ impl<'a> Checker<'a> {
         if !purge {
             *top_z = top_z.max(m.from[2].max(m.to[2]));
         }
+        bent_before.push(bent_before.last().copied().unwrap_or(0) + u32::from(bead.bent));
         beads.push(bead);
         if !on_clay && !step {
             self.close_stretch();

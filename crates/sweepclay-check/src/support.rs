@@ -254,6 +254,76 @@ impl Recent {
     }
 }
 
+/// Beads the shortcut looks past its answer, each way, for a nearer one.
+const LOOK_PAST: usize = 8;
+
+/// Whether no bead within [`LOOK_PAST`] of the shortcut's answer `best`
+/// is nearer the middle. The walk stops at the first bead that is no
+/// nearer, which is the nearest of a pass that runs straight or gently
+/// curved (the distance to a point is then unimodal along it); where the
+/// pass below turns (a bead marked `bent`: a corner, a tight curl, a
+/// turnaround) a nearer bead may lie a few beads on, so the beads past
+/// the turn are asked. A bead whose start is farther from the middle than
+/// `best` plus its own length (an L1 bound: no square root) cannot be
+/// nearer.
+#[inline]
+fn alone(
+    beads: &[Bead],
+    bent_before: &[u32],
+    settled: usize,
+    best: &Candidate,
+    q: &Query,
+    mid: [f64; 3],
+) -> bool {
+    let kb = best.id as usize;
+    let lo = kb.saturating_sub(LOOK_PAST);
+    let hi = (kb + LOOK_PAST).min(settled.saturating_sub(1));
+    // `bent_before[k]` counts the bent beads before bead k.
+    if bent_before
+        .get(hi + 1)
+        .zip(bent_before.get(lo))
+        .is_none_or(|(h, l)| h == l)
+    {
+        return true;
+    }
+    alone_past_bends(beads, best, q, mid, (lo, kb, hi))
+}
+
+/// [`alone`] where the pass turns within reach: the beads past a bend,
+/// each way, asked. Rare, so kept out of the shortcut's code.
+#[cold]
+#[inline(never)]
+fn alone_past_bends(
+    beads: &[Bead],
+    best: &Candidate,
+    q: &Query,
+    mid: [f64; 3],
+    (lo, kb, hi): (usize, usize, usize),
+) -> bool {
+    // Along a pass that runs straight up to a bend the distance only grows
+    // away from the walk's answer: only beads past a bend are asked.
+    let nearer = |k: usize| {
+        let b = &beads[k];
+        let (f, t) = (b.from32, b.to32);
+        let (fx, fy) = (f64::from(f[0]) - mid[0], f64::from(f[1]) - mid[1]);
+        let l1 = f64::from((t[0] - f[0]).abs() + (t[1] - f[1]).abs());
+        let reach = best.d + l1;
+        fx * fx + fy * fy <= reach * reach
+            && matches!(q.classify(b, k as u32), Class::Below(c) if c.nearer(best).is_lt())
+    };
+    let side = |ks: &mut dyn Iterator<Item = usize>| {
+        let mut past_bend = false;
+        for k in ks {
+            past_bend |= beads[k].bent;
+            if past_bend && nearer(k) {
+                return false;
+            }
+        }
+        true
+    };
+    side(&mut (kb + 1..=hi)) && side(&mut (lo..kb).rev())
+}
+
 /// The support of a new bead found without a search, or `None` when
 /// anything about its surroundings is unusual (then the full search of
 /// [`pick_support`] decides). Beads rest on the pass below, which runs
@@ -272,6 +342,7 @@ impl Recent {
 #[inline]
 pub(crate) fn follow_support(
     beads: &[Bead],
+    bent_before: &[u32],
     settled: usize,
     tops: &TopGrid,
     start: u32,
@@ -303,7 +374,7 @@ pub(crate) fn follow_support(
             break;
         }
     }
-    if !best.covers {
+    if !best.covers || !alone(beads, bent_before, settled, &best, q, mid) {
         return None;
     }
     // The full search's square; wider if a settled bead is so wide that it

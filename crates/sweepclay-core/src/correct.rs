@@ -301,7 +301,7 @@ fn find_self_intersection(s: &Surface) -> Option<(u32, u32, [f64; 3])> {
                     // converges, whose pass between them at that height is
                     // short (an inward-leaning cone's top is small, but its
                     // neighbours are still neighbours).
-                    if d2 < w2 && pass_length(s, a, b as usize, i - ca.first as usize) > 1.6 * w {
+                    if d2 < w2 && pass_apart(s, a, b as usize, i - ca.first as usize, w) {
                         return Some((a as u32, b, p));
                     }
                 }
@@ -311,23 +311,54 @@ fn find_self_intersection(s: &Surface) -> Option<(u32, u32, [f64; 3])> {
     None
 }
 
-/// Plan length of the pass that lays sample `k` of column `a` (its pass
-/// k + 1), from column `a` to column `b`: the same pass's samples of the
-/// columns between (a column with fewer passes contributes its top).
-fn pass_length(s: &Surface, a: usize, b: usize, k: usize) -> f64 {
+/// Whether two points of columns `a` and `b` closer than a bead (`w`) are
+/// apart along the pass that lays sample `k` of column `a` (its pass
+/// k + 1): more than 1.6 w of that pass between them (the U-turn of
+/// radius w/2, the tightest whose sides do not touch, is π w/2 long), or
+/// a pass that turns back on itself between them (a curl tighter than a
+/// bead, whose sides touch however short it is). The same pass's samples
+/// of the columns between are used (a column with fewer passes
+/// contributes its top).
+fn pass_apart(s: &Surface, a: usize, b: usize, k: usize, w: f64) -> bool {
+    let (len, turn) = pass_length(s, a, b, k);
+    len > 1.6 * w || turn >= std::f64::consts::PI
+}
+
+/// Plan length and net turning (radians, signed turns summed, so jitter
+/// cancels and a curl counts its whole turn) of the pass that lays sample
+/// `k` of column `a`, from column `a` to column `b` (see [`pass_apart`]).
+fn pass_length(s: &Surface, a: usize, b: usize, k: usize) -> (f64, f64) {
     let at = |c: usize| {
         let col = &s.columns[c];
         let i = col.first as usize + k.min(col.len().saturating_sub(1));
         s.position(c, i)
     };
-    let mut len = 0.0;
+    let (mut len, mut turn) = (0.0, 0.0);
     let mut prev = at(a);
+    let mut heading: Option<f64> = None;
     for c in a + 1..=b {
         let p = at(c);
-        len += (p[0] - prev[0]).hypot(p[1] - prev[1]);
+        let (dx, dy) = (p[0] - prev[0], p[1] - prev[1]);
+        let l = dx.hypot(dy);
+        // Steps under 0.01 mm have no direction worth the name.
+        if l > 0.01 {
+            let h = dy.atan2(dx);
+            if let Some(h0) = heading {
+                let mut d = h - h0;
+                while d > std::f64::consts::PI {
+                    d -= std::f64::consts::TAU;
+                }
+                while d < -std::f64::consts::PI {
+                    d += std::f64::consts::TAU;
+                }
+                turn += d;
+            }
+            heading = Some(h);
+        }
+        len += l;
         prev = p;
     }
-    len
+    (len, turn.abs())
 }
 
 /// Where an offset larger than a bend's radius on its inner side folds the
@@ -606,7 +637,7 @@ mod tests {
                     *b > a + far
                         && (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2)
                             < w * w
-                        && pass_length(s, *a, *b, *k) > 1.6 * w
+                        && pass_apart(s, *a, *b, *k, w)
                 })
             })
     }

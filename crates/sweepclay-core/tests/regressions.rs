@@ -2,7 +2,9 @@
 //! kept as regression tests: each must slice and pass the independent check.
 //! r1: returning turn over a just-laid pass end; r2: tilted pass beside a
 //! wider bead; r3: first layer thicker than 3 mm; r4: steep climbing turn;
-//! r5: lean-out step at the trajectory's start; r6: steep tilted pass.
+//! r5: lean-out step at the trajectory's start; r6: steep tilted pass;
+//! r7: the checker's support shortcut at a pass that curls round a corner
+//! of tiny beads (the shortcut answered a bead that was not the nearest).
 //! Polylines with sharp corners (SVG-like imports): p1, p2: a corner's
 //! pile-up of fresh clay read as double deposition; p3: the same tilted
 //! pass within the extruder body's reach round a corner (fixed in the
@@ -31,4 +33,4 @@ macro_rules! regression {
     )*};
 }
 
-regression!(r1, r2, r3, r4, r5, r6, p1, p2, p3, p4, p5, p6);
+regression!(r1, r2, r3, r4, r5, r6, r7, p1, p2, p3, p4, p5, p6);
