@@ -67,6 +67,9 @@ struct ServeArgs {
     /// Refuse designs with more surface samples than this (estimated).
     #[arg(long, default_value_t = DEFAULT_MAX_SAMPLES)]
     max_samples: u64,
+    /// Longest a request may wait for a worker and run (seconds).
+    #[arg(long, default_value_t = 60)]
+    timeout: u64,
 }
 
 #[derive(Args, Debug)]
@@ -395,9 +398,18 @@ fn serve(a: ServeArgs) -> Result<i32> {
             "sweepclay modeler: http://{host}:{}/  (Ctrl+C to stop)",
             addr.port()
         );
-        let limits = sweepclay_web::api::Limits {
+        let mut limits = sweepclay_web::api::Limits {
             max_samples: a.max_samples as f64,
+            request_timeout: std::time::Duration::from_secs(a.timeout),
+            ..Default::default()
         };
+        // Bound to every interface on purpose: any Host; else the names of
+        // loopback and the address given.
+        if addr.ip().is_unspecified() {
+            limits.hosts.clear();
+        } else if !limits.hosts.iter().any(|h| h == &a.host) {
+            limits.hosts.push(a.host.clone());
+        }
         sweepclay_web::run(listener, limits).await?;
         Ok(0)
     })

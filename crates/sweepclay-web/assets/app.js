@@ -496,7 +496,9 @@ $('import').addEventListener('click', () => $('import-file').click());
 $('import-file').addEventListener('change', async () => {
   const { name, text } = await readFile($('import-file'));
   const format = /\.svg$/i.test(name) || text.trimStart().startsWith('<') ? 'svg' : 'csv';
-  const r = await fetch(`/api/import/${format}`, { method: 'POST', body: text });
+  const r = await fetch(`/api/import/${format}`, {
+    method: 'POST', headers: { 'content-type': 'application/octet-stream' }, body: text,
+  });
   const body = await r.json();
   if (!r.ok) {
     showError(`${name}: ${body.error}`);

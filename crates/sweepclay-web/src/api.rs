@@ -27,6 +27,9 @@ pub struct ApiError {
     /// Where in the design the failures are.
     #[serde(skip_serializing_if = "Vec::is_empty")]
     pub locations: Vec<String>,
+    /// Seconds after which a busy server may be asked again (503).
+    #[serde(skip)]
+    pub retry_after: Option<u32>,
 }
 
 impl ApiError {
@@ -38,6 +41,15 @@ impl ApiError {
             key: None,
             failures: Vec::new(),
             locations: Vec::new(),
+            retry_after: None,
+        }
+    }
+
+    /// The same error, saying when to try again (`Retry-After`).
+    pub fn retry_after(self, secs: u32) -> Self {
+        ApiError {
+            retry_after: Some(secs),
+            ..self
         }
     }
 }
@@ -67,16 +79,38 @@ impl From<Error> for ApiError {
     }
 }
 
-/// Limits that keep one request from exhausting the machine.
-#[derive(Clone, Copy, Debug, PartialEq)]
+/// Limits that keep one request, or many, from exhausting the machine
+/// (docs/MODELER.md, "Limits and safety").
+#[derive(Clone, Debug, PartialEq)]
 pub struct Limits {
     /// Most surface samples a design may have (estimated before slicing).
     pub max_samples: f64,
+    /// Slices, checks and meshes run at once (default: the cores).
+    pub workers: usize,
+    /// Requests that may wait for a worker; beyond them, 503 with
+    /// `Retry-After` (default: 4 a worker).
+    pub queue: usize,
+    /// How long a request may wait for a worker and run (default 60 s);
+    /// past it, 503.
+    pub request_timeout: std::time::Duration,
+    /// The names the server answers to in `Host` (with any port):
+    /// `127.0.0.1`, `localhost`, `[::1]` and the address it was started
+    /// on. Empty: any (a server bound to every interface, on purpose).
+    pub hosts: Vec<String>,
 }
 
 impl Default for Limits {
     fn default() -> Self {
-        Limits { max_samples: 1.5e6 }
+        let workers = std::thread::available_parallelism().map_or(2, |n| n.get());
+        Limits {
+            max_samples: 1.5e6,
+            workers,
+            queue: 4 * workers,
+            request_timeout: std::time::Duration::from_secs(60),
+            hosts: ["127.0.0.1", "localhost", "[::1]"]
+                .map(String::from)
+                .to_vec(),
+        }
     }
 }
 

@@ -24,6 +24,7 @@
 //! a design's estimated sample count ([`api::Limits`]).
 
 pub mod api;
+pub mod guard;
 pub mod verify;
 
 use api::{ApiError, Limits};
@@ -83,11 +84,23 @@ pub const ASSETS: &[(&str, &str, &str)] = &[
 impl IntoResponse for ApiError {
     fn into_response(self) -> Response {
         let status = StatusCode::from_u16(self.status).unwrap_or(StatusCode::BAD_REQUEST);
-        (status, Json(self)).into_response()
+        let retry = self.retry_after;
+        let mut res = (status, Json(self)).into_response();
+        if let Some(secs) = retry {
+            res.headers_mut()
+                .insert(header::RETRY_AFTER, axum::http::HeaderValue::from(secs));
+        }
+        res
     }
 }
 
-type Shared = Arc<Limits>;
+/// What every handler shares: the limits and the pool of workers.
+struct AppState {
+    limits: Limits,
+    pool: guard::Pool,
+}
+
+type Shared = Arc<AppState>;
 
 /// The modeler's routes, with the given limits.
 pub fn router(limits: Limits) -> Router {
@@ -101,6 +114,19 @@ pub fn router(limits: Limits) -> Router {
     let check_route = Router::new()
         .route("/api/check", post(check))
         .layer(DefaultBodyLimit::max(GCODE_BODY_LIMIT));
+    let hosts = Arc::new(limits.hosts.clone());
+    let guard = axum::middleware::from_fn(move |req: axum::extract::Request, next| {
+        let body_limit = if req.uri().path() == "/api/check" {
+            GCODE_BODY_LIMIT
+        } else {
+            DESIGN_BODY_LIMIT
+        };
+        guard::same_origin(hosts.clone(), body_limit, req, next)
+    });
+    let state = Arc::new(AppState {
+        pool: guard::Pool::new(&limits),
+        limits,
+    });
     Router::new()
         .route("/", get(|| asset(Path("index.html".into()))))
         .route("/assets/{name}", get(asset))
@@ -108,7 +134,11 @@ pub fn router(limits: Limits) -> Router {
         .merge(design_routes)
         .merge(check_route)
         .fallback(|| async { ApiError::new(404, "no such page or API route") })
-        .with_state(Arc::new(limits))
+        .method_not_allowed_fallback(|| async {
+            ApiError::new(405, "this route does not take that method")
+        })
+        .layer(guard)
+        .with_state(state)
 }
 
 async fn asset(Path(name): Path<String>) -> Response {
@@ -139,7 +169,7 @@ async fn meta(State(limits): State<Shared>) -> Response {
         "presets": presets,
         "params": Params::default(),
         "examples": examples,
-        "max_samples": limits.max_samples,
+        "max_samples": limits.limits.max_samples,
     }))
     .into_response()
 }
@@ -158,22 +188,17 @@ fn text(body: Result<Bytes, BytesRejection>) -> Result<String, ApiError> {
         .map_err(|e| ApiError::new(400, format!("the body is not UTF-8 text: {e}")))
 }
 
-/// Runs CPU-bound work off the async threads.
-async fn blocking<T: Send + 'static>(
-    f: impl FnOnce() -> Result<T, ApiError> + Send + 'static,
-) -> Result<T, ApiError> {
-    tokio::task::spawn_blocking(f)
-        .await
-        .unwrap_or_else(|e| Err(ApiError::new(500, format!("internal error: {e}"))))
-}
-
 async fn with_design<T: Send + 'static>(
     limits: Shared,
     body: Result<Bytes, BytesRejection>,
     f: impl FnOnce(sweepclay_core::Design) -> Result<T, ApiError> + Send + 'static,
 ) -> Result<T, ApiError> {
     let text = text(body)?;
-    blocking(move || f(api::parse_design(&text, &limits)?)).await
+    let state = limits.clone();
+    state
+        .pool
+        .run(move || f(api::parse_design(&text, &limits.limits)?))
+        .await
 }
 
 #[derive(Deserialize)]
@@ -278,11 +303,14 @@ async fn stl(
 }
 
 async fn import(
+    State(state): State<Shared>,
     Path(format): Path<String>,
     body: Result<Bytes, BytesRejection>,
 ) -> Result<Json<api::Imported>, ApiError> {
     let text = text(body)?;
-    blocking(move || api::import(&format, &text))
+    state
+        .pool
+        .run(move || api::import(&format, &text))
         .await
         .map(Json)
 }
@@ -295,6 +323,7 @@ struct CheckQuery {
 }
 
 async fn check(
+    State(state): State<Shared>,
     Query(q): Query<CheckQuery>,
     body: Result<Bytes, BytesRejection>,
 ) -> Result<Json<sweepclay_check::Report>, ApiError> {
@@ -315,21 +344,23 @@ async fn check(
         None => None,
     };
     let text = text(body)?;
-    blocking(move || {
-        // Without `printer`, a sweepclay file is checked for the printer
-        // its header names, any other for `generic` (as the CLI does).
-        let cfg = match printer {
-            Some(p) => verify::printer_check(&p),
-            None => sweepclay_check::header::config_from_header(&text, &CheckConfig::default())
-                .unwrap_or_else(|| CheckConfig {
-                    printer: "generic (assumed: pass ?printer=)".into(),
-                    ..CheckConfig::default()
-                }),
-        };
-        Ok(sweepclay_check::check(&text, &cfg))
-    })
-    .await
-    .map(Json)
+    state
+        .pool
+        .run(move || {
+            // Without `printer`, a sweepclay file is checked for the printer
+            // its header names, any other for `generic` (as the CLI does).
+            let cfg = match printer {
+                Some(p) => verify::printer_check(&p),
+                None => sweepclay_check::header::config_from_header(&text, &CheckConfig::default())
+                    .unwrap_or_else(|| CheckConfig {
+                        printer: "generic (assumed: pass ?printer=)".into(),
+                        ..CheckConfig::default()
+                    }),
+            };
+            Ok(sweepclay_check::check(&text, &cfg))
+        })
+        .await
+        .map(Json)
 }
 
 /// Serves the modeler on `listener` until Ctrl+C.

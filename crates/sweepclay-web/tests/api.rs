@@ -16,9 +16,12 @@ async fn server(limits: Limits) -> String {
     format!("http://{addr}")
 }
 
+/// POSTs `body` as the page does (`application/json`; the work routes
+/// take nothing a cross-origin page could send without asking).
 async fn post(url: &str, body: impl Into<reqwest::Body>) -> reqwest::Response {
     reqwest::Client::new()
         .post(url)
+        .header("content-type", "application/json")
         .body(body)
         .send()
         .await
@@ -171,6 +174,7 @@ async fn bad_input_gets_4xx_with_messages() {
 async fn oversize_bodies_and_sample_counts_are_refused() {
     let base = server(Limits {
         max_samples: 50_000.0,
+        ..Limits::default()
     })
     .await;
     let big = vec![b' '; sweepclay_web::DESIGN_BODY_LIMIT + 1];
@@ -246,4 +250,134 @@ async fn imports_and_checks() {
     assert_eq!(r.status(), 200);
     let v: Value = r.json().await.unwrap();
     assert_eq!(v["diagnostics_total"], 1, "{v}");
+}
+
+/// Sends raw request `head` (and no body) and returns the response's
+/// status line and headers and body, as text.
+async fn raw(base: &str, head: &str) -> String {
+    let (addr, head) = (
+        base.trim_start_matches("http://").to_string(),
+        head.to_string(),
+    );
+    tokio::task::spawn_blocking(move || {
+        use std::io::{Read, Write};
+        let mut s = std::net::TcpStream::connect(addr).unwrap();
+        s.set_read_timeout(Some(std::time::Duration::from_secs(5)))
+            .unwrap();
+        s.write_all(head.as_bytes()).unwrap();
+        let mut out = Vec::new();
+        let _ = s.read_to_end(&mut out);
+        String::from_utf8_lossy(&out).into_owned()
+    })
+    .await
+    .unwrap()
+}
+
+#[tokio::test]
+async fn only_the_pages_own_origin_is_served() {
+    let base = server(Limits::default()).await;
+    let addr = base.trim_start_matches("http://").to_string();
+    // Another Host (DNS rebinding): 421, with a JSON body.
+    let r = raw(
+        &base,
+        "GET /api/meta HTTP/1.1\r\nHost: evil.example\r\nConnection: close\r\n\r\n",
+    )
+    .await;
+    assert!(r.starts_with("HTTP/1.1 421"), "{r}");
+    assert!(r.contains("\"error\""), "{r}");
+    // localhost by name is this server.
+    let port = addr.rsplit(':').next().unwrap();
+    let r = raw(
+        &base,
+        &format!("GET /api/meta HTTP/1.1\r\nHost: localhost:{port}\r\nConnection: close\r\n\r\n"),
+    )
+    .await;
+    assert!(r.starts_with("HTTP/1.1 200"), "{}", &r[..80.min(r.len())]);
+    let design = examples::example("t4").unwrap();
+    // A cross-origin page: refused, even with the right content type.
+    let r = reqwest::Client::new()
+        .post(format!("{base}/api/slice"))
+        .header("content-type", "application/json")
+        .header("origin", "http://evil.example")
+        .body(design)
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(r.status(), 403);
+    // The page's own origin works.
+    let r = reqwest::Client::new()
+        .post(format!("{base}/api/slice"))
+        .header("content-type", "application/json")
+        .header("origin", &base)
+        .body(design)
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(r.status(), 200);
+    // A text/plain POST (which a browser sends cross-origin unasked) does
+    // no work, and no CORS header is ever sent.
+    let r = reqwest::Client::new()
+        .post(format!("{base}/api/gcode"))
+        .header("content-type", "text/plain")
+        .body(design)
+        .send()
+        .await
+        .unwrap();
+    assert_eq!(r.status(), 415);
+    assert!(r.headers().get("access-control-allow-origin").is_none());
+    assert_eq!(r.headers()["x-content-type-options"], "nosniff");
+    assert_eq!(
+        r.headers()["content-security-policy"],
+        "frame-ancestors 'none'"
+    );
+    // 405 has a JSON body too.
+    let r = reqwest::get(format!("{base}/api/slice")).await.unwrap();
+    assert_eq!(r.status(), 405);
+    let v: Value = r.json().await.unwrap();
+    assert!(v["error"].as_str().unwrap().contains("method"), "{v}");
+}
+
+#[tokio::test]
+async fn a_body_over_the_limit_is_refused_before_it_is_sent() {
+    let base = server(Limits::default()).await;
+    let addr = base.trim_start_matches("http://");
+    // 10 GB announced, nothing sent: 413 at once, no 100 Continue.
+    let r = raw(
+        &base,
+        &format!("POST /api/check HTTP/1.1\r\nHost: {addr}\r\nContent-Type: application/octet-stream\r\nContent-Length: 10000000000\r\nExpect: 100-continue\r\n\r\n"),
+    )
+    .await;
+    assert!(r.starts_with("HTTP/1.1 413"), "{r}");
+    assert!(!r.contains("100 Continue"), "{r}");
+}
+
+#[tokio::test]
+async fn beyond_the_workers_and_the_queue_the_answer_is_503() {
+    // One worker, no queue: of several slices at once, some are refused
+    // with Retry-After, none fails otherwise.
+    let base = server(Limits {
+        workers: 1,
+        queue: 0,
+        ..Limits::default()
+    })
+    .await;
+    let design = examples::example("t1").unwrap();
+    let mut tasks = Vec::new();
+    for _ in 0..6 {
+        let url = format!("{base}/api/gcode");
+        tasks.push(tokio::spawn(async move {
+            let r = post(&url, design).await;
+            (
+                r.status().as_u16(),
+                r.headers().get("retry-after").is_some(),
+            )
+        }));
+    }
+    let mut codes = Vec::new();
+    for t in tasks {
+        codes.push(t.await.unwrap());
+    }
+    assert!(codes.iter().any(|c| c.0 == 200), "{codes:?}");
+    assert!(codes.contains(&(503, true)), "{codes:?}");
+    assert!(codes.iter().all(|c| c.0 == 200 || c.0 == 503), "{codes:?}");
 }
