@@ -141,20 +141,28 @@ impl LayerPlan {
     /// first, non-decreasing), with the tallest columns within reach of the
     /// extruder body around each (see [`reach_max`]).
     ///
-    /// Tries the paper's single stage first (N' = ⌊h_short/Δz_min⌋); then
-    /// two stages with the same N'; then fewer tilted passes until tilted
-    /// passes are flat enough that the nozzle body clears the layer below
-    /// (see `docs/ALGORITHMS.md`, "slope condition").
+    /// Tries the paper's layering first (N' = ⌊h_short/Δz_min⌋ tilted
+    /// passes, with an upper stage where the tall end needs one). Where the
+    /// nozzle body would not clear the layer below (the slope condition),
+    /// fewer tilted passes would thicken the short end's layers, so the next
+    /// candidate is flat layers of about Δz_min from the bed up, the paper's
+    /// upper stage throughout; only then fewer tilted passes (see
+    /// `docs/ALGORITHMS.md`, "Choosing N'" and "slope condition").
     pub fn choose(h: &[f64], reach: &Reach, params: &Params) -> Result<LayerPlan> {
         let (dmin, dmax) = (params.layer_height, params.max_layer_height);
         let h_short = h[0];
         let h_tall = *h.last().expect("at least one column");
         let spread = params.nozzle_height - COLLISION_MARGIN_MM - dmax;
         let n = ((h_short / dmin + 1e-9).floor() as u32).max(1);
+        let tilted = |lower: u32| (lower, dmax.min((h_short + spread) / f64::from(lower)));
+        // Flat from the bed: one lower pass of Δz_min, then the upper stage.
+        let flat = (n >= 2).then_some((1, dmin));
+        let candidates = std::iter::once(tilted(n))
+            .chain(flat)
+            .chain((1..n).rev().map(tilted));
         let mut last_err = None;
-        for lower in (1..=n).rev() {
-            let Some((k, low, up)) = Self::tall_layers(h_short, h_tall, lower, spread, dmin, dmax)
-            else {
+        for (lower, cap) in candidates {
+            let Some((k, low, up)) = Self::tall_layers(h_tall, lower, cap, dmin, dmax) else {
                 last_err = Some(format!(
                     "the {h_tall:.2} mm tall end cannot be split into layers between {dmin} and {dmax} mm; raise params.max_layer_height"
                 ));
@@ -181,20 +189,19 @@ impl LayerPlan {
         Err(Error::Layering(last_err.unwrap_or_default()))
     }
 
-    /// The tall column's layering for `lower` tilted passes: `(K, δ_low,
-    /// δ_up)`. The lower stage reaches at most h_short + H_s (so its tilted
-    /// passes span at most H_s) in layers of at most Δz_max; the rest is
+    /// The tall column's layering for `lower` tilted passes whose tall-end
+    /// layers are at most `cap`: `(K, δ_low, δ_up)`. With the paper's cap
+    /// min(Δz_max, (h_short + H_s) / N') the lower stage reaches at most
+    /// h_short + H_s (so its tilted passes span at most H_s); the rest is
     /// split into upper layers as close to Δz_min as divides it.
     fn tall_layers(
-        h_short: f64,
         h_tall: f64,
         lower: u32,
-        spread: f64,
+        cap: f64,
         dmin: f64,
         dmax: f64,
     ) -> Option<(u32, f64, f64)> {
         let n = lower as f64;
-        let cap = dmax.min((h_short + spread) / n);
         if h_tall <= n * cap + 1e-9 {
             // Single stage: every column in N' tilted layers.
             let d = h_tall / n;
@@ -404,7 +411,21 @@ mod tests {
         // 20 mm of rise over 22 mm of trajectory.
         let h = heights(30.0, 50.0, 21);
         let plan = choose(&h, &p).unwrap();
-        assert!(plan.lower_passes < 24, "{plan:?}");
+        // Flat layers of Δz_min from the bed: 1.25 mm, then 48.75 mm in 39
+        // layers of 1.25 mm; no layer thicker than asked.
+        assert_eq!(plan.lower_passes, 1, "{plan:?}");
+        assert_eq!(plan.passes, 40, "{plan:?}");
+        assert!((plan.lower_layer_mm - 1.25).abs() < 1e-12, "{plan:?}");
+        assert!((plan.upper_layer_mm - 1.25).abs() < 1e-12, "{plan:?}");
+        for &hj in &h {
+            let c = plan.column(hj);
+            let mut last = 0.0;
+            for k in 1..=c.passes {
+                let z = plan.height(k, hj);
+                assert!((z - last - 1.25).abs() < 1e-9, "h = {hj}: pass {k} at {z}");
+                last = z;
+            }
+        }
         let pts: Vec<[f64; 2]> = (0..h.len()).map(|i| [1.1 * i as f64, 0.0]).collect();
         assert!(plan
             .slope_violation(&h, &reach_max(&pts, &h, 9.6, 9))

@@ -148,7 +148,18 @@ fn layer_stats(c: &Corrected) -> LayerStats {
     let thicker_because = (thickest > asked * 1.005).then(|| {
         let short = (s.columns.iter().map(|c| c.height).fold(f64::INFINITY, f64::min) / asked)
             .floor();
-        if f64::from(plan.lower_passes) < short {
+        if lower_mm[1] <= asked * 1.005 {
+            let rest = plan.tall(plan.passes) - plan.tall(plan.lower_passes);
+            let below = match plan.lower_passes {
+                1 => "first layer".to_string(),
+                n => format!("first {n} layers"),
+            };
+            format!(
+                "layers may not be thinner than layer_height, and the tall end's {rest:.2} mm above its {below} divides into {} whole layers of {:.3} mm",
+                plan.passes - plan.lower_passes,
+                plan.upper_layer_mm
+            )
+        } else if f64::from(plan.lower_passes) < short {
             format!(
                 "the extruder body ({} mm radius) limits how steeply a tilted pass may climb past clay already laid (the slope condition): {} tilted passes where the short end alone has room for {short}, so each column's layers are its height over {}",
                 s.printer.nozzle_radius, plan.lower_passes, plan.lower_passes

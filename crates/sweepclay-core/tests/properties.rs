@@ -338,3 +338,40 @@ proptest! {
         }
     }
 }
+
+proptest! {
+    // Each case slices up to about 400k samples: a fifth of the cases
+    // (60 by default, 300 with PROPTEST_CASES=1500 by hand).
+    #![proptest_config(ProptestConfig { cases: (cases() / 5).max(4), failure_persistence: None, .. ProptestConfig::default() })]
+
+    #[test]
+    fn large_and_fine_designs_print_in_clay(
+        (zs, zt) in (20.0..110.0f64, 20.0..110.0f64),
+        radius in 60.0..220.0f64, start in -180.0..180.0f64, span in 60.0..200.0f64,
+        wobble in prop::collection::vec(-10.0..10.0f64, 3..8),
+        (xs, xt) in (-6.0..6.0f64, -6.0..6.0f64),
+        layer in 0.5..0.8f64, spacing in 0.3..2.0f64, nozzle_height in 30.0..100.0f64,
+    ) {
+        // Walls up to about half a metre long on a 600 mm printer, fine
+        // layers, any spacing and extruder height (docs/ALGORITHMS.md §3).
+        let n = wobble.len();
+        let cp: Vec<[f64; 2]> = wobble.iter().enumerate().map(|(i, w)| {
+            let a = (start + span * i as f64 / (n - 1) as f64).to_radians();
+            [(radius + w) * a.cos(), (radius + w) * a.sin()]
+        }).collect();
+        let len = radius * span.to_radians();
+        prop_assume!((zs - zt).abs() < 0.5 * len);
+        // Bounded work a case: about 400k samples at most.
+        prop_assume!(len / spacing * zs.max(zt) / layer < 400_000.0);
+        let v = serde_json::json!({
+            "sweepclay": 1, "name": "large and fine",
+            "profile_start": { "control_points": [[0.0, 0.0], [xs, zs / 2.0], [0.0, zs]] },
+            "profile_end": { "control_points": [[0.0, 0.0], [xt, zt / 2.0], [0.0, zt]] },
+            "trajectory": { "control_points": cp },
+            "params": { "layer_height": layer, "max_layer_height": 2.0 * layer,
+                        "spacing": spacing, "nozzle_height": nozzle_height },
+            "printer": { "name": "big", "build_volume": [600.0, 600.0, 600.0], "origin": [300.0, 300.0] },
+        });
+        prints_in_clay(&Design::from_json(&v.to_string()).unwrap())?;
+    }
+}

@@ -70,7 +70,7 @@ async fn a_valid_design_gives_geometry_and_stats() {
     assert_eq!(r.status(), 200);
     let v: Value = r.json().await.unwrap();
     let n = v["stats"]["sample_points"].as_u64().unwrap() as usize;
-    assert_eq!(n, 15_074);
+    assert_eq!(n, 21_998);
     assert_eq!(v["stats"]["stages"], 2);
     assert_eq!(v["surface"]["positions"].as_array().unwrap().len(), 3 * n);
     assert_eq!(v["path"]["order"].as_array().unwrap().len(), n);
