@@ -82,7 +82,7 @@ struct SliceArgs {
     /// Printer preset (cerambot-plus, cerambot-mini, generic) or a printer JSON file; overrides the design's.
     #[arg(long)]
     printer: Option<String>,
-    /// Override a parameter, e.g. `--set layer_height=1.5` (repeatable). Keys: layer_height, max_layer_height, spacing, nozzle_height, width_min, width_max, overlap, max_overhang_deg, feedrate.
+    /// Override a parameter, e.g. `--set layer_height=1.5` (repeatable). Keys: layer_height, max_layer_height, spacing, nozzle_height, width_min, width_max, overlap, max_overhang_deg, feedrate, floor_layers (vessels).
     #[arg(long = "set", value_name = "KEY=VALUE")]
     sets: Vec<String>,
     /// Refuse the G-code if a bead overlaps the bead below by less than

@@ -275,8 +275,12 @@ fn find_self_intersection(s: &Surface) -> Option<(u32, u32, [f64; 3])> {
     let mut near: Vec<u32> = Vec::new();
     for (a, seg) in segs.iter().enumerate() {
         near.clear();
+        let n = segs.len();
+        let closed = s.vessel.is_some();
         grid.for_each_near_segment(seg[0], seg[1], w, |b| {
-            if (b as usize) > a + far && segment_distance(*seg, segs[b as usize]) < w {
+            // Round a loop, the last curves are the first ones' neighbours.
+            let apart = (b as usize) > a + far && (!closed || a + n - b as usize > far);
+            if apart && segment_distance(*seg, segs[b as usize]) < w {
                 near.push(b);
             }
         });
@@ -320,23 +324,31 @@ fn find_self_intersection(s: &Surface) -> Option<(u32, u32, [f64; 3])> {
 /// of the columns between are used (a column with fewer passes
 /// contributes its top).
 fn pass_apart(s: &Surface, a: usize, b: usize, k: usize, w: f64) -> bool {
-    let (len, turn) = pass_length(s, a, b, k);
-    len > 1.6 * w || turn >= std::f64::consts::PI
+    let apart = |(len, turn): (f64, f64)| len > 1.6 * w || turn >= std::f64::consts::PI;
+    let n = s.columns.len();
+    // Round a loop the pass joins them both ways.
+    apart(pass_length(s, a..=b, k))
+        && (s.vessel.is_none() || apart(pass_length(s, (b..=a + n).map(|c| c % n), k)))
 }
 
 /// Plan length and net turning (radians, signed turns summed, so jitter
 /// cancels and a curl counts its whole turn) of the pass that lays sample
-/// `k` of column `a`, from column `a` to column `b` (see [`pass_apart`]).
-fn pass_length(s: &Surface, a: usize, b: usize, k: usize) -> (f64, f64) {
+/// `k` of the first column of `cols`, through the others in order (see
+/// [`pass_apart`]).
+fn pass_length(s: &Surface, cols: impl IntoIterator<Item = usize>, k: usize) -> (f64, f64) {
     let at = |c: usize| {
         let col = &s.columns[c];
         let i = col.first as usize + k.min(col.len().saturating_sub(1));
         s.position(c, i)
     };
     let (mut len, mut turn) = (0.0, 0.0);
+    let mut cols = cols.into_iter();
+    let Some(a) = cols.next() else {
+        return (0.0, 0.0);
+    };
     let mut prev = at(a);
     let mut heading: Option<f64> = None;
-    for c in a + 1..=b {
+    for c in cols {
         let p = at(c);
         let (dx, dy) = (p[0] - prev[0], p[1] - prev[1]);
         let l = dx.hypot(dy);
@@ -367,7 +379,11 @@ fn pass_length(s: &Surface, a: usize, b: usize, k: usize) -> (f64, f64) {
 /// each other against the direction of Ψ. Checked at each curve's
 /// extreme offsets, where a fold starts; one test a curve.
 fn find_fold(s: &Surface) -> Option<(u32, u32, [f64; 3])> {
-    for (a, w) in s.columns.windows(2).enumerate() {
+    let n = s.columns.len();
+    // A loop's last curve is followed by its first.
+    let pairs = n - usize::from(s.vessel.is_none());
+    for a in 0..pairs {
+        let w = [&s.columns[a], &s.columns[(a + 1) % n]];
         let step = [w[1].p[0] - w[0].p[0], w[1].p[1] - w[0].p[1]];
         for smp in [
             s.samples[w[0].samples().start],
@@ -388,7 +404,7 @@ fn find_fold(s: &Surface) -> Option<(u32, u32, [f64; 3])> {
         ) {
             let (p, q) = (w[0].point(smp.xi, smp.z), w[1].point(smp.xi, smp.z));
             if (q[0] - p[0]) * step[0] + (q[1] - p[1]) * step[1] <= 0.0 {
-                return Some((a as u32, a as u32 + 1, p));
+                return Some((a as u32, ((a + 1) % n) as u32, p));
             }
         }
     }

@@ -107,11 +107,38 @@ fn lerp_table(table: &[f64], t: f64) -> f64 {
     table[i] + s * (table[i + 1] - table[i])
 }
 
+/// f of a control curve `[u, f]` with u strictly increasing, sampled at
+/// u = k / 2048 and clamped to [0, 1].
+fn function_table(pts: &[[f64; 2]]) -> Vec<f64> {
+    let curve = BSpline::clamped(pts.to_vec()).expect("≥ 2 points");
+    let poly = curve.flatten(256);
+    let rows = 2048;
+    let mut table = Vec::with_capacity(rows + 1);
+    let mut seg = 0;
+    for k in 0..=rows {
+        let u = k as f64 / rows as f64;
+        while seg + 2 < poly.len() && poly[seg + 1][0] < u {
+            seg += 1;
+        }
+        let (a, b) = (poly[seg], poly[seg + 1]);
+        let s = if b[0] > a[0] {
+            ((u - a[0]) / (b[0] - a[0])).clamp(0.0, 1.0)
+        } else {
+            0.0
+        };
+        table.push((a[1] + s * (b[1] - a[1])).clamp(0.0, 1.0));
+    }
+    table
+}
+
 /// The interpolation function f(u) of paper §4 (Fig. 3).
 #[derive(Clone, Debug, PartialEq)]
 pub enum Interpolation {
     /// f(u) = u, the default.
     Linear,
+    /// f(u) = (1 − cos 2πu) / 2, the default round a closed Ψ: C_s at the
+    /// start point, C_t half way round, and back.
+    Cosine,
     /// f sampled at u = k / (len − 1).
     Table(Vec<f64>),
 }
@@ -162,24 +189,7 @@ impl Interpolation {
                 ));
             }
         }
-        let curve = BSpline::clamped(pts.clone()).expect("≥ 2 points");
-        let poly = curve.flatten(256);
-        let rows = 2048;
-        let mut table = Vec::with_capacity(rows + 1);
-        let mut seg = 0;
-        for k in 0..=rows {
-            let u = k as f64 / rows as f64;
-            while seg + 2 < poly.len() && poly[seg + 1][0] < u {
-                seg += 1;
-            }
-            let (a, b) = (poly[seg], poly[seg + 1]);
-            let s = if b[0] > a[0] {
-                ((u - a[0]) / (b[0] - a[0])).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            table.push((a[1] + s * (b[1] - a[1])).clamp(0.0, 1.0));
-        }
+        let mut table = function_table(pts);
         // Flattening error can break monotonicity by a rounding step; repair.
         for k in 1..table.len() {
             if table[k] < table[k - 1] {
@@ -189,10 +199,58 @@ impl Interpolation {
         Ok(Interpolation::Table(table))
     }
 
+    /// f(u) round a closed Ψ: f(0) = f(1) = 0, values in [0, 1], u
+    /// strictly increasing between control points; f may rise and fall.
+    /// Omitted: [`Interpolation::Cosine`].
+    pub fn new_closed(spec: Option<&CurveSpec>) -> Result<Interpolation> {
+        let Some(spec) = spec else {
+            return Ok(Interpolation::Cosine);
+        };
+        let key = "interpolation.control_points";
+        let pts = &spec.control_points;
+        check_points(key, pts, 2)?;
+        let (first, last) = (pts[0], pts[pts.len() - 1]);
+        if first != [0.0, 0.0] {
+            return Err(Error::invalid(
+                format!("{key}[0]"),
+                format!("must be [0, 0] (got {first:?})"),
+            ));
+        }
+        if last != [1.0, 0.0] {
+            return Err(Error::invalid(
+                format!("{key}[{}]", pts.len() - 1),
+                format!(
+                    "must be [1, 0] for a closed trajectory: the loop comes back to the start profile, so f(1) = f(0) = 0 (got {last:?})"
+                ),
+            ));
+        }
+        for i in 1..pts.len() {
+            if pts[i][0] <= pts[i - 1][0] {
+                return Err(Error::invalid(
+                    format!("{key}[{i}]"),
+                    format!(
+                        "u must increase strictly ({} after {})",
+                        pts[i][0],
+                        pts[i - 1][0]
+                    ),
+                ));
+            }
+            if !(0.0..=1.0).contains(&pts[i][1]) {
+                return Err(Error::invalid(
+                    format!("{key}[{i}]"),
+                    format!("f must lie between 0 and 1 (got {})", pts[i][1]),
+                ));
+            }
+        }
+        let table = function_table(pts);
+        Ok(Interpolation::Table(table))
+    }
+
     /// λ = f(u) for u ∈ [0, 1].
     pub fn eval(&self, u: f64) -> f64 {
         match self {
             Interpolation::Linear => u.clamp(0.0, 1.0),
+            Interpolation::Cosine => 0.5 * (1.0 - (std::f64::consts::TAU * u).cos()),
             Interpolation::Table(t) => lerp_table(t, u),
         }
     }
@@ -201,10 +259,50 @@ impl Interpolation {
 /// Ψ resampled by arc length.
 #[derive(Clone, Debug, PartialEq)]
 pub struct Trajectory {
-    /// The sample points p_0 … p_{n−1}, relative to `o`.
+    /// The sample points p_0 … p_{n−1}, relative to `o`. A closed Ψ does
+    /// not repeat p_0 at the end: p_{n−1} is followed by p_0.
     pub points: Vec<[f64; 2]>,
-    /// Arc length of Ψ in mm.
+    /// Arc length of Ψ in mm (a closed Ψ's whole loop).
     pub length: f64,
+    /// Whether Ψ is a loop (a vessel, docs/ALGORITHMS.md §8).
+    pub closed: bool,
+}
+
+/// The polyline of a periodic uniform cubic B-spline whose control polygon
+/// wraps round (`pts` not repeated), `per_span` points a span, closed by
+/// repeating its first point. Each span j is the cubic of control points
+/// j … j + 3 (mod m) in the uniform basis.
+pub fn periodic_bspline(pts: &[[f64; 2]], per_span: usize) -> Vec<[f64; 2]> {
+    let m = pts.len();
+    let mut out = Vec::with_capacity(m * per_span + 1);
+    for j in 0..m {
+        let [p0, p1, p2, p3] = [0, 1, 2, 3].map(|k| pts[(j + k) % m]);
+        for step in 0..per_span {
+            let t = step as f64 / per_span as f64;
+            let (t2, t3) = (t * t, t * t * t);
+            let b0 = (1.0 - t).powi(3) / 6.0;
+            let b1 = (3.0 * t3 - 6.0 * t2 + 4.0) / 6.0;
+            let b2 = (-3.0 * t3 + 3.0 * t2 + 3.0 * t + 1.0) / 6.0;
+            let b3 = t3 / 6.0;
+            out.push([
+                b0 * p0[0] + b1 * p1[0] + b2 * p2[0] + b3 * p3[0],
+                b0 * p0[1] + b1 * p1[1] + b2 * p2[1] + b3 * p3[1],
+            ]);
+        }
+    }
+    out.push(out[0]);
+    out
+}
+
+/// Twice the signed area of a closed polygon (positive counter-clockwise).
+pub fn signed_area2(poly: &[[f64; 2]]) -> f64 {
+    let n = poly.len();
+    (0..n)
+        .map(|i| {
+            let (a, b) = (poly[i], poly[(i + 1) % n]);
+            a[0] * b[1] - b[0] * a[1]
+        })
+        .sum()
 }
 
 /// Arc length at each vertex of a polyline (0 at the first).
@@ -243,15 +341,11 @@ pub fn resample_polyline(poly: &[[f64; 2]], cum: &[f64], n: usize) -> Vec<[f64; 
 }
 
 impl Trajectory {
-    /// Validates Ψ (not closed, no self-intersection, non-zero length) and
-    /// resamples it into `round(length / spacing) + 1` points.
+    /// Validates Ψ (no self-intersection, non-zero length) and resamples
+    /// it into `round(length / spacing) + 1` points (open), or
+    /// `round(length / spacing)` round the loop (closed).
     pub fn new(spec: &TrajectorySpec, spacing: f64) -> Result<Trajectory> {
-        if spec.closed {
-            return Err(Error::invalid(
-                "trajectory.closed",
-                "closed trajectories are reserved for a later version; use an open curve",
-            ));
-        }
+        let closed = spec.closed;
         let poly = match (&spec.control_points, &spec.points) {
             (Some(_), Some(_)) => {
                 return Err(Error::invalid(
@@ -265,6 +359,14 @@ impl Trajectory {
                     "needs `control_points` (a B-spline) or `points` (a polyline)",
                 ))
             }
+            (Some(cp), None) if closed => {
+                check_points("trajectory.control_points", cp, 3)?;
+                let est: f64 = (0..cp.len())
+                    .map(|i| dist(cp[i], cp[(i + 1) % cp.len()]))
+                    .sum();
+                let per_span = ((est / (spacing / 8.0)) as usize / cp.len()).clamp(16, 1 << 14);
+                periodic_bspline(cp, per_span)
+            }
             (Some(cp), None) => {
                 check_points("trajectory.control_points", cp, 2)?;
                 let curve = BSpline::clamped(cp.clone()).expect("≥ 2 points");
@@ -274,12 +376,26 @@ impl Trajectory {
                 curve.flatten(per_span)
             }
             (None, Some(p)) => {
-                check_points("trajectory.points", p, 2)?;
-                let mut v: Vec<[f64; 2]> = Vec::with_capacity(p.len());
+                check_points("trajectory.points", p, if closed { 3 } else { 2 })?;
+                let mut v: Vec<[f64; 2]> = Vec::with_capacity(p.len() + 1);
                 for q in p {
                     if v.last().is_none_or(|l| dist(*l, *q) > 1e-9) {
                         v.push(*q);
                     }
+                }
+                if closed {
+                    // A loop closes back to its first point (given again
+                    // or not).
+                    if v.len() > 1 && dist(v[0], v[v.len() - 1]) <= 1e-9 {
+                        v.pop();
+                    }
+                    if v.len() < 3 {
+                        return Err(Error::invalid(
+                            "trajectory.points",
+                            "a closed trajectory needs at least 3 distinct points",
+                        ));
+                    }
+                    v.push(v[0]);
                 }
                 v
             }
@@ -292,34 +408,62 @@ impl Trajectory {
                 format!("is too short ({length:.2} mm); it must be at least two samples long"),
             ));
         }
-        let n = ((length / spacing).round() as usize).max(1) + 1;
-        let points = resample_polyline(&poly, &cum, n);
-        let traj = Trajectory { points, length };
+        let points = if closed {
+            // n points round the loop; the (n + 1)-th would be p_0 again.
+            let n = ((length / spacing).round() as usize).max(3);
+            let mut pts = resample_polyline(&poly, &cum, n + 1);
+            pts.pop();
+            if signed_area2(&pts).abs() < 1e-9 {
+                return Err(Error::invalid(
+                    "trajectory",
+                    "a closed trajectory must enclose an area",
+                ));
+            }
+            pts
+        } else {
+            let n = ((length / spacing).round() as usize).max(1) + 1;
+            resample_polyline(&poly, &cum, n)
+        };
+        let traj = Trajectory {
+            points,
+            length,
+            closed,
+        };
         traj.check_self_intersection()?;
         Ok(traj)
+    }
+
+    /// The number of segments of the polyline: n − 1 open, n closed.
+    fn segments(&self) -> usize {
+        self.points.len() - usize::from(!self.closed)
     }
 
     /// Refuses a trajectory whose polyline crosses itself (grid of
     /// segments; linear time for curves that do not pile up in one place).
     fn check_self_intersection(&self) -> Result<()> {
         let pts = &self.points;
-        let seg_len = self.length / (pts.len() - 1) as f64;
+        let segs = self.segments();
+        let end = |i: usize| pts[(i + 1) % pts.len()];
+        let seg_len = self.length / segs as f64;
         let mut grid = Grid2::new(seg_len.max(1e-3));
-        for i in 0..pts.len() - 1 {
-            grid.insert_segment(pts[i], pts[i + 1], i as u32);
+        for (i, &p) in pts.iter().enumerate().take(segs) {
+            grid.insert_segment(p, end(i), i as u32);
         }
-        for i in 0..pts.len() - 1 {
-            let (a, b) = (pts[i], pts[i + 1]);
+        for i in 0..segs {
+            let (a, b) = (pts[i], end(i));
             let mut hit = None;
             grid.for_each_near_segment(a, b, 0.0, |j| {
                 let j = j as usize;
-                if j > i + 1 && hit.is_none() && segments_cross(a, b, pts[j], pts[j + 1]) {
+                // Neighbours share an end; a loop's last segment is the
+                // first one's neighbour.
+                let neighbour = j <= i + 1 || (self.closed && i == 0 && j == segs - 1);
+                if !neighbour && hit.is_none() && segments_cross(a, b, pts[j], end(j)) {
                     hit = Some(j);
                 }
             });
             if let Some(j) = hit {
-                let u1 = i as f64 / (pts.len() - 1) as f64;
-                let u2 = j as f64 / (pts.len() - 1) as f64;
+                let u1 = i as f64 / segs as f64;
+                let u2 = j as f64 / segs as f64;
                 return Err(Error::invalid(
                     "trajectory",
                     format!(
@@ -470,13 +614,44 @@ mod tests {
         };
         let e = Trajectory::new(&spec, 1.1).unwrap_err();
         assert!(e.to_string().contains("crosses itself"), "{e}");
+        // Closed, it crosses itself too; a loop's two ends are neighbours,
+        // not a crossing.
         let spec = TrajectorySpec {
             closed: true,
             ..spec
         };
-        assert!(Trajectory::new(&spec, 1.1)
-            .unwrap_err()
-            .to_string()
-            .starts_with("trajectory.closed"));
+        let e = Trajectory::new(&spec, 1.1).unwrap_err();
+        assert!(e.to_string().contains("crosses itself"), "{e}");
+        let square = TrajectorySpec {
+            points: Some(vec![[0.0, 0.0], [40.0, 0.0], [40.0, 40.0], [0.0, 40.0]]),
+            ..spec
+        };
+        let t = Trajectory::new(&square, 1.0).unwrap();
+        assert!(t.closed && (t.length - 160.0).abs() < 1e-9);
+        assert_eq!(t.points.len(), 160, "p_0 is not repeated");
+        let wrap = dist(t.points[159], t.points[0]);
+        assert!((wrap - 1.0).abs() < 1e-9, "the loop closes evenly: {wrap}");
+    }
+
+    #[test]
+    fn a_periodic_b_spline_of_a_regular_polygon_is_round() {
+        // The uniform cubic B-spline of a regular m-gon of radius R is a
+        // closed curve between R·(2 + cos(2π/m))/3 and the same at the
+        // span ends: for m = 8 within 3 % of a circle.
+        let cp: Vec<[f64; 2]> = (0..8)
+            .map(|i| {
+                let a = std::f64::consts::TAU * i as f64 / 8.0;
+                [30.0 * a.cos(), 30.0 * a.sin()]
+            })
+            .collect();
+        let poly = periodic_bspline(&cp, 32);
+        assert_eq!(poly.first(), poly.last());
+        let want = 30.0 * (2.0 + (std::f64::consts::TAU / 8.0).cos()) / 3.0;
+        let r0 = poly[0][0].hypot(poly[0][1]);
+        assert!((r0 - want).abs() < 1e-9, "{r0} vs {want}");
+        for p in &poly {
+            let r = p[0].hypot(p[1]);
+            assert!(r > 0.97 * want && r < 1.03 * want, "{r}");
+        }
     }
 }

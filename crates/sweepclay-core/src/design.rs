@@ -55,8 +55,10 @@ pub struct TrajectorySpec {
     /// Or: the vertices of a polyline (e.g. from an SVG import).
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub points: Option<Vec<[f64; 2]>>,
-    /// Reserved for closed trajectories (vases); must be `false` for now.
-    #[serde(default)]
+    /// Ψ is a loop: a vessel with a floor and a spiral wall
+    /// (docs/ALGORITHMS.md §8). A B-spline's control polygon then wraps
+    /// round; a polyline closes from its last point to its first.
+    #[serde(default, skip_serializing_if = "std::ops::Not::not")]
     pub closed: bool,
     /// The frame of the profiles' horizontal offset (default radial).
     #[serde(default, skip_serializing_if = "Offset::is_radial")]
@@ -108,7 +110,17 @@ pub struct Params {
     pub max_overhang_deg: f64,
     /// Printing speed. Default 2000 mm/min.
     pub feedrate: f64,
+    /// Flat layers of a vessel's floor (closed Ψ only; 0 = bottomless).
+    /// Omitted: [`DEFAULT_FLOOR_LAYERS`] for a vessel.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub floor_layers: Option<u32>,
 }
+
+/// Floor layers of a vessel when `params.floor_layers` is omitted.
+pub const DEFAULT_FLOOR_LAYERS: u32 = 2;
+
+/// Most floor layers a vessel may have.
+pub const MAX_FLOOR_LAYERS: u32 = 20;
 
 impl Default for Params {
     fn default() -> Self {
@@ -122,6 +134,7 @@ impl Default for Params {
             overlap: 2.0 / 3.0,
             max_overhang_deg: 57.0,
             feedrate: 2000.0,
+            floor_layers: None,
         }
     }
 }
@@ -156,6 +169,14 @@ impl Params {
         range("params.overlap", self.overlap, 0.5, 0.95)?;
         range("params.max_overhang_deg", self.max_overhang_deg, 1.0, 80.0)?;
         range("params.feedrate", self.feedrate, 1.0, 100_000.0)?;
+        if let Some(f) = self.floor_layers {
+            if f > MAX_FLOOR_LAYERS {
+                return Err(Error::invalid(
+                    "params.floor_layers",
+                    format!("must be between 0 and {MAX_FLOOR_LAYERS} (got {f})"),
+                ));
+            }
+        }
         Ok(())
     }
 
@@ -191,10 +212,21 @@ impl Params {
         "overlap",
         "max_overhang_deg",
         "feedrate",
+        "floor_layers",
     ];
 
     /// Sets one parameter by name (`--set key=value`).
     pub fn set(&mut self, key: &str, value: f64) -> Result<()> {
+        if key == "floor_layers" {
+            if !(value.fract() == 0.0 && (0.0..=f64::from(MAX_FLOOR_LAYERS)).contains(&value)) {
+                return Err(Error::invalid(
+                    "params.floor_layers",
+                    format!("must be a whole number from 0 to {MAX_FLOOR_LAYERS} (got {value})"),
+                ));
+            }
+            self.floor_layers = Some(value as u32);
+            return Ok(());
+        }
         let slot = match key {
             "layer_height" => &mut self.layer_height,
             "max_layer_height" => &mut self.max_layer_height,

@@ -119,6 +119,7 @@ mod tests {
             passes: offsets.len() as u32,
             stages: 1,
             returning_points: 0,
+            vessel: None,
         }
     }
 

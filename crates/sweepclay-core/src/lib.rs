@@ -50,6 +50,7 @@ pub mod preview;
 pub mod printer;
 pub mod surface;
 pub mod toolpath;
+pub mod vessel;
 
 pub use correct::{Corrected, CorrectionReport};
 pub use design::{Design, Offset, Params};

@@ -45,19 +45,23 @@ pub fn path_index_of_samples(s: &Sliced) -> Vec<u32> {
     let surface = &s.corrected.surface;
     let mut of = vec![0u32; surface.samples.len()];
     for (i, p) in s.toolpath.points.iter().enumerate() {
-        of[sample_of_point(surface, p)] = i as u32;
+        if let Some(si) = sample_of_point(surface, p) {
+            of[si] = i as u32;
+        }
     }
     of
 }
 
-/// The surface sample a toolpath point visits.
-pub fn sample_of_point(s: &Surface, p: &crate::toolpath::PathPoint) -> usize {
+/// The surface sample a toolpath point visits (`None` for a vessel's
+/// floor beads inside the base ring, which are not surface samples).
+pub fn sample_of_point(s: &Surface, p: &crate::toolpath::PathPoint) -> Option<usize> {
     let col = &s.columns[p.column as usize];
     let local = match p.kind {
         PointKind::Pass => p.pass as usize - 1,
         PointKind::Top => col.passes as usize,
+        PointKind::Floor => return None,
     };
-    col.first as usize + local
+    Some(col.first as usize + local)
 }
 
 /// The closed solid of the surface thickened to the bead width: each sample

@@ -84,6 +84,7 @@ pub fn svg(s: &Sliced) -> String {
         }
         let stroke = match kind {
             PointKind::Top => "#111".to_string(),
+            PointKind::Floor => "#9a7b4f".to_string(),
             PointKind::Pass => colour((pass as f64 - 1.0) / (st.passes.max(2) - 1) as f64),
         };
         let _ = writeln!(

@@ -11,6 +11,7 @@ use crate::design::{Design, Offset, Params};
 use crate::error::{Error, Result};
 use crate::layers::LayerPlan;
 use crate::printer::Printer;
+use crate::vessel::VesselPlan;
 
 /// One transition curve, at trajectory sample p_i.
 #[derive(Clone, Debug, PartialEq)]
@@ -77,8 +78,11 @@ pub struct Surface {
     pub columns: Vec<Column>,
     /// All samples, column by column, bottom up.
     pub samples: Vec<Sample>,
-    /// The layering the samples follow.
+    /// The layering the samples follow. For a vessel, a single stage of
+    /// all its layers and turns; [`Surface::vessel`] holds its layering.
     pub plan: LayerPlan,
+    /// A vessel's layering (closed Ψ), else `None`.
+    pub vessel: Option<VesselPlan>,
     /// Whether the tall end is the end of Ψ (else its start).
     pub tall_at_end: bool,
     /// C_s sampled.
@@ -121,9 +125,13 @@ impl Surface {
 /// The unit normal of the polyline `pts` at point `i`, to the left of the
 /// direction of travel: from the chord of its neighbours (one-sided at the
 /// ends), so a straight wall has one normal and a bend turns it smoothly.
-fn normal(pts: &[[f64; 2]], i: usize) -> [f64; 2] {
-    let a = pts[i.saturating_sub(1)];
-    let b = pts[(i + 1).min(pts.len() - 1)];
+fn normal(pts: &[[f64; 2]], i: usize, closed: bool) -> [f64; 2] {
+    let n = pts.len();
+    let (a, b) = if closed {
+        (pts[(i + n - 1) % n], pts[(i + 1) % n])
+    } else {
+        (pts[i.saturating_sub(1)], pts[(i + 1).min(n - 1)])
+    };
     let (tx, ty) = (b[0] - a[0], b[1] - a[1]);
     let l = tx.hypot(ty);
     if l > 0.0 {
@@ -151,12 +159,33 @@ pub fn sample_surface(design: &Design) -> Result<Surface> {
             ));
         }
     }
-    let interp = Interpolation::new(design.interpolation.as_ref())?;
+    let closed = design.trajectory.closed;
+    if !closed && params.floor_layers.is_some() {
+        return Err(Error::invalid(
+            "params.floor_layers",
+            "a floor needs a closed trajectory (\"closed\": true in the trajectory): an open wall has no inside",
+        ));
+    }
+    let interp = if closed {
+        Interpolation::new_closed(design.interpolation.as_ref())?
+    } else {
+        Interpolation::new(design.interpolation.as_ref())?
+    };
     let traj = Trajectory::new(&design.trajectory, params.spacing)?;
     let n = traj.points.len();
+    // "Outward" for a loop: right of travel on a counter-clockwise one.
+    let outward = if closed && crate::curves::signed_area2(&traj.points) > 0.0 {
+        -1.0
+    } else {
+        1.0
+    };
     let mut columns = Vec::with_capacity(n);
     for (i, &p) in traj.points.iter().enumerate() {
-        let u = i as f64 / (n - 1) as f64;
+        let u = if closed {
+            i as f64 / n as f64
+        } else {
+            i as f64 / (n - 1) as f64
+        };
         let dir = match design.trajectory.offset {
             Offset::Radial => {
                 let r = p[0].hypot(p[1]);
@@ -171,7 +200,7 @@ pub fn sample_surface(design: &Design) -> Result<Surface> {
                 }
                 [p[0] / r, p[1] / r]
             }
-            Offset::Normal => normal(&traj.points, i),
+            Offset::Normal => normal(&traj.points, i, closed).map(|v| outward * v),
         };
         let lambda = interp.eval(u);
         columns.push(Column {
@@ -184,6 +213,9 @@ pub fn sample_surface(design: &Design) -> Result<Surface> {
             passes: 0,
             top: false,
         });
+    }
+    if closed {
+        return sample_vessel(design, columns, traj.length, params, printer, start, end);
     }
     let tall_at_end = end.height >= start.height;
     // Columns from the short end (the order the layering works in).
@@ -208,6 +240,7 @@ pub fn sample_surface(design: &Design) -> Result<Surface> {
         columns,
         samples: Vec::new(),
         plan,
+        vessel: None,
         tall_at_end,
         start,
         end,
@@ -239,6 +272,65 @@ pub fn sample_surface(design: &Design) -> Result<Surface> {
     }
     surface.columns = columns;
     surface.samples = samples;
+    Ok(surface)
+}
+
+/// The samples of a vessel (docs/ALGORITHMS.md §8): each column's base
+/// layers, its spiral turns and, but for the last column, whose last turn
+/// already ends on the rim, the rim bead.
+fn sample_vessel(
+    design: &Design,
+    mut columns: Vec<Column>,
+    length: f64,
+    params: Params,
+    printer: Printer,
+    start: Profile,
+    end: Profile,
+) -> Result<Surface> {
+    let n = columns.len();
+    let heights: Vec<f64> = columns.iter().map(|c| c.height).collect();
+    let floor = params
+        .floor_layers
+        .unwrap_or(crate::design::DEFAULT_FLOOR_LAYERS);
+    let v = VesselPlan::choose(&heights, &params, floor)?;
+    let layers = v.base_layers + v.turns;
+    let plan = LayerPlan {
+        passes: layers + 1,
+        lower_passes: layers + 1,
+        lower_layer_mm: v.turn_mm[0],
+        upper_layer_mm: v.turn_mm[1],
+        spread_mm: 0.0,
+        first_toward_tall: true,
+        min_top_bead_mm: 0.0,
+    };
+    let mut surface = Surface {
+        name: design.name.clone(),
+        columns: Vec::new(),
+        samples: Vec::with_capacity(n * (layers as usize + 1)),
+        plan,
+        vessel: None,
+        tall_at_end: true,
+        start,
+        end,
+        trajectory_length: length,
+        spacing: length / n as f64,
+        params,
+        printer,
+    };
+    for (i, col) in columns.iter_mut().enumerate() {
+        col.first = surface.samples.len() as u32;
+        col.passes = layers;
+        col.top = i + 1 < n;
+        let base = (1..=v.base_layers).map(|b| f64::from(b) * v.base_layer_mm);
+        let spiral = (1..=v.turns).map(|k| v.spiral_z(k, i, n, col.height));
+        let rim = col.top.then_some(col.height);
+        for z in base.chain(spiral).chain(rim) {
+            let xi = surface.design_offset(col, z, 1.0);
+            surface.samples.push(Sample { z, xi });
+        }
+    }
+    surface.columns = columns;
+    surface.vessel = Some(v);
     Ok(surface)
 }
 

@@ -18,8 +18,12 @@ use serde::Serialize;
 pub enum PointKind {
     /// A point of a regular pass.
     Pass,
-    /// A top-edge bead laid by a returning turn.
+    /// A top-edge bead laid by a returning turn; in a vessel, a bead of
+    /// the last turn, which lays the rim level.
     Top,
+    /// A bead of a vessel's floor inside its base ring (not a surface
+    /// sample).
+    Floor,
 }
 
 /// One point of the toolpath, remembering where it came from.
@@ -49,11 +53,16 @@ pub struct Toolpath {
     pub stages: u8,
     /// Number of returning turns that climb the top edge.
     pub returning_points: u32,
+    /// A vessel's floor and turns (closed Ψ), else `None`.
+    pub vessel: Option<crate::vessel::VesselPath>,
 }
 
 /// Orders the samples of a corrected surface into one continuous path.
 pub fn plan_path(c: &Corrected) -> Toolpath {
     let s = &c.surface;
+    if let Some(v) = &s.vessel {
+        return crate::vessel::plan_vessel_path(c, v);
+    }
     let n = s.columns.len();
     let k_max = s.plan.passes;
     // a[k]: first ordered column visited by pass k.
@@ -126,6 +135,7 @@ pub fn plan_path(c: &Corrected) -> Toolpath {
         passes: k_max,
         stages: if s.plan.two_stage() { 2 } else { 1 },
         returning_points: returning,
+        vessel: None,
     }
 }
 

@@ -283,7 +283,7 @@ fn view(s: &Sliced, moved: Vec<u32>, slice_ms: f64) -> SliceView {
     let path = PathView {
         order: pts
             .iter()
-            .map(|p| mesh::sample_of_point(surf, p) as u32)
+            .map(|p| mesh::sample_of_point(surf, p).map_or(u32::MAX, |i| i as u32))
             .collect(),
         width: s.extrusion.width.iter().map(|&w| round2(w)).collect(),
         pass: pts.iter().map(|p| p.pass).collect(),
