@@ -330,13 +330,27 @@ fn slice(a: SliceArgs) -> Result<i32> {
             st.sample_points,
             st.curves
         );
-        say!(
-            "  passes             {} ({} stage{}, {} returning turns)",
-            st.passes,
-            st.stages,
-            if st.stages == 1 { "" } else { "s" },
-            st.returning_points
-        );
+        if let Some(v) = &st.vessel {
+            say!(
+                "  floor              {} layer{} of {} rings inside the base ring ({:.1} cm²)",
+                v.floor_layers,
+                if v.floor_layers == 1 { "" } else { "s" },
+                v.floor_rings,
+                v.floor_area_cm2
+            );
+            say!(
+                "  wall               {} spiral turns and a rim turn, one continuous path",
+                v.wall_turns
+            );
+        } else {
+            say!(
+                "  passes             {} ({} stage{}, {} returning turns)",
+                st.passes,
+                st.stages,
+                if st.stages == 1 { "" } else { "s" },
+                st.returning_points
+            );
+        }
         say!(
             "  layer heights      {} (layer_height {})",
             st.layers.summary(),

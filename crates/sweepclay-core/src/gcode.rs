@@ -7,6 +7,7 @@
 //! increasing E until the printer's end code.
 
 use crate::extrude::Extrusion;
+use crate::toolpath::{PointKind, Toolpath};
 use crate::Sliced;
 use std::io::{self, Write};
 
@@ -68,6 +69,13 @@ pub fn emit<W: Write>(s: &Sliced, out: &mut W) -> io::Result<Vec<usize>> {
     writeln!(out, "; passes: {}", st.passes)?;
     writeln!(out, "; stages: {}", st.stages)?;
     writeln!(out, "; returning_points: {}", st.returning_points)?;
+    if let Some(v) = &st.vessel {
+        writeln!(
+            out,
+            "; vessel: floor_layers={} floor_rings={} floor_area_cm2={:.1} wall_turns={}",
+            v.floor_layers, v.floor_rings, v.floor_area_cm2, v.wall_turns
+        )?;
+    }
     writeln!(out, "; layer_heights: {}", st.layers.summary())?;
     if let Some(why) = &st.layers.thicker_because {
         writeln!(out, "; layer_heights_thicker_because: {}", one_line(why))?;
@@ -100,7 +108,8 @@ pub fn emit<W: Write>(s: &Sliced, out: &mut W) -> io::Result<Vec<usize>> {
     }
     let before = out.count;
     let points = &s.toolpath.points;
-    let lines = emit_moves(
+    let types = move_types(&s.toolpath);
+    let lines = emit_typed_moves(
         out.inner,
         points.len(),
         |i| points[i].pos,
@@ -112,12 +121,36 @@ pub fn emit<W: Write>(s: &Sliced, out: &mut W) -> io::Result<Vec<usize>> {
             feed_mm_min: pa.feedrate,
             travel_feed_mm_min: pr.travel_feedrate,
         },
+        &types,
     )?;
     out.write_all(pr.end_gcode.as_bytes())?;
     if !pr.end_gcode.is_empty() && !pr.end_gcode.ends_with('\n') {
         writeln!(out)?;
     }
     Ok(lines.into_iter().map(|l| l + before).collect())
+}
+
+/// Where a vessel's moves change between floor and wall, for `;TYPE:`
+/// comments (a wall's are not typed: it is all wall). The base ring under
+/// the wall counts as wall.
+pub fn move_types(t: &Toolpath) -> Vec<(usize, &'static str)> {
+    if t.vessel.is_none() {
+        return Vec::new();
+    }
+    let mut types = Vec::new();
+    let mut last = None;
+    for (i, p) in t.points.iter().enumerate().skip(1) {
+        let name = if p.kind == PointKind::Floor {
+            "Bottom solid infill"
+        } else {
+            "External perimeter"
+        };
+        if last != Some(name) {
+            types.push((i, name));
+            last = Some(name);
+        }
+    }
+    types
 }
 
 /// How [`emit_moves`] writes moves.
@@ -194,6 +227,21 @@ pub fn emit_moves<W: Write>(
     ex: &Extrusion,
     f: &MoveFormat,
 ) -> io::Result<Vec<usize>> {
+    emit_typed_moves(out, n, pos, ex, f, &[])
+}
+
+/// [`emit_moves`] with a `;TYPE:` comment (PrusaSlicer's and Cura's way of
+/// telling a viewer what a move prints) before the move to point `i` for
+/// each `(i, name)` of `types`, sorted by `i`.
+pub fn emit_typed_moves<W: Write>(
+    out: &mut W,
+    n: usize,
+    pos: impl Fn(usize) -> [f64; 3],
+    ex: &Extrusion,
+    f: &MoveFormat,
+    types: &[(usize, &str)],
+) -> io::Result<Vec<usize>> {
+    let mut types = types.iter().peekable();
     const CHUNK: usize = 1 << 16;
     let o = f.origin;
     let mut buf: Vec<u8> = Vec::with_capacity(CHUNK + 256);
@@ -236,6 +284,12 @@ pub fn emit_moves<W: Write>(
                 line += 1;
                 *last = q;
             }
+        }
+        if let Some(&(_, name)) = types.next_if(|t| t.0 <= i) {
+            buf.extend_from_slice(b";TYPE:");
+            buf.extend_from_slice(name.as_bytes());
+            buf.push(b'\n');
+            line += 1;
         }
         let de = ex.volume[i] * f.e_per_mm3;
         let e = if f.relative_e {

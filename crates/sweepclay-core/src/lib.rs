@@ -87,6 +87,22 @@ pub struct Stats {
     pub bounds_mm: [[f64; 3]; 2],
     /// The layer heights the path really uses.
     pub layers: LayerStats,
+    /// A vessel's floor and wall, else `None`.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub vessel: Option<VesselStats>,
+}
+
+/// The parts of a vessel (docs/ALGORITHMS.md §8).
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct VesselStats {
+    /// Flat floor layers (0: bottomless).
+    pub floor_layers: u32,
+    /// Concentric rings inside the base ring, each floor layer.
+    pub floor_rings: u32,
+    /// Area of the floor inside the base ring (cm²).
+    pub floor_area_cm2: f64,
+    /// Spiral turns of the wall, the rim turn not counted.
+    pub wall_turns: u32,
 }
 
 /// The layer heights a sliced design uses, per stage (docs/ALGORITHMS.md
@@ -121,6 +137,21 @@ impl LayerStats {
 fn layer_stats(c: &Corrected) -> LayerStats {
     let s = &c.surface;
     let plan = &s.plan;
+    if let Some(v) = &s.vessel {
+        // The spiral's layers (the first turn rises from the floor and the
+        // rim turn tapers to the rim, as in any vase mode).
+        let asked = s.params.layer_height;
+        return LayerStats {
+            lower_mm: v.turn_mm,
+            upper_mm: None,
+            thicker_because: (v.turn_mm[1] > asked * 1.005).then(|| {
+                format!(
+                    "the rim's height varies round the loop: each column's wall above the floor is split into the same {} spiral turns, so its layers are thicker where it is taller",
+                    v.turns
+                )
+            }),
+        };
+    }
     let mut lower = [f64::INFINITY, 0.0f64];
     let mut upper = [f64::INFINITY, 0.0f64];
     for col in &s.columns {
@@ -256,6 +287,12 @@ fn stats(c: &Corrected, t: &Toolpath, e: &Extrusion) -> Stats {
         time_min: e.path_length / c.surface.params.feedrate + travel / pr.travel_feedrate,
         bounds_mm: [lo, hi],
         layers: layer_stats(c),
+        vessel: t.vessel.as_ref().map(|v| VesselStats {
+            floor_layers: v.floor_layers,
+            floor_rings: v.floor_rings,
+            floor_area_cm2: v.floor_area_mm2 / 100.0,
+            wall_turns: v.turns,
+        }),
     }
 }
 

@@ -293,6 +293,33 @@ fn sample_vessel(
         .floor_layers
         .unwrap_or(crate::design::DEFAULT_FLOOR_LAYERS);
     let v = VesselPlan::choose(&heights, &params, floor)?;
+    // The extruder body's reach, and the clay just laid along the loop
+    // that it may touch, as the checker counts them; columns where the
+    // rim is, where collisions happen (docs/ALGORITHMS.md §8).
+    let spacing = length / n as f64;
+    let reach = printer.nozzle_radius + params.width_max / 2.0;
+    let exempt = ((printer.nozzle_radius + params.width_max) / spacing) as usize;
+    let offset = |c: &Column| {
+        let t = 1.0;
+        (1.0 - c.lambda) * start.offset(t) + c.lambda * end.offset(t)
+    };
+    let points: Vec<[f64; 2]> = columns
+        .iter()
+        .map(|c| {
+            let q = c.point(offset(c), 0.0);
+            [q[0], q[1]]
+        })
+        .collect();
+    if let Some((i, over)) = v.body_violation(&points, &heights, reach, exempt) {
+        let c = &columns[i];
+        return Err(Error::invalid(
+            "interpolation",
+            format!(
+                "the rim rises or falls too steeply for a spiral near ({:.1}, {:.1}) mm, u = {:.3}: the extruder body ({} mm radius) would meet clay {over:.2} mm above the nozzle there; bring the two profiles' heights closer, or make the interpolation change more gently along the loop",
+                c.p[0], c.p[1], c.u, printer.nozzle_radius
+            ),
+        ));
+    }
     let layers = v.base_layers + v.turns;
     let plan = LayerPlan {
         passes: layers + 1,
@@ -313,14 +340,14 @@ fn sample_vessel(
         start,
         end,
         trajectory_length: length,
-        spacing: length / n as f64,
+        spacing,
         params,
         printer,
     };
     for (i, col) in columns.iter_mut().enumerate() {
         col.first = surface.samples.len() as u32;
         col.passes = layers;
-        col.top = i + 1 < n;
+        col.top = v.has_rim(i, n, col.height);
         let base = (1..=v.base_layers).map(|b| f64::from(b) * v.base_layer_mm);
         let spiral = (1..=v.turns).map(|k| v.spiral_z(k, i, n, col.height));
         let rim = col.top.then_some(col.height);

@@ -115,7 +115,71 @@ impl VesselPlan {
         let d = (h - base) / f64::from(self.turns);
         base + (f64::from(k - 1) + (i + 1) as f64 / n as f64) * d
     }
+
+    /// Whether column `i` of `n` gets a rim bead: where the last turn ends
+    /// at least half a layer below the rim (a thinner bead is no bead, as
+    /// for the top-edge beads of a wall; the rim is then level to within
+    /// half a layer).
+    pub fn has_rim(&self, i: usize, n: usize, h: f64) -> bool {
+        h - self.spiral_z(self.turns, i, n, h) >= 0.5 * self.base_layer_mm - 1e-9
+    }
+
+    /// The first column where the extruder body would meet clay already
+    /// laid (docs/ALGORITHMS.md §8): for every pair of columns `i`, `j`
+    /// within `reach` in plan, the turn below at `j` (or, more than
+    /// `exempt` columns back along the loop, this turn at `j`) must not
+    /// stand more than [`BODY_GRAZE_MM`] above the nozzle at `i`. Checked
+    /// at the turns where the difference is largest (it is linear in the
+    /// turn). `points` are the columns in plan, `h` their rims.
+    pub fn body_violation(
+        &self,
+        points: &[[f64; 2]],
+        h: &[f64],
+        reach: f64,
+        exempt: usize,
+    ) -> Option<(usize, f64)> {
+        let n = points.len();
+        let mut grid = crate::grid::Grid2::new(reach.max(1e-3));
+        for (i, p) in points.iter().enumerate() {
+            grid.insert_segment(*p, *p, i as u32);
+        }
+        let turns = [1.max(self.turns.min(2)), self.turns];
+        let mut worst: Option<(usize, f64)> = None;
+        for (i, p) in points.iter().enumerate() {
+            grid.for_each_near_segment(*p, *p, reach, |j| {
+                let j = j as usize;
+                let q = points[j];
+                if (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) > reach * reach || j == i {
+                    return;
+                }
+                for k in turns {
+                    let me = self.spiral_z(k, i, n, h[i]);
+                    let below = if k > 1 {
+                        self.spiral_z(k - 1, j, n, h[j])
+                    } else {
+                        self.base_mm()
+                    };
+                    // This turn's clay at j, laid long enough ago to count.
+                    let back = (i + n - j) % n;
+                    let same = if j < i && back > exempt {
+                        self.spiral_z(k, j, n, h[j])
+                    } else {
+                        f64::MIN
+                    };
+                    let over = below.max(same) - me;
+                    if over > BODY_GRAZE_MM && worst.is_none_or(|w| over > w.1) {
+                        worst = Some((i, over));
+                    }
+                }
+            });
+        }
+        worst
+    }
 }
+
+/// Clay this little above the nozzle tip, near the edge of the extruder
+/// body, is a graze on a bead's rounded edge (as the checker allows).
+pub const BODY_GRAZE_MM: f64 = 0.2;
 
 /// The concentric rings that fill a closed polygon `outer` (the base ring,
 /// counter-clockwise or not) inside it: offsets inward by `pitch`, 2 ·
