@@ -46,7 +46,7 @@ enum Command {
     Slice(SliceArgs),
     /// Check any G-code file for clay printability (exit 0 only if printable).
     Check(CheckArgs),
-    /// Write the bundled example designs t1–t6 into a directory.
+    /// Write the bundled example designs (walls t1–t6, vessels vase, flower, cup) into a directory.
     Examples {
         /// Directory to write into (created if missing).
         dir: PathBuf,
@@ -74,7 +74,7 @@ struct ServeArgs {
 
 #[derive(Args, Debug)]
 struct SliceArgs {
-    /// Design file; a bundled example name (`t1` … `t6`) also works.
+    /// Design file; a bundled example name (`t1` … `t6`, `vase`, `flower`, `cup`) also works.
     design: String,
     /// Output G-code file [default: the design's name with .gcode].
     #[arg(short, long)]

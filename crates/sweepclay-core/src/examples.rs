@@ -1,5 +1,7 @@
-//! The bundled example designs, modelled on the paper's Table 1 models t1–t6
-//! (Fig. 11). `sweepclay examples DIR` writes them out.
+//! The bundled example designs: walls modelled on the paper's Table 1
+//! models t1–t6 (Fig. 11), and three vessels (a round vase, a flower vase
+//! whose two profiles differ, a cup for the cerambot-mini). `sweepclay
+//! examples DIR` writes them out.
 
 /// `(file name, design JSON)` for each bundled example.
 pub const EXAMPLES: &[(&str, &str)] = &[
@@ -9,6 +11,9 @@ pub const EXAMPLES: &[(&str, &str)] = &[
     ("t4.json", include_str!("../../../examples/t4.json")),
     ("t5.json", include_str!("../../../examples/t5.json")),
     ("t6.json", include_str!("../../../examples/t6.json")),
+    ("vase.json", include_str!("../../../examples/vase.json")),
+    ("flower.json", include_str!("../../../examples/flower.json")),
+    ("cup.json", include_str!("../../../examples/cup.json")),
 ];
 
 /// A bundled example by name (`t1` or `t1.json`).

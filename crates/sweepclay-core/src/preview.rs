@@ -55,16 +55,25 @@ pub fn svg(s: &Sliced) -> String {
         out,
         r#"<text x="{MARGIN}" y="28" font-size="18" font-weight="bold">{name}</text>"#
     );
+    let layering = match &st.vessel {
+        Some(v) => format!(
+            "floor of {} layers · {} spiral turns",
+            v.floor_layers, v.wall_turns
+        ),
+        None => format!(
+            "{} passes · {} stage{}",
+            st.passes,
+            st.stages,
+            if st.stages == 1 { "" } else { "s" }
+        ),
+    };
     let _ = writeln!(
         out,
-        r#"<text x="{MARGIN}" y="50" font-size="13">{:.1} × {:.1} × {:.1} mm · {} points · {} passes · {} stage{} · {:.1} m · {:.1} ml · {:.1} min</text>"#,
+        r#"<text x="{MARGIN}" y="50" font-size="13">{:.1} × {:.1} × {:.1} mm · {} points · {layering} · {:.1} m · {:.1} ml · {:.1} min</text>"#,
         st.size_mm[0],
         st.size_mm[1],
         st.size_mm[2],
         st.sample_points,
-        st.passes,
-        st.stages,
-        if st.stages == 1 { "" } else { "s" },
         st.path_length_mm / 1000.0,
         st.volume_ml,
         st.time_min
@@ -99,7 +108,7 @@ pub fn svg(s: &Sliced) -> String {
     }
     let _ = writeln!(
         out,
-        r##"<text x="{MARGIN}" y="{:.0}" font-size="11" fill="#555">passes coloured blue (first) to red (last); black: top-edge beads of returning turns; green: start; red: end</text>"##,
+        r##"<text x="{MARGIN}" y="{:.0}" font-size="11" fill="#555">passes coloured blue (first) to red (last); black: top-edge beads of returning turns (a vessel: its rim); brown: floor; green: start; red: end</text>"##,
         H - 10.0
     );
     out.push_str("</svg>\n");
