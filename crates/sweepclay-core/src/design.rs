@@ -348,12 +348,26 @@ impl Design {
     pub fn estimated_samples(&self) -> f64 {
         use crate::bspline::polyline_length as poly;
         let t = &self.trajectory;
-        let length = poly(t.control_points.as_deref().unwrap_or(&[]))
-            + poly(t.points.as_deref().unwrap_or(&[]));
+        let pts = t
+            .control_points
+            .as_deref()
+            .or(t.points.as_deref())
+            .unwrap_or(&[]);
+        let mut length = poly(pts);
+        let mut floor = 0.0;
+        let p = &self.params;
+        if t.closed && pts.len() > 1 {
+            // The closing side; a vessel's floor rings, a pitch apart,
+            // fill at most the control polygon's area (docs/ALGORITHMS.md §8).
+            length += crate::bspline::dist(pts[pts.len() - 1], pts[0]);
+            let area = 0.5 * crate::curves::signed_area2(pts).abs();
+            let pitch = p.width_min * (1.0 - crate::vessel::FLOOR_OVERLAP);
+            let layers = p.floor_layers.unwrap_or(DEFAULT_FLOOR_LAYERS);
+            floor = 1.5 * area / (pitch * p.spacing) * f64::from(layers);
+        }
         let top = |c: &CurveSpec| c.control_points.iter().map(|p| p[1]).fold(0.0, f64::max);
         let height = top(&self.profile_start).max(top(&self.profile_end));
-        let p = &self.params;
-        (length / p.spacing + 1.0) * (height / p.layer_height + 1.0)
+        (length / p.spacing + 1.0) * (height / p.layer_height + 1.0) + floor
     }
 }
 
@@ -372,7 +386,8 @@ mod tests {
     fn sample_estimate_bounds_the_real_count() {
         for (name, text) in crate::examples::EXAMPLES {
             let d = Design::from_json(text).unwrap();
-            let real = crate::surface::sample_surface(&d).unwrap().samples.len() as f64;
+            // Path points: the surface's samples and a vessel's floor.
+            let real = crate::slice(&d).unwrap().toolpath.points.len() as f64;
             let est = d.estimated_samples();
             assert!(est >= real && est < 3.0 * real, "{name}: {est} vs {real}");
         }

@@ -145,10 +145,17 @@ fn layer_stats(c: &Corrected) -> LayerStats {
             lower_mm: v.turn_mm,
             upper_mm: None,
             thicker_because: (v.turn_mm[1] > asked * 1.005).then(|| {
-                format!(
-                    "the rim's height varies round the loop: each column's wall above the floor is split into the same {} spiral turns, so its layers are thicker where it is taller",
-                    v.turns
-                )
+                if v.turn_mm[1] - v.turn_mm[0] < 1e-6 {
+                    format!(
+                        "layers may not be thinner than layer_height, and the wall above the floor divides into {} whole spiral turns of {:.3} mm",
+                        v.turns, v.turn_mm[1]
+                    )
+                } else {
+                    format!(
+                        "the rim's height varies round the loop: each column's wall above the floor is split into the same {} spiral turns, so its layers are thicker where it is taller",
+                        v.turns
+                    )
+                }
             }),
         };
     }

@@ -348,12 +348,49 @@ fn sample_vessel(
         col.first = surface.samples.len() as u32;
         col.passes = layers;
         col.top = v.has_rim(i, n, col.height);
-        let base = (1..=v.base_layers).map(|b| f64::from(b) * v.base_layer_mm);
+        // The base ring stands straight through the floor's layers (as
+        // its first layer lies), so the floor's rings fit inside it on
+        // every layer; the wall's lean starts above the floor.
+        let first = surface.design_offset(col, v.base_layer_mm, 1.0);
+        for b in 1..=v.base_layers {
+            let z = f64::from(b) * v.base_layer_mm;
+            surface.samples.push(Sample { z, xi: first });
+        }
         let spiral = (1..=v.turns).map(|k| v.spiral_z(k, i, n, col.height));
         let rim = col.top.then_some(col.height);
-        for z in base.chain(spiral).chain(rim) {
+        for z in spiral.chain(rim) {
             let xi = surface.design_offset(col, z, 1.0);
             surface.samples.push(Sample { z, xi });
+        }
+    }
+    if v.floor_layers > 0 {
+        let ring: Vec<[f64; 2]> = columns
+            .iter()
+            .map(|c| {
+                let q = c.point(surface.samples[c.first as usize].xi, 0.0);
+                [q[0], q[1]]
+            })
+            .collect();
+        let pitch = surface.params.width_min * (1.0 - crate::vessel::FLOOR_OVERLAP);
+        let rings = crate::vessel::floor_rings(&ring, pitch, surface.spacing);
+        let start = [ring[0][0], ring[0][1], 0.0];
+        let (_, step) = crate::vessel::floor_entries(&rings, start);
+        if step > 2.0 * pitch {
+            return Err(Error::invalid(
+                "trajectory",
+                format!(
+                    "the floor's innermost ring is a sliver the path would reach only by a step of {step:.1} mm across clay of the same layer; widen the narrow part of the shape, or print the vessel bottomless (params.floor_layers = 0)"
+                ),
+            ));
+        }
+        if let Some((depth, k)) = crate::vessel::floor_split(&ring, pitch) {
+            return Err(Error::invalid(
+                "trajectory",
+                format!(
+                    "the floor's rings would split into {k} separate islands {depth:.1} mm inside the wall (a waist about {:.0} mm wide or narrower): one continuous path cannot go from one to the next without crossing clay; widen the waist, or print the vessel bottomless (params.floor_layers = 0)",
+                    2.0 * depth
+                ),
+            ));
         }
     }
     surface.columns = columns;

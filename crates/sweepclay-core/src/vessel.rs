@@ -187,7 +187,11 @@ pub const BODY_GRAZE_MM: f64 = 0.2;
 /// and turned the way `outer` turns. An offset that splits (a waist
 /// narrower than two beads) gives several rings at one depth; they follow
 /// each other outermost first.
-pub fn floor_rings(outer: &[[f64; 2]], pitch: f64, spacing: f64) -> Vec<Vec<[f64; 2]>> {
+///
+/// A ring whose two sides come closer than 3/4 of `pitch` (its mean width
+/// 2A/P, area over half the perimeter: the last ring of a long ellipse) would lay its beads on each other; it becomes the line
+/// down its middle instead, an open [`FloorRing`].
+pub fn floor_rings(outer: &[[f64; 2]], pitch: f64, spacing: f64) -> Vec<FloorRing> {
     let ccw = signed_area2(outer) > 0.0;
     let mut contour: Vec<[f64; 2]> = outer.to_vec();
     if !ccw {
@@ -202,6 +206,9 @@ pub fn floor_rings(outer: &[[f64; 2]], pitch: f64, spacing: f64) -> Vec<Vec<[f64
             // The first contour of a shape is its outside; an inward
             // offset of a simple polygon has no holes.
             let Some(ring) = shape.first() else { continue };
+            if is_speck(ring, pitch) {
+                continue;
+            }
             let mut ring = resample_loop(ring, spacing);
             if ring.len() < 3 {
                 continue;
@@ -209,7 +216,22 @@ pub fn floor_rings(outer: &[[f64; 2]], pitch: f64, spacing: f64) -> Vec<Vec<[f64
             if !ccw {
                 ring.reverse();
             }
-            rings.push(ring);
+            let mut closed = ring.clone();
+            closed.push(ring[0]);
+            let perimeter = crate::curves::arc_lengths(&closed)[ring.len()];
+            if 2.0 * ring_area(&ring) / perimeter < 0.75 * pitch {
+                if let Some(line) = midline(&ring, spacing) {
+                    rings.push(FloorRing {
+                        pts: line,
+                        open: true,
+                    });
+                }
+            } else {
+                rings.push(FloorRing {
+                    pts: ring,
+                    open: false,
+                });
+            }
             found = true;
         }
         if !found {
@@ -217,6 +239,103 @@ pub fn floor_rings(outer: &[[f64; 2]], pitch: f64, spacing: f64) -> Vec<Vec<[f64
         }
     }
     rings
+}
+
+/// The first depth (mm inside `outer`) at which its inward offsets by
+/// multiples of `pitch` split into separate islands, if they do: one
+/// continuous path cannot go from one island to the next without crossing
+/// the clay between them, so such a floor is refused (docs/ALGORITHMS.md
+/// §8).
+pub fn floor_split(outer: &[[f64; 2]], pitch: f64) -> Option<(f64, usize)> {
+    let mut contour: Vec<[f64; 2]> = outer.to_vec();
+    if signed_area2(outer) < 0.0 {
+        contour.reverse();
+    }
+    for depth in 1..=MAX_FLOOR_RINGS {
+        let d = pitch * depth as f64;
+        let style = OutlineStyle::new(-d).line_join(LineJoin::Round(0.25));
+        let islands = contour
+            .outline(&style)
+            .iter()
+            .filter(|shape| shape.first().is_some_and(|c| !is_speck(c, pitch)))
+            .count();
+        match islands {
+            0 => return None,
+            1 => {}
+            k => return Some((d, k)),
+        }
+    }
+    None
+}
+
+/// Whether an offset contour encloses less than a pitch squared: a speck
+/// the squeeze of the beads round it fills (docs/ALGORITHMS.md §8).
+fn is_speck(contour: &[[f64; 2]], pitch: f64) -> bool {
+    ring_area(contour) < pitch * pitch
+}
+
+/// One element of a floor layer: a closed ring, or the open line down the
+/// middle of a ring too thin to lay as one.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FloorRing {
+    /// Points about `spacing` apart.
+    pub pts: Vec<[f64; 2]>,
+    /// An open line (laid end to end), not a ring.
+    pub open: bool,
+}
+
+/// The line down the middle of a thin closed ring: between the point
+/// farthest from its centroid and the point farthest from that, the mean
+/// of its two sides, points about `spacing` apart (`None` for a speck).
+fn midline(ring: &[[f64; 2]], spacing: f64) -> Option<Vec<[f64; 2]>> {
+    let m = ring.len();
+    let c = ring.iter().fold([0.0, 0.0], |a, p| {
+        [a[0] + p[0] / m as f64, a[1] + p[1] / m as f64]
+    });
+    let far = |from: [f64; 2]| {
+        (0..m)
+            .max_by(|&x, &y| {
+                let dx = (ring[x][0] - from[0]).hypot(ring[x][1] - from[1]);
+                let dy = (ring[y][0] - from[0]).hypot(ring[y][1] - from[1]);
+                dx.total_cmp(&dy)
+            })
+            .unwrap_or(0)
+    };
+    let a = far(c);
+    let b = far(ring[a]);
+    let side = |forward: bool| -> Vec<[f64; 2]> {
+        let mut v = vec![ring[a]];
+        let mut i = a;
+        while i != b {
+            i = if forward {
+                (i + 1) % m
+            } else {
+                (i + m - 1) % m
+            };
+            v.push(ring[i]);
+        }
+        v
+    };
+    let (s1, s2) = (side(true), side(false));
+    let (c1, c2) = (
+        crate::curves::arc_lengths(&s1),
+        crate::curves::arc_lengths(&s2),
+    );
+    let length = 0.5 * (c1[c1.len() - 1] + c2[c2.len() - 1]);
+    if length < spacing || s1.len() < 2 || s2.len() < 2 {
+        return None;
+    }
+    let k = ((length / spacing).round() as usize).max(2);
+    let (r1, r2) = (
+        crate::curves::resample_polyline(&s1, &c1, k),
+        crate::curves::resample_polyline(&s2, &c2, k),
+    );
+    Some(
+        r1.iter()
+            .zip(&r2)
+            .map(|(p, q)| [0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1])])
+            .collect(),
+    )
 }
 
 /// A closed polygon resampled into points about `spacing` apart (at least
@@ -251,6 +370,37 @@ fn nearest(ring: &[[f64; 2]], p: [f64; 3]) -> usize {
         .unwrap_or(0)
 }
 
+/// Where each floor element is entered, and the longest step into an open
+/// line (mm; a ring is entered at its nearest point, a line only at an
+/// end): each ring nearest the previous one's entry,
+/// the first nearest `start` (where the base ring begins); an open line at
+/// its nearer end.
+pub fn floor_entries(rings: &[FloorRing], start: [f64; 3]) -> (Vec<usize>, f64) {
+    let mut entry = Vec::with_capacity(rings.len());
+    let mut at = start;
+    let mut longest = 0.0f64;
+    for r in rings {
+        let pts = &r.pts;
+        // An open line is entered at an end; inward layers leave it at
+        // the other end, where the next (outward) layer comes back.
+        let e = if r.open {
+            if d2(at, pts[0]) <= d2(at, pts[pts.len() - 1]) {
+                0
+            } else {
+                pts.len() - 1
+            }
+        } else {
+            nearest(pts, at)
+        };
+        if r.open {
+            longest = longest.max(d2(at, pts[e]).sqrt());
+        }
+        entry.push(e);
+        at = [pts[e][0], pts[e][1], 0.0];
+    }
+    (entry, longest)
+}
+
 /// The toolpath of a vessel: the base layers (floor rings inward on one
 /// layer, outward on the next, so the last ends on the base ring), the
 /// spiral turns, and the rim. Every sample of the surface is visited once;
@@ -272,21 +422,15 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
     };
     // Where each ring is entered: nearest the previous ring's entry,
     // the first nearest column 0 (where the base ring starts).
-    let mut entry = Vec::with_capacity(rings.len());
-    let mut at = s.position(0, s.columns[0].first as usize);
-    for r in &rings {
-        let e = nearest(r, at);
-        entry.push(e);
-        at = [r[e][0], r[e][1], 0.0];
-    }
-    let floor_points: usize = rings.iter().map(Vec::len).sum();
+    let entry = floor_entries(&rings, s.position(0, s.columns[0].first as usize)).0;
+    let floor_points: usize = rings.iter().map(|r| r.pts.len()).sum();
     let total = s.samples.len() + floor_points * v.floor_layers as usize;
     let mut points = Vec::with_capacity(total);
     let mut below = Vec::with_capacity(total);
     // Path index of each column's samples, and of each floor ring's points
     // on the layer below.
     let mut path_of = vec![u32::MAX; s.samples.len()];
-    let mut ring_below: Vec<Vec<u32>> = rings.iter().map(|r| vec![u32::MAX; r.len()]).collect();
+    let mut ring_below: Vec<Vec<u32>> = rings.iter().map(|r| vec![u32::MAX; r.pts.len()]).collect();
     let visit_column = |points: &mut Vec<PathPoint>,
                         below: &mut Vec<Option<u32>>,
                         path_of: &mut Vec<u32>,
@@ -312,9 +456,15 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
         // The last base layer runs outward, the one before inward, …
         let outward = (base - layer).is_multiple_of(2);
         let mut floor = |points: &mut Vec<PathPoint>, below: &mut Vec<Option<u32>>, r: usize| {
-            let ring = &rings[r];
-            for step in 0..ring.len() {
-                let j = (entry[r] + step) % ring.len();
+            let ring = &rings[r].pts;
+            let m = ring.len();
+            for step in 0..m {
+                let j = match (rings[r].open, outward == (entry[r] == 0)) {
+                    (false, _) => (entry[r] + step) % m,
+                    // Open: inward from the entry end, outward back to it.
+                    (true, true) => m - 1 - step,
+                    (true, false) => step,
+                };
                 let under = ring_below[r][j];
                 below.push((under != u32::MAX).then_some(under));
                 ring_below[r][j] = points.len() as u32;
@@ -396,7 +546,11 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
         path_of.iter().all(|&p| p != u32::MAX),
         "every sample is visited"
     );
-    let floor_area = rings.first().map_or(0.0, |_| ring_area(&base_ring));
+    let floor_area = if v.floor_layers > 0 {
+        ring_area(&base_ring)
+    } else {
+        0.0
+    };
     Toolpath {
         points,
         below,
@@ -444,11 +598,12 @@ mod tests {
     #[test]
     fn a_circle_fills_with_concentric_rings() {
         let rings = floor_rings(&circle(30.0, 200), 2.55, 1.1);
-        // Radii 30 − 2.55 k down to the last ring longer than 3.3 mm.
+        // Radii 30 − 2.55 k; the last (1.95 mm) is a line across the middle.
         assert_eq!(rings.len(), 11, "{}", rings.len());
-        for (k, ring) in rings.iter().enumerate() {
+        assert!(rings[..10].iter().all(|r| !r.open));
+        for (k, ring) in rings.iter().enumerate().take(10) {
             let want = 30.0 - 2.55 * (k + 1) as f64;
-            for p in ring {
+            for p in &ring.pts {
                 assert!((p[0].hypot(p[1]) - want).abs() < 0.05, "ring {k}: {p:?}");
             }
         }
@@ -458,9 +613,118 @@ mod tests {
     fn rings_turn_the_way_the_outline_turns() {
         let mut cw = circle(20.0, 100);
         cw.reverse();
-        for ring in floor_rings(&cw, 2.55, 1.1) {
-            assert!(signed_area2(&ring) < 0.0);
+        for ring in floor_rings(&cw, 2.55, 1.1).iter().filter(|r| !r.open) {
+            assert!(signed_area2(&ring.pts) < 0.0);
         }
+    }
+
+    fn cup(r: f64, h: f64, floor: u32) -> crate::Sliced {
+        let cp: Vec<[f64; 2]> = circle(r, 400);
+        let d = crate::Design::from_json(
+            &serde_json::json!({
+                "sweepclay": 1,
+                "profile_start": { "control_points": [[0.0, 0.0], [0.0, h]] },
+                "profile_end": { "control_points": [[0.0, 0.0], [0.0, h]] },
+                "trajectory": { "points": cp, "closed": true },
+                "params": { "floor_layers": floor },
+            })
+            .to_string(),
+        )
+        .unwrap();
+        crate::slice(&d).unwrap()
+    }
+
+    #[test]
+    fn a_cylinder_is_a_helix_over_a_floor_of_rings() {
+        let s = cup(30.0, 40.0, 2);
+        let t = &s.toolpath;
+        let v = t.vessel.as_ref().unwrap();
+        // 40 mm: 2 floor layers of 1.25 mm, then 30 turns of 1.25 mm.
+        assert_eq!((v.floor_layers, v.turns), (2, 30));
+        // Rings 2.55 mm apart inside a base ring of radius 30.
+        assert_eq!(v.floor_rings, 11);
+        let wall: Vec<&PathPoint> = t
+            .points
+            .iter()
+            .filter(|p| p.kind == PointKind::Pass && p.pos[2] > 2.5 + 1e-9)
+            .collect();
+        let per_turn = s.corrected.surface.columns.len() as f64;
+        for w in wall.windows(2) {
+            let (a, b) = (w[0].pos, w[1].pos);
+            // On the cylinder (the polygon's points are within 0.01 mm)...
+            assert!((a[0].hypot(a[1]) - 30.0).abs() < 0.02, "{a:?}");
+            // ... rising one pitch a turn: 1.25 mm over the loop.
+            let rise = b[2] - a[2];
+            assert!((rise - 1.25 / per_turn).abs() < 1e-9, "{rise}");
+        }
+        let top = wall.last().unwrap().pos[2];
+        assert!((top - 40.0).abs() < 1e-9, "the spiral ends on the rim");
+        // The rim turn is level with the rim.
+        for p in t.points.iter().filter(|p| p.kind == PointKind::Top) {
+            assert!((p.pos[2] - 40.0).abs() < 1e-9);
+        }
+    }
+
+    #[test]
+    fn the_floor_covers_the_inside_of_the_loop() {
+        for r in [12.0, 30.0, 55.0] {
+            let s = cup(r, 20.0, 1);
+            let t = &s.toolpath;
+            // Each floor bead covers the pitch across and the spacing
+            // along; the base ring covers half a pitch inward.
+            let pitch = 3.0 * (1.0 - FLOOR_OVERLAP);
+            let floor: f64 = t
+                .points
+                .windows(2)
+                .filter(|w| w[1].kind == PointKind::Floor && w[0].kind == PointKind::Floor)
+                .map(|w| {
+                    let (a, b) = (w[0].pos, w[1].pos);
+                    (a[0] - b[0])
+                        .hypot(a[1] - b[1])
+                        .min(2.0 * s.corrected.surface.spacing)
+                })
+                .sum::<f64>()
+                * pitch;
+            let base = std::f64::consts::TAU * r * pitch / 2.0;
+            let inside = std::f64::consts::PI * r * r;
+            let covered = (floor + base) / inside;
+            assert!((covered - 1.0).abs() < 0.02, "r = {r}: {covered}");
+            // Every point inside lies under a bead: within half a bead
+            // width of a floor or base-ring point (points 1.1 mm apart).
+            let beads: Vec<[f64; 3]> = t
+                .points
+                .iter()
+                .filter(|p| p.pos[2] < 1.3)
+                .map(|p| p.pos)
+                .collect();
+            let (mut inside, mut under) = (0, 0);
+            for gx in -60..=60 {
+                for gy in -60..=60 {
+                    let q = [gx as f64, gy as f64];
+                    if q[0].hypot(q[1]) > r {
+                        continue;
+                    }
+                    inside += 1;
+                    let reach = 1.5f64.hypot(0.55);
+                    if beads.iter().any(|b| d2(*b, q) <= reach * reach) {
+                        under += 1;
+                    }
+                }
+            }
+            assert!(
+                under as f64 >= 0.98 * inside as f64,
+                "r = {r}: {under} of {inside}"
+            );
+        }
+    }
+
+    #[test]
+    fn a_bottomless_vessel_stands_on_one_ring() {
+        let s = cup(30.0, 20.0, 0);
+        let t = &s.toolpath;
+        assert!(t.points.iter().all(|p| p.kind != PointKind::Floor));
+        assert_eq!(t.vessel.as_ref().unwrap().floor_rings, 0);
+        assert_eq!(t.points[0].pos[2], 1.25);
     }
 
     #[test]

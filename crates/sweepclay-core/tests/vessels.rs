@@ -1,0 +1,150 @@
+//! Property tests of vessels (closed Ψ, docs/ALGORITHMS.md §8): random
+//! loops — ellipses, lobed loops, cornered polylines, loops off the centre,
+//! radial and normal offsets, 0–4 floor layers, one or two profiles —
+//! through the whole pipeline, with the independent checker as the oracle
+//! and the vessel's own invariants checked directly.
+
+use proptest::prelude::*;
+mod common;
+
+use sweepclay_core::toolpath::PointKind;
+use sweepclay_core::{slice, Design, Error};
+
+/// 300 cases by default, a fifth of them here (or `PROPTEST_CASES`).
+fn cases() -> u32 {
+    std::env::var("PROPTEST_CASES")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(300)
+        / 5
+}
+
+#[derive(Debug, Clone)]
+struct Loop {
+    shape: u8,
+    rx: f64,
+    ry: f64,
+    lobes: u32,
+    depth: f64,
+    centre: (f64, f64),
+    normal: bool,
+}
+
+fn a_loop() -> impl Strategy<Value = Loop> {
+    (
+        0u8..3,
+        (18.0..55.0f64, 18.0..55.0f64),
+        (3u32..8, 0.0..0.18f64),
+        (-20.0..20.0f64, -20.0..20.0f64),
+        any::<bool>(),
+    )
+        .prop_map(|(shape, (rx, ry), (lobes, depth), centre, normal)| Loop {
+            shape,
+            rx,
+            ry,
+            lobes,
+            depth,
+            centre,
+            normal,
+        })
+}
+
+/// The trajectory: an ellipse (B-spline), a lobed loop (polyline) or a
+/// cornered polygon (polyline), centred off o.
+fn trajectory(l: &Loop) -> serde_json::Value {
+    let (cx, cy) = l.centre;
+    let offset = if l.normal { "normal" } else { "radial" };
+    let at = |t: f64, r: f64| [cx + r * l.rx * t.cos(), cy + r * l.ry * t.sin()];
+    match l.shape {
+        0 => {
+            let cp: Vec<[f64; 2]> = (0..8)
+                .map(|i| at(std::f64::consts::TAU * i as f64 / 8.0, 1.0))
+                .collect();
+            serde_json::json!({ "control_points": cp, "closed": true, "offset": offset })
+        }
+        1 => {
+            let pts: Vec<[f64; 2]> = (0..240)
+                .map(|i| {
+                    let t = std::f64::consts::TAU * i as f64 / 240.0;
+                    at(t, 1.0 + l.depth * (l.lobes as f64 * t).cos())
+                })
+                .collect();
+            serde_json::json!({ "points": pts, "closed": true, "offset": offset })
+        }
+        _ => {
+            let pts: Vec<[f64; 2]> = (0..l.lobes)
+                .map(|i| at(std::f64::consts::TAU * i as f64 / l.lobes as f64, 1.0))
+                .collect();
+            serde_json::json!({ "points": pts, "closed": true, "offset": offset })
+        }
+    }
+}
+
+fn profile(h: f64, lean: f64) -> serde_json::Value {
+    serde_json::json!({ "control_points": [[0.0, 0.0], [lean, h / 2.0], [0.0, h]] })
+}
+
+proptest! {
+    #![proptest_config(ProptestConfig { cases: cases().max(4), failure_persistence: None, .. ProptestConfig::default() })]
+
+    #[test]
+    fn random_vessels_print_in_clay(
+        l in a_loop(),
+        (hs, ht) in (12.0..60.0f64, 0.0..12.0f64),
+        (ls, lt) in (-6.0..6.0f64, -6.0..6.0f64),
+        two in any::<bool>(),
+        floor in 0u32..5,
+    ) {
+        let end = if two { profile(hs + ht, lt) } else { profile(hs, ls) };
+        let v = serde_json::json!({
+            "sweepclay": 1, "name": "random vessel",
+            "profile_start": profile(hs, ls),
+            "profile_end": end,
+            "trajectory": trajectory(&l),
+            "params": { "floor_layers": floor },
+            "printer": { "name": "wide", "build_volume": [300.0, 300.0, 200.0], "origin": [150.0, 150.0] },
+        });
+        let d = Design::from_json(&v.to_string()).unwrap();
+        let s = match slice(&d) {
+            Ok(s) => s,
+            // Refusals that name their reason are correct: Ψ too tight, a
+            // radial loop round o's wrong side, a rim too steep or too
+            // uneven for a spiral.
+            Err(Error::SelfIntersection(_)) => return Ok(()),
+            Err(e @ Error::Invalid { .. }) => {
+                let m = e.to_string();
+                prop_assert!(
+                    m.contains("too steeply") || m.contains("varies") || m.contains("centre o")
+                        || m.contains("crosses itself") || m.contains("separate islands") || m.contains("sliver"),
+                    "{m}"
+                );
+                return Ok(());
+            }
+            Err(e) => return Err(TestCaseError::fail(format!("{e}"))),
+        };
+        let p = &s.corrected.surface.params;
+        let t = &s.toolpath;
+        let vs = t.vessel.as_ref().unwrap();
+        // The floor first, then only wall: no floor bead after the spiral
+        // begins.
+        let first_wall = t.points.iter().position(|q| q.pos[2] > (floor.max(1) as f64) * p.layer_height + 1e-9).unwrap();
+        prop_assert!(t.points[first_wall..].iter().all(|q| q.kind != PointKind::Floor));
+        prop_assert_eq!(vs.floor_rings == 0, floor == 0 || vs.floor_area_mm2 < 30.0);
+        // Spiral layers within the bounds, the first turn and the rim turn
+        // excepted (they rise from the floor and taper to the rim).
+        let lo = s.stats.layers.lower_mm;
+        prop_assert!(lo[0] >= p.layer_height - 1e-9 && lo[1] <= p.max_layer_height + 1e-9, "{:?}", lo);
+        // z never falls by more than a graze from one point to the next
+        // of the spiral, and the top is within one layer of the rim.
+        let top = t.points.iter().map(|q| q.pos[2]).fold(0.0, f64::max);
+        let rim = s.corrected.surface.columns.iter().map(|c| c.height).fold(0.0, f64::max);
+        prop_assert!((rim - top).abs() <= p.max_layer_height + 1e-9);
+        // The independent checker's full search agrees (its fast path,
+        // which `slice` runs, can refuse a good vessel: docs/CHECKER.md,
+        // "Known gaps").
+        let r = common::check_full(&s);
+        prop_assert!(r.printable, "{}\ndesign:\n{}", r.render(), d.to_json());
+        prop_assert_eq!(r.extrusion_runs, 1);
+        prop_assert_eq!(r.findings[sweepclay_check::Finding::UnderMinOverlap].count, 0);
+    }
+}
