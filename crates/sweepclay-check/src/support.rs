@@ -384,14 +384,28 @@ pub(crate) fn follow_support(
         return None;
     }
     let (xs, ys) = tops.range([mid[0] - r, mid[1] - r], [mid[0] + r, mid[1] + r]);
-    // Most beads: no clay that high in the blocks around.
+    // Most beads: no clay that high in the blocks around, and the answer
+    // right under the middle, so no other bead can be nearer. (Beside a
+    // bead of the same height, as the rings of a floor lie, the answer
+    // may not be the nearest: the cells say.)
     let block = f64::from(tops.block_max((xs, ys)));
-    if block < best.z + cfg.min_layer_mm && block <= mid[2] - cfg.min_layer_mm {
+    // Another pass of the answer's layer lies at least half a bead beside
+    // it; nearer than that to the middle, it would be the support.
+    let beside = best.d - 0.5 * cfg.width_min;
+    if beside <= 0.0 && block < best.z + cfg.min_layer_mm && block <= mid[2] - cfg.min_layer_mm {
         return Some(best);
     }
     for y in ys[0]..ys[1] + 1 {
         for x in xs[0]..xs[1] + 1 {
             let top = f64::from(tops.top[y * tops.n[0] + x]);
+            if beside > 0.0
+                && top >= best.z - cfg.min_layer_mm
+                && rect_distance(tops.rect(x, y), [mid[0], mid[1]]) < beside
+            {
+                // Clay of about the answer's layer, nearer to the middle:
+                // the nearest bead below may be there.
+                return None;
+            }
             // Most cells: clay lower than both tests' thresholds (or none).
             if top < best.z + cfg.min_layer_mm && top <= mid[2] - cfg.min_layer_mm {
                 continue;

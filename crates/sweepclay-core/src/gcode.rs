@@ -241,7 +241,11 @@ pub fn emit_typed_moves<W: Write>(
     f: &MoveFormat,
     types: &[(usize, &str)],
 ) -> io::Result<Vec<usize>> {
-    let mut types = types.iter().peekable();
+    // Index of the next `;TYPE:` change (usize::MAX: none): one compare a
+    // move.
+    let mut types = types.iter();
+    let mut next_type = types.next();
+    let mut next_at = next_type.map_or(usize::MAX, |t| t.0);
     const CHUNK: usize = 1 << 16;
     let o = f.origin;
     let mut buf: Vec<u8> = Vec::with_capacity(CHUNK + 256);
@@ -285,11 +289,15 @@ pub fn emit_typed_moves<W: Write>(
                 *last = q;
             }
         }
-        if let Some(&(_, name)) = types.next_if(|t| t.0 <= i) {
-            buf.extend_from_slice(b";TYPE:");
-            buf.extend_from_slice(name.as_bytes());
-            buf.push(b'\n');
-            line += 1;
+        if i >= next_at {
+            if let Some(&(_, name)) = next_type {
+                buf.extend_from_slice(b";TYPE:");
+                buf.extend_from_slice(name.as_bytes());
+                buf.push(b'\n');
+                line += 1;
+            }
+            next_type = types.next();
+            next_at = next_type.map_or(usize::MAX, |t| t.0);
         }
         let de = ex.volume[i] * f.e_per_mm3;
         let e = if f.relative_e {

@@ -275,6 +275,66 @@ pub fn sample_surface(design: &Design) -> Result<Surface> {
     Ok(surface)
 }
 
+/// The column a vessel's path starts each layer and turn at: the one
+/// nearest the floor's innermost ring, so each ring is entered a short
+/// step from the one before (docs/ALGORITHMS.md §8). Refuses a floor that
+/// splits into islands, or whose innermost line is out of a short step's
+/// reach.
+fn floor_start(
+    columns: &[Column],
+    params: &Params,
+    spacing: f64,
+    start: &Profile,
+    end: &Profile,
+    first_layer: f64,
+) -> Result<usize> {
+    use crate::vessel::{floor_entries, floor_rings, floor_split, FLOOR_OVERLAP};
+    // The base ring as its first layer lies (it stands straight through
+    // the floor).
+    let ring: Vec<[f64; 2]> = columns
+        .iter()
+        .map(|c| {
+            let t = (first_layer / c.height).min(1.0);
+            let xi = (1.0 - c.lambda) * start.offset(t) + c.lambda * end.offset(t);
+            let q = c.point(xi, 0.0);
+            [q[0], q[1]]
+        })
+        .collect();
+    let pitch = params.width_min * (1.0 - FLOOR_OVERLAP);
+    if let Some((depth, k)) = floor_split(&ring, pitch) {
+        return Err(Error::invalid(
+            "trajectory",
+            format!(
+                "the floor's rings would split into {k} separate islands {depth:.1} mm inside the wall (a waist about {:.0} mm wide or narrower): one continuous path cannot go from one to the next without crossing clay; widen the waist, or print the vessel bottomless (params.floor_layers = 0)",
+                2.0 * depth
+            ),
+        ));
+    }
+    let rings = floor_rings(&ring, pitch, spacing);
+    let Some(inner) = rings.last() else {
+        return Ok(0);
+    };
+    let m = inner.pts.len() as f64;
+    let c = inner
+        .pts
+        .iter()
+        .fold([0.0, 0.0], |a, p| [a[0] + p[0] / m, a[1] + p[1] / m]);
+    let d2 = |p: [f64; 2]| (p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2);
+    let first = (0..ring.len())
+        .min_by(|&a, &b| d2(ring[a]).total_cmp(&d2(ring[b])))
+        .unwrap_or(0);
+    let (_, step) = floor_entries(&rings, [ring[first][0], ring[first][1], 0.0]);
+    if step > 2.0 * pitch {
+        return Err(Error::invalid(
+            "trajectory",
+            format!(
+                "the floor's innermost ring is a sliver the path would reach only by a step of {step:.1} mm across clay of the same layer; widen the narrow part of the shape, or print the vessel bottomless (params.floor_layers = 0)"
+            ),
+        ));
+    }
+    Ok(first)
+}
+
 /// The samples of a vessel (docs/ALGORITHMS.md §8): each column's base
 /// layers, its spiral turns and, but for the last column, whose last turn
 /// already ends on the rim, the rim bead.
@@ -292,11 +352,14 @@ fn sample_vessel(
     let floor = params
         .floor_layers
         .unwrap_or(crate::design::DEFAULT_FLOOR_LAYERS);
-    let v = VesselPlan::choose(&heights, &params, floor)?;
+    let mut v = VesselPlan::choose(&heights, &params, floor)?;
+    let spacing = length / n as f64;
+    if v.floor_layers > 0 {
+        v.start = floor_start(&columns, &params, spacing, &start, &end, v.base_layer_mm)?;
+    }
     // The extruder body's reach, and the clay just laid along the loop
     // that it may touch, as the checker counts them; columns where the
     // rim is, where collisions happen (docs/ALGORITHMS.md §8).
-    let spacing = length / n as f64;
     let reach = printer.nozzle_radius + params.width_max / 2.0;
     let exempt = ((printer.nozzle_radius + params.width_max) / spacing) as usize;
     let offset = |c: &Column| {
@@ -320,6 +383,7 @@ fn sample_vessel(
             ),
         ));
     }
+    let rim = v.rim_beads(&points, &heights, reach, exempt);
     let layers = v.base_layers + v.turns;
     let plan = LayerPlan {
         passes: layers + 1,
@@ -347,7 +411,7 @@ fn sample_vessel(
     for (i, col) in columns.iter_mut().enumerate() {
         col.first = surface.samples.len() as u32;
         col.passes = layers;
-        col.top = v.has_rim(i, n, col.height);
+        col.top = rim[i];
         // The base ring stands straight through the floor's layers (as
         // its first layer lies), so the floor's rings fit inside it on
         // every layer; the wall's lean starts above the floor.
@@ -361,36 +425,6 @@ fn sample_vessel(
         for z in spiral.chain(rim) {
             let xi = surface.design_offset(col, z, 1.0);
             surface.samples.push(Sample { z, xi });
-        }
-    }
-    if v.floor_layers > 0 {
-        let ring: Vec<[f64; 2]> = columns
-            .iter()
-            .map(|c| {
-                let q = c.point(surface.samples[c.first as usize].xi, 0.0);
-                [q[0], q[1]]
-            })
-            .collect();
-        let pitch = surface.params.width_min * (1.0 - crate::vessel::FLOOR_OVERLAP);
-        let rings = crate::vessel::floor_rings(&ring, pitch, surface.spacing);
-        let start = [ring[0][0], ring[0][1], 0.0];
-        let (_, step) = crate::vessel::floor_entries(&rings, start);
-        if step > 2.0 * pitch {
-            return Err(Error::invalid(
-                "trajectory",
-                format!(
-                    "the floor's innermost ring is a sliver the path would reach only by a step of {step:.1} mm across clay of the same layer; widen the narrow part of the shape, or print the vessel bottomless (params.floor_layers = 0)"
-                ),
-            ));
-        }
-        if let Some((depth, k)) = crate::vessel::floor_split(&ring, pitch) {
-            return Err(Error::invalid(
-                "trajectory",
-                format!(
-                    "the floor's rings would split into {k} separate islands {depth:.1} mm inside the wall (a waist about {:.0} mm wide or narrower): one continuous path cannot go from one to the next without crossing clay; widen the waist, or print the vessel bottomless (params.floor_layers = 0)",
-                    2.0 * depth
-                ),
-            ));
         }
     }
     surface.columns = columns;

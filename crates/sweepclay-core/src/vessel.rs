@@ -48,6 +48,10 @@ pub struct VesselPlan {
     pub turns: u32,
     /// Thinnest and thickest spiral layer δ_i round the loop (mm).
     pub turn_mm: [f64; 2],
+    /// The column each layer and turn begins at (the path's start in
+    /// plan, chosen near the floor's centre so the rings join by short
+    /// steps; docs/ALGORITHMS.md §8).
+    pub start: usize,
 }
 
 impl VesselPlan {
@@ -105,6 +109,7 @@ impl VesselPlan {
             base_layer_mm: dmin,
             turns,
             turn_mm: [(lo - base) / k, (hi - base) / k],
+            start: 0,
         })
     }
 
@@ -113,7 +118,12 @@ impl VesselPlan {
     pub fn spiral_z(&self, k: u32, i: usize, n: usize, h: f64) -> f64 {
         let base = self.base_mm();
         let d = (h - base) / f64::from(self.turns);
-        base + (f64::from(k - 1) + (i + 1) as f64 / n as f64) * d
+        base + (f64::from(k - 1) + (self.order(i, n) + 1) as f64 / n as f64) * d
+    }
+
+    /// Where column `i` of `n` comes in a turn (0 for [`VesselPlan::start`]).
+    pub fn order(&self, i: usize, n: usize) -> usize {
+        (i + n - self.start % n) % n
     }
 
     /// Whether column `i` of `n` gets a rim bead: where the last turn ends
@@ -122,6 +132,59 @@ impl VesselPlan {
     /// half a layer).
     pub fn has_rim(&self, i: usize, n: usize, h: f64) -> bool {
         h - self.spiral_z(self.turns, i, n, h) >= 0.5 * self.base_layer_mm - 1e-9
+    }
+
+    /// Which columns get a rim bead: the run from the turn's start while
+    /// [`VesselPlan::has_rim`] holds and the nozzle, level at the rim,
+    /// clears the last turn's clay within `reach` in plan and the rim
+    /// beads laid more than `exempt` columns before (a rim that rises
+    /// steeply ahead ends the run early: the rim is then level to within
+    /// a layer there). `points` and `h` as for
+    /// [`VesselPlan::body_violation`].
+    pub fn rim_beads(
+        &self,
+        points: &[[f64; 2]],
+        h: &[f64],
+        reach: f64,
+        exempt: usize,
+    ) -> Vec<bool> {
+        let n = points.len();
+        let mut grid = crate::grid::Grid2::new(reach.max(1e-3));
+        for (i, p) in points.iter().enumerate() {
+            grid.insert_segment(*p, *p, i as u32);
+        }
+        let mut rim: Vec<bool> = (0..n).map(|i| self.has_rim(i, n, h[i])).collect();
+        // The rim turn is one run from the turn's start: once a bead is
+        // left out, so are the rest (a gap would be a jump across).
+        let mut ended = false;
+        for m in 0..n {
+            let i = (self.start + m) % n;
+            if ended || !rim[i] {
+                rim[i] = false;
+                ended = true;
+                continue;
+            }
+            let p = points[i];
+            let mut clear = true;
+            grid.for_each_near_segment(p, p, reach, |j| {
+                let j = j as usize;
+                let q = points[j];
+                if (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) > reach * reach {
+                    return;
+                }
+                let mut top = self.spiral_z(self.turns, j, n, h[j]);
+                let (oi, oj) = (self.order(i, n), self.order(j, n));
+                if oj < oi && oi - oj > exempt && rim[j] {
+                    top = top.max(h[j]);
+                }
+                if top - h[i] > BODY_GRAZE_MM {
+                    clear = false;
+                }
+            });
+            rim[i] = clear;
+            ended = !clear;
+        }
+        rim
     }
 
     /// The first column where the extruder body would meet clay already
@@ -160,8 +223,8 @@ impl VesselPlan {
                         self.base_mm()
                     };
                     // This turn's clay at j, laid long enough ago to count.
-                    let back = (i + n - j) % n;
-                    let same = if j < i && back > exempt {
+                    let (oi, oj) = (self.order(i, n), self.order(j, n));
+                    let same = if oj < oi && oi - oj > exempt {
                         self.spiral_z(k, j, n, h[j])
                     } else {
                         f64::MIN
@@ -422,7 +485,8 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
     };
     // Where each ring is entered: nearest the previous ring's entry,
     // the first nearest column 0 (where the base ring starts).
-    let entry = floor_entries(&rings, s.position(0, s.columns[0].first as usize)).0;
+    let c0 = &s.columns[v.start];
+    let entry = floor_entries(&rings, s.position(v.start, c0.first as usize)).0;
     let floor_points: usize = rings.iter().map(|r| r.pts.len()).sum();
     let total = s.samples.len() + floor_points * v.floor_layers as usize;
     let mut points = Vec::with_capacity(total);
@@ -483,24 +547,24 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
                     floor(&mut points, &mut below, r);
                 }
             }
-            for i in 0..n {
+            for m in 0..n {
                 visit_column(
                     &mut points,
                     &mut below,
                     &mut path_of,
-                    i,
+                    (v.start + m) % n,
                     local,
                     layer,
                     PointKind::Pass,
                 );
             }
         } else {
-            for i in 0..n {
+            for m in 0..n {
                 visit_column(
                     &mut points,
                     &mut below,
                     &mut path_of,
-                    i,
+                    (v.start + m) % n,
                     local,
                     layer,
                     PointKind::Pass,
@@ -514,13 +578,13 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
         }
     }
     for k in 1..=v.turns {
-        for i in 0..n {
+        for m in 0..n {
             let local = (base + k) as usize - 1;
             visit_column(
                 &mut points,
                 &mut below,
                 &mut path_of,
-                i,
+                (v.start + m) % n,
                 local,
                 base + k,
                 PointKind::Pass,
@@ -528,7 +592,7 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
         }
     }
     let rim = base + v.turns + 1;
-    for i in 0..n {
+    for i in (0..n).map(|m| (v.start + m) % n) {
         if s.columns[i].top {
             let local = s.columns[i].passes as usize;
             visit_column(
