@@ -1,8 +1,10 @@
-//! Trajectories from other tools: the first open curve of an SVG file, or a
-//! CSV of points, as the polyline `trajectory.points` of a design
-//! (docs/FORMATS.md). Pure: text in, points out.
+//! Trajectories from other tools: the first curve of an SVG file, or a CSV
+//! of points, as the polyline `trajectory.points` of a design, open or
+//! closed (a vessel; docs/FORMATS.md). Pure: text in, points out.
 //!
-//! SVG: the first `path`, `polyline`, `polygon` or `line` outside `<defs>`,
+//! SVG: the first `path`, `polyline`, `polygon`, `line`, `circle`,
+//! `ellipse` or `rect` outside `<defs>` (the last four and a path that
+//! closes are loops),
 //! with the `transform`s of the element and its ancestors applied. Curves
 //! (cubic, quadratic, arcs, smooth variants) are flattened to segments of at
 //! most [`FLATTEN_MM`]. Units: user units are CSS pixels (25.4/96 mm)
@@ -24,9 +26,25 @@ pub const MAX_POINTS: usize = 2000;
 
 const PX_MM: f64 = 25.4 / 96.0;
 
-/// The first open curve of an SVG document as trajectory points (mm,
-/// centred on `o`, y up).
+/// An imported trajectory: its points and whether it is a loop (a vessel:
+/// `trajectory.closed`; the first point is then not repeated at the end).
+#[derive(Clone, Debug, PartialEq)]
+pub struct ImportedPath {
+    /// The points (mm).
+    pub points: Vec<[f64; 2]>,
+    /// A closed shape: `<circle>`, `<ellipse>`, `<rect>`, `<polygon>`, a
+    /// `<path>` that closes, or a CSV whose last point meets its first.
+    pub closed: bool,
+}
+
+/// The first curve of an SVG document as trajectory points (mm, centred on
+/// `o`, y up), open or closed.
 pub fn svg_trajectory(text: &str) -> Result<Vec<[f64; 2]>> {
+    svg_path(text).map(|p| p.points)
+}
+
+/// [`svg_trajectory`] with whether the shape is closed.
+pub fn svg_path(text: &str) -> Result<ImportedPath> {
     let doc = roxmltree::Document::parse(text)
         .map_err(|e| Error::invalid("svg", format!("not an SVG document: {e}")))?;
     let root = doc.root_element();
@@ -47,13 +65,13 @@ pub fn svg_trajectory(text: &str) -> Result<Vec<[f64; 2]>> {
         .find(|n| {
             matches!(
                 n.tag_name().name(),
-                "path" | "polyline" | "polygon" | "line"
+                "path" | "polyline" | "polygon" | "line" | "circle" | "ellipse" | "rect"
             )
         })
         .ok_or_else(|| {
             Error::invalid(
                 "svg",
-                "no <path>, <polyline>, <polygon> or <line> element to import",
+                "no <path>, <polyline>, <polygon>, <line>, <circle>, <ellipse> or <rect> element to import",
             )
         })?;
     let tag = node.tag_name().name();
@@ -86,17 +104,61 @@ pub fn svg_trajectory(text: &str) -> Result<Vec<[f64; 2]>> {
             )
         })
     };
-    let local: Vec<[f64; 2]> = match tag {
-        "path" => flatten_path(attr("d")?, step)?,
-        "line" => vec![[num("x1")?, num("y1")?], [num("x2")?, num("y2")?]],
+    let opt = |name: &str| -> Result<f64> {
+        if node.attribute(name).is_some() {
+            num(name)
+        } else {
+            Ok(0.0)
+        }
+    };
+    let ellipse = |cx: f64, cy: f64, rx: f64, ry: f64| -> Result<Vec<[f64; 2]>> {
+        if !(rx > 0.0 && ry > 0.0 && rx.is_finite() && ry.is_finite()) {
+            return Err(Error::invalid(
+                format!("svg <{tag}>"),
+                "its radius must be a positive number",
+            ));
+        }
+        let around = std::f64::consts::TAU * rx.max(ry);
+        let n = ((around / step).ceil() as usize).clamp(16, 4 * MAX_POINTS);
+        Ok((0..n)
+            .map(|i| {
+                let a = std::f64::consts::TAU * i as f64 / n as f64;
+                [cx + rx * a.cos(), cy + ry * a.sin()]
+            })
+            .collect())
+    };
+    let (local, closed): (Vec<[f64; 2]>, bool) = match tag {
+        "path" => {
+            let (pts, closed) = flatten_path(attr("d")?, step)?;
+            (pts, closed)
+        }
+        "line" => (
+            vec![[num("x1")?, num("y1")?], [num("x2")?, num("y2")?]],
+            false,
+        ),
+        "circle" => {
+            let r = num("r")?;
+            (ellipse(opt("cx")?, opt("cy")?, r, r)?, true)
+        }
+        "ellipse" => (
+            ellipse(opt("cx")?, opt("cy")?, num("rx")?, num("ry")?)?,
+            true,
+        ),
+        "rect" => {
+            let (x, y, w, h) = (opt("x")?, opt("y")?, num("width")?, num("height")?);
+            if !(w > 0.0 && h > 0.0) {
+                return Err(Error::invalid(
+                    "svg <rect>",
+                    "its width and height must be positive",
+                ));
+            }
+            (vec![[x, y], [x + w, y], [x + w, y + h], [x, y + h]], true)
+        }
         _ => {
-            let mut pts: Vec<[f64; 2]> = PointsParser::from(attr("points")?)
+            let pts: Vec<[f64; 2]> = PointsParser::from(attr("points")?)
                 .map(|(x, y)| [x, y])
                 .collect();
-            if tag == "polygon" && !pts.is_empty() {
-                pts.push(pts[0]);
-            }
-            pts
+            (pts, tag == "polygon")
         }
     };
     let pts: Vec<[f64; 2]> = local
@@ -106,13 +168,18 @@ pub fn svg_trajectory(text: &str) -> Result<Vec<[f64; 2]>> {
             [x * mm_per_unit, -y * mm_per_unit]
         })
         .collect();
-    let mut pts = finish(pts, &format!("svg <{tag}>"))?;
-    centre(&mut pts);
+    let mut pts = finish_path(pts, closed, &format!("svg <{tag}>"))?;
+    centre(&mut pts.points);
     Ok(pts)
 }
 
 /// Points of a CSV file as a trajectory (mm, as given: not centred).
 pub fn csv_trajectory(text: &str) -> Result<Vec<[f64; 2]>> {
+    csv_path(text).map(|p| p.points)
+}
+
+/// [`csv_trajectory`], closed when its last point meets its first.
+pub fn csv_path(text: &str) -> Result<ImportedPath> {
     let mut pts = Vec::new();
     for (i, line) in text.lines().enumerate() {
         let line = line.split('#').next().unwrap_or("").trim();
@@ -143,7 +210,38 @@ pub fn csv_trajectory(text: &str) -> Result<Vec<[f64; 2]>> {
         }
         pts.push(xy);
     }
-    finish(pts, "csv")
+    let closed = pts.len() > 3
+        && pts
+            .first()
+            .zip(pts.last())
+            .is_some_and(|(a, b)| (a[0] - b[0]).hypot(a[1] - b[1]) <= 1e-6);
+    finish_path(pts, closed, "csv")
+}
+
+/// [`finish`] for a path that may be closed: a loop drops a repeated first
+/// point, is resampled round its closing side too, and needs three points.
+fn finish_path(mut pts: Vec<[f64; 2]>, closed: bool, key: &str) -> Result<ImportedPath> {
+    if !closed {
+        return Ok(ImportedPath {
+            points: finish(pts, key)?,
+            closed,
+        });
+    }
+    if let Some(&first) = pts.first() {
+        pts.push(first);
+    }
+    let mut points = finish(pts, key)?;
+    // The loop's repeated first point.
+    if points.len() > 1 {
+        points.pop();
+    }
+    if points.len() < 3 {
+        return Err(Error::invalid(
+            key,
+            "a closed shape needs at least three distinct points",
+        ));
+    }
+    Ok(ImportedPath { points, closed })
 }
 
 fn finish(pts: Vec<[f64; 2]>, key: &str) -> Result<Vec<[f64; 2]>> {
@@ -263,7 +361,10 @@ fn unit_scale(root: &roxmltree::Node) -> Result<f64> {
     })
 }
 
-fn flatten_path(d: &str, step: f64) -> Result<Vec<[f64; 2]>> {
+/// The first sub-path of `d` flattened, and whether it closes (a `Z`, or
+/// an end on its start).
+fn flatten_path(d: &str, step: f64) -> Result<(Vec<[f64; 2]>, bool)> {
+    let mut closed = false;
     let mut pts: Vec<[f64; 2]> = Vec::new();
     let mut start = [0.0, 0.0];
     let mut cur = [0.0, 0.0];
@@ -287,6 +388,8 @@ fn flatten_path(d: &str, step: f64) -> Result<Vec<[f64; 2]>> {
             SimplePathSegment::ClosePath => {
                 cur = start;
                 pts.push(cur);
+                closed = true;
+                break;
             }
             SimplePathSegment::CurveTo {
                 x1,
@@ -328,7 +431,15 @@ fn flatten_path(d: &str, step: f64) -> Result<Vec<[f64; 2]>> {
     if pts.is_empty() {
         return Err(Error::invalid("svg <path> d", "is empty"));
     }
-    Ok(pts)
+    // A path drawn back onto its start without a `Z` is closed too.
+    let ends_on_start = pts.len() > 3 && {
+        let (a, b) = (pts[0], pts[pts.len() - 1]);
+        (a[0] - b[0]).hypot(a[1] - b[1]) <= 1e-6 * (1.0 + a[0].abs() + a[1].abs())
+    };
+    if closed || ends_on_start {
+        pts.pop();
+    }
+    Ok((pts, closed || ends_on_start))
 }
 
 /// Segments for a Bézier curve so each is at most `step` long (the control
@@ -406,8 +517,16 @@ mod tests {
             ("not xml", "not an SVG document"),
             ("<html/>", "not <svg>"),
             (
-                r#"<svg xmlns="http://www.w3.org/2000/svg"><rect/></svg>"#,
+                r#"<svg xmlns="http://www.w3.org/2000/svg"><g/></svg>"#,
                 "no <path>",
+            ),
+            (
+                r#"<svg xmlns="http://www.w3.org/2000/svg"><rect/></svg>"#,
+                "has no `width`",
+            ),
+            (
+                r#"<svg xmlns="http://www.w3.org/2000/svg"><circle r="-3"/></svg>"#,
+                "positive",
             ),
             (
                 r#"<svg xmlns="http://www.w3.org/2000/svg"><path/></svg>"#,
@@ -425,6 +544,49 @@ mod tests {
             let e = svg_trajectory(svg).unwrap_err().to_string();
             assert!(e.contains(want), "{svg}: {e}");
         }
+    }
+
+    #[test]
+    fn closed_shapes_import_as_loops() {
+        let mm = |body: &str| {
+            format!(
+                r#"<svg xmlns="http://www.w3.org/2000/svg" width="200mm" height="200mm" viewBox="0 0 200 200">{body}</svg>"#
+            )
+        };
+        // A circle of radius 30 mm: a loop round o, 2π·30 long.
+        let c = svg_path(&mm(r#"<circle cx="100" cy="80" r="30"/>"#)).unwrap();
+        assert!(c.closed);
+        for p in &c.points {
+            assert!((p[0].hypot(p[1]) - 30.0).abs() < 1e-3, "{p:?}");
+        }
+        let e = svg_path(&mm(r#"<ellipse cx="50" cy="50" rx="40" ry="20"/>"#)).unwrap();
+        assert!(e.closed);
+        let xs = e.points.iter().map(|p| p[0].abs()).fold(0.0, f64::max);
+        assert!((xs - 40.0).abs() < 1e-3);
+        let r = svg_path(&mm(r#"<rect x="10" y="10" width="60" height="40"/>"#)).unwrap();
+        assert!(r.closed);
+        assert_eq!(r.points.len(), 4);
+        assert!(r.points.contains(&[-30.0, 20.0]) && r.points.contains(&[30.0, -20.0]));
+        // Closed paths (with Z, or ending on their start) and polygons.
+        for body in [
+            r#"<path d="M 0 0 L 50 0 L 50 50 Z"/>"#,
+            r#"<path d="M 0 0 L 50 0 L 50 50 L 0 0"/>"#,
+            r#"<polygon points="0,0 50,0 50,50"/>"#,
+        ] {
+            let p = svg_path(&mm(body)).unwrap();
+            assert!(p.closed, "{body}");
+            assert_eq!(p.points.len(), 3, "{body}: {:?}", p.points);
+        }
+        assert!(
+            !svg_path(&mm(r#"<path d="M 0 0 L 50 0 L 50 50"/>"#))
+                .unwrap()
+                .closed
+        );
+        // A CSV whose last point meets its first.
+        let c = csv_path("0,0\n40,0\n40,40\n0,40\n0,0\n").unwrap();
+        assert!(c.closed);
+        assert_eq!(c.points.len(), 4);
+        assert!(!csv_path("0,0\n40,0\n40,40\n").unwrap().closed);
     }
 
     #[test]

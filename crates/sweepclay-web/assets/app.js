@@ -5,7 +5,7 @@
 
 import { CurveEditor, fmt } from './editor.js';
 import { View3D } from './view3d.js';
-import { sample } from './bspline.js';
+import { sample, samplePeriodic } from './bspline.js';
 
 const $ = (id) => document.getElementById(id);
 const STORE = 'sweepclay.design.v1';
@@ -20,6 +20,7 @@ const PARAMS = [
   ['overlap', 'overlap target', '', 0.01],
   ['max_overhang_deg', 'overhang threshold', '°', 1],
   ['feedrate', 'feedrate', 'mm/min', 50],
+  ['floor_layers', 'floor layers (vessel)', '', 1],
 ];
 
 const state = {
@@ -57,7 +58,9 @@ function trajectoryPoints(d) {
 }
 
 function interpolationPoints(d) {
-  return d.interpolation ? d.interpolation.control_points : [[0, 0], [1, 1]];
+  if (d.interpolation) return d.interpolation.control_points;
+  // A vessel's default, (1 − cos 2πu)/2, is drawn as a curve (below).
+  return d.trajectory.closed ? [[0, 0], [1, 0]] : [[0, 0], [1, 1]];
 }
 
 /** Replaces the design; `record` adds an undo step. */
@@ -81,6 +84,7 @@ function setDesign(d, { record = true, fit = false } = {}) {
   }
   fillParams();
   $('offset').value = d.trajectory.offset === 'normal' ? 'normal' : 'radial';
+  $('closed').checked = !!d.trajectory.closed;
   updateUndo();
   requestSlice(fit);
 }
@@ -145,7 +149,13 @@ const editors = [
       if (d.trajectory.points) d.trajectory.points = pts;
       else d.trajectory.control_points = pts;
     }, final),
-    curve: (pts) => (state.design?.trajectory.points ? pts : curve(pts)),
+    curve: (pts) => {
+      const t = state.design?.trajectory;
+      // A closed trajectory wraps round: the polygon closes, the
+      // B-spline is periodic (docs/FORMATS.md).
+      if (t?.closed) return t.points ? pts.concat(pts.slice(0, 1)) : samplePeriodic(pts);
+      return t?.points ? pts : curve(pts);
+    },
     centre: true,
     snap: 1,
     grid: 10,
@@ -155,19 +165,28 @@ const editors = [
   new CurveEditor($('ed-interp'), {
     get: () => (state.design ? interpolationPoints(state.design) : [[0, 0], [1, 1]]),
     set: (pts, final) => edit((d) => { d.interpolation = { control_points: pts }; }, final),
-    curve,
+    curve: (pts) => {
+      const d = state.design;
+      if (d?.trajectory.closed && !d.interpolation) {
+        return Array.from({ length: 101 }, (_, i) => [i / 100, (1 - Math.cos(2 * Math.PI * i / 100)) / 2]);
+      }
+      return curve(pts);
+    },
     fixed: [-0.04, -0.04, 1.04, 1.04],
     snap: 0.02,
     grid: 0.1,
     minPoints: 2,
     pinned: (i, pts) => i === 0 || i === pts.length - 1,
     constrain: (i, [u, f], pts) => {
-      // Endpoints pinned; u strictly and f weakly increasing: monotone.
+      // Endpoints pinned; u strictly and f weakly increasing: monotone. Round
+      // a vessel f comes back to 0 and may rise and fall between.
+      const closed = state.design?.trajectory.closed;
       if (i === 0) return [0, 0];
-      if (i === pts.length - 1) return [1, 1];
+      if (i === pts.length - 1) return [1, closed ? 0 : 1];
       const [pu, pf] = pts[i - 1];
       const [nu, nf] = pts[i + 1];
       if (nu - pu < 0.02) return null;
+      if (closed) return [Math.min(nu - 0.01, Math.max(pu + 0.01, u)), Math.min(1, Math.max(0, f))];
       return [Math.min(nu - 0.01, Math.max(pu + 0.01, u)), Math.min(nf, Math.max(pf, f))];
     },
     label: ([u, f]) => `u ${fmt(u)}, λ ${fmt(f)}`,
@@ -177,6 +196,19 @@ const editors = [
 state.editors = editors;
 
 $('snap').addEventListener('change', (e) => editors.forEach((ed) => { ed.snapOn = e.target.checked; }));
+$('closed').addEventListener('change', (e) => edit((d) => {
+  // A loop (a vessel) or an open wall; the interpolation and the floor
+  // follow (docs/FORMATS.md).
+  const ip = d.interpolation?.control_points;
+  if (e.target.checked) {
+    d.trajectory.closed = true;
+    if (ip && ip[ip.length - 1][1] !== 0) delete d.interpolation;
+  } else {
+    delete d.trajectory.closed;
+    if (ip && ip[ip.length - 1][1] !== 1) delete d.interpolation;
+    if (d.params) delete d.params.floor_layers;
+  }
+}, true));
 $('offset').addEventListener('change', (e) => edit((d) => {
   if (e.target.value === 'normal') d.trajectory.offset = 'normal';
   else delete d.trajectory.offset;
@@ -414,10 +446,13 @@ function buildParams() {
 function fillParams() {
   const d = state.design;
   const p = { ...state.meta.params, ...(d.params || {}) };
+  if (p.floor_layers === undefined || p.floor_layers === null) p.floor_layers = 2;
   for (const [key] of PARAMS) {
     const inp = $(`p-${key}`);
     if (document.activeElement !== inp) inp.value = Number(Number(p[key]).toFixed(4));
   }
+  // Only a vessel has a floor.
+  $('p-floor_layers').disabled = !d.trajectory.closed;
   const printer = typeof d.printer === 'string' ? d.printer : d.printer ? '' : 'generic';
   $('p-printer').value = printer;
   if (document.activeElement !== $('name')) $('name').value = d.name || '';
@@ -507,6 +542,15 @@ $('import-file').addEventListener('change', async () => {
   edit((d) => {
     d.trajectory = { points: body.points };
     if (body.offset === 'normal') d.trajectory.offset = 'normal';
+    if (body.closed) {
+      d.trajectory.closed = true;
+      const ip = d.interpolation?.control_points;
+      if (ip && ip[ip.length - 1][1] !== 0) delete d.interpolation;
+    } else {
+      const ip = d.interpolation?.control_points;
+      if (ip && ip[ip.length - 1][1] !== 1) delete d.interpolation;
+      if (d.params) delete d.params.floor_layers;
+    }
   }, true);
   if (body.note) showNote(`${name}: ${body.note}`);
   editors[2].fitted = false;

@@ -39,3 +39,25 @@ export function sample(ctrl, count = 200) {
   for (let i = 0; i <= count; i++) out.push(evalAt(ctrl, i / count, kv));
   return out;
 }
+
+/**
+ * `per` points a span along the periodic uniform cubic B-spline whose
+ * control polygon wraps round (a closed trajectory: the same curve as
+ * sweepclay-core's curves.rs `periodic_bspline`), closed by its first point.
+ */
+export function samplePeriodic(ctrl, per = 24) {
+  const m = ctrl.length;
+  if (m < 3) return ctrl.concat(ctrl.slice(0, 1));
+  const out = [];
+  for (let j = 0; j < m; j++) {
+    const [p0, p1, p2, p3] = [0, 1, 2, 3].map((k) => ctrl[(j + k) % m]);
+    for (let s = 0; s < per; s++) {
+      const t = s / per;
+      const b = [(1 - t) ** 3 / 6, (3 * t ** 3 - 6 * t * t + 4) / 6,
+        (-3 * t ** 3 + 3 * t * t + 3 * t + 1) / 6, t ** 3 / 6];
+      out.push([0, 1].map((a) => b[0] * p0[a] + b[1] * p1[a] + b[2] * p2[a] + b[3] * p3[a]));
+    }
+  }
+  out.push(out[0]);
+  return out;
+}

@@ -155,7 +155,8 @@ pub struct SurfaceView {
 /// The toolpath over the surface's samples.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct PathView {
-    /// The sample each path point visits, in print order.
+    /// The sample each path point visits, in print order (a vessel's floor
+    /// beads: their positions, after the samples').
     pub order: Vec<u32>,
     /// Bead width per path point (mm, 0.01).
     pub width: Vec<f32>,
@@ -280,11 +281,22 @@ fn view(s: &Sliced, moved: Vec<u32>, slice_ms: f64) -> SliceView {
         .flat_map(|c| [c.first, c.len() as u32])
         .collect();
     let pts = &s.toolpath.points;
+    // A vessel's floor beads are not surface samples: their positions
+    // follow the samples', in print order.
+    let mut extra = surf.samples.len() as u32;
+    let order = pts
+        .iter()
+        .map(|p| match mesh::sample_of_point(surf, p) {
+            Some(i) => i as u32,
+            None => {
+                positions.extend(p.pos.map(round2));
+                extra += 1;
+                extra - 1
+            }
+        })
+        .collect();
     let path = PathView {
-        order: pts
-            .iter()
-            .map(|p| mesh::sample_of_point(surf, p).map_or(u32::MAX, |i| i as u32))
-            .collect(),
+        order,
         width: s.extrusion.width.iter().map(|&w| round2(w)).collect(),
         pass: pts.iter().map(|p| p.pass).collect(),
         top: (0..pts.len() as u32)
@@ -414,13 +426,15 @@ pub struct Imported {
     /// What the page should tell the user about that choice.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub note: Option<String>,
+    /// A closed shape (a vessel's loop: `trajectory.closed`).
+    pub closed: bool,
 }
 
 /// Imports a trajectory; `format` is `svg` or `csv`.
 pub fn import(format: &str, text: &str) -> Result<Imported, ApiError> {
-    let mut points = match format {
-        "svg" => sweepclay_core::import::svg_trajectory(text)?,
-        "csv" => sweepclay_core::import::csv_trajectory(text)?,
+    let path = match format {
+        "svg" => sweepclay_core::import::svg_path(text)?,
+        "csv" => sweepclay_core::import::csv_path(text)?,
         other => {
             return Err(ApiError::new(
                 400,
@@ -429,10 +443,14 @@ pub fn import(format: &str, text: &str) -> Result<Imported, ApiError> {
             .with_key("format"))
         }
     };
+    let (mut points, closed) = (path.points, path.closed);
     for p in &mut points {
         *p = p.map(|x| (x * 1000.0).round() / 1000.0);
     }
-    let length_mm = sweepclay_core::bspline::polyline_length(&points);
+    let mut length_mm = sweepclay_core::bspline::polyline_length(&points);
+    if closed {
+        length_mm += sweepclay_core::bspline::dist(points[points.len() - 1], points[0]);
+    }
     // Near o a radial offset flips from side to side: 10 mm, about two of
     // the widest beads.
     let (offset, note) = sweepclay_core::import::offset_for(&points, 10.0);
@@ -441,6 +459,7 @@ pub fn import(format: &str, text: &str) -> Result<Imported, ApiError> {
         length_mm,
         offset,
         note,
+        closed,
     })
 }
 

@@ -375,6 +375,76 @@ async fn draw_preview_and_download_verified_gcode() {
         err.as_str().unwrap().contains("\"offset\": \"normal\""),
         "{err}"
     );
+
+    // A vessel: from the low wall t5, import a circle from a drawing
+    // program; the page closes the trajectory; three floor layers; the
+    // verdict is printable and the downloaded G-code, floor and spiral in
+    // one run, checks.
+    c.execute("const s = document.getElementById('example'); s.value = 't5'; s.dispatchEvent(new Event('change'));", vec![])
+        .await
+        .unwrap();
+    wait_js(
+        &c,
+        "return window.sweepclay.design.name.startsWith('t5') && !window.sweepclay.design.trajectory.closed && document.getElementById('p-floor_layers').disabled",
+        "the open wall t5",
+    )
+    .await;
+    let cup = tmp.path().join("cup.svg");
+    std::fs::write(
+        &cup,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm" viewBox="0 0 100 100"><circle cx="50" cy="50" r="30"/></svg>"#,
+    )
+    .unwrap();
+    c.find(fantoccini::Locator::Id("import-file"))
+        .await
+        .unwrap()
+        .send_keys(cup.to_str().unwrap())
+        .await
+        .unwrap();
+    wait_js(
+        &c,
+        "return window.sweepclay.design.trajectory.closed === true && document.getElementById('closed').checked && !document.getElementById('p-floor_layers').disabled",
+        "the imported circle as a closed trajectory",
+    )
+    .await;
+    c.execute("const s = document.getElementById('offset'); s.value = 'radial'; s.dispatchEvent(new Event('change'));", vec![])
+        .await
+        .unwrap();
+    c.execute("const f = document.getElementById('p-floor_layers'); f.value = '3'; f.dispatchEvent(new Event('change'));", vec![])
+        .await
+        .unwrap();
+    wait_js(
+        &c,
+        "return window.sweepclay.design.params.floor_layers === 3 && !window.sweepclay.inFlight && !window.sweepclay.pending && document.getElementById('verdict').dataset.printable === 'true'",
+        "the verdict on the vessel",
+    )
+    .await;
+    for f in std::fs::read_dir(&downloads).unwrap() {
+        std::fs::remove_file(f.unwrap().path()).unwrap();
+    }
+    c.find(fantoccini::Locator::Id("download-gcode"))
+        .await
+        .unwrap()
+        .click()
+        .await
+        .unwrap();
+    let deadline = Instant::now() + Duration::from_secs(30);
+    let file = loop {
+        let done = std::fs::read_dir(&downloads)
+            .unwrap()
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .find(|p| p.extension().is_some_and(|x| x == "gcode"));
+        if let Some(p) = done {
+            break p;
+        }
+        assert!(Instant::now() < deadline, "no vessel G-code was downloaded");
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    };
+    let text = std::fs::read_to_string(&file).unwrap();
+    assert!(text.contains(";TYPE:Bottom solid infill") && text.contains("floor_layers=3"));
+    let report = sweepclay_check::check(&text, &sweepclay_web::verify::printer_check(&printer));
+    assert!(report.printable, "{:?}", report.failures);
+    assert_eq!(report.extrusion_runs, 1);
     assert_eq!(js(&c, "return window.sweepclayErrors").await, json!([]));
     c.close().await.unwrap();
 }
