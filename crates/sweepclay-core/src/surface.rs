@@ -275,9 +275,10 @@ pub fn sample_surface(design: &Design) -> Result<Surface> {
     Ok(surface)
 }
 
-/// The column a vessel's path starts each layer and turn at: the one
-/// nearest the floor's innermost ring, so each ring is entered a short
-/// step from the one before (docs/ALGORITHMS.md §8). Refuses a floor that
+/// The columns a vessel's path may start each layer and turn at, best
+/// first: Ψ's start, or the one nearest the floor's innermost ring, where
+/// each ring is entered a short step from the one before
+/// (docs/ALGORITHMS.md §8). Refuses a floor that
 /// splits into islands, or whose innermost line is out of a short step's
 /// reach.
 fn floor_start(
@@ -287,7 +288,7 @@ fn floor_start(
     start: &Profile,
     end: &Profile,
     first_layer: f64,
-) -> Result<usize> {
+) -> Result<Vec<usize>> {
     use crate::vessel::{floor_entries, floor_rings, floor_split, FLOOR_OVERLAP};
     // The base ring as its first layer lies (it stands straight through
     // the floor).
@@ -312,7 +313,7 @@ fn floor_start(
     }
     let rings = floor_rings(&ring, pitch, spacing);
     let Some(inner) = rings.last() else {
-        return Ok(0);
+        return Ok(vec![0]);
     };
     let m = inner.pts.len() as f64;
     let c = inner
@@ -320,19 +321,29 @@ fn floor_start(
         .iter()
         .fold([0.0, 0.0], |a, p| [a[0] + p[0] / m, a[1] + p[1] / m]);
     let d2 = |p: [f64; 2]| (p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2);
-    let first = (0..ring.len())
+    let centre = (0..ring.len())
         .min_by(|&a, &b| d2(ring[a]).total_cmp(&d2(ring[b])))
         .unwrap_or(0);
-    let (_, step) = floor_entries(&rings, [ring[first][0], ring[first][1], 0.0]);
-    if step > 2.0 * pitch {
+    // The start of Ψ first (where the default interpolation keeps the rim
+    // flat across the seam), then the column nearest the floor's centre.
+    let mut worst = 0.0f64;
+    let ok: Vec<usize> = [0, centre]
+        .into_iter()
+        .filter(|&st| {
+            let (_, step) = floor_entries(&rings, [ring[st][0], ring[st][1], 0.0]);
+            worst = worst.max(step);
+            step <= 2.0 * pitch
+        })
+        .collect();
+    if ok.is_empty() {
         return Err(Error::invalid(
             "trajectory",
             format!(
-                "the floor's innermost ring is a sliver the path would reach only by a step of {step:.1} mm across clay of the same layer; widen the narrow part of the shape, or print the vessel bottomless (params.floor_layers = 0)"
+                "the floor's innermost ring is a sliver the path would reach only by a step of {worst:.1} mm across clay of the same layer; widen the narrow part of the shape, or print the vessel bottomless (params.floor_layers = 0)"
             ),
         ));
     }
-    Ok(first)
+    Ok(ok)
 }
 
 /// The samples of a vessel (docs/ALGORITHMS.md §8): each column's base
@@ -354,9 +365,11 @@ fn sample_vessel(
         .unwrap_or(crate::design::DEFAULT_FLOOR_LAYERS);
     let mut v = VesselPlan::choose(&heights, &params, floor)?;
     let spacing = length / n as f64;
-    if v.floor_layers > 0 {
-        v.start = floor_start(&columns, &params, spacing, &start, &end, v.base_layer_mm)?;
-    }
+    let starts = if v.floor_layers > 0 {
+        floor_start(&columns, &params, spacing, &start, &end, v.base_layer_mm)?
+    } else {
+        vec![0]
+    };
     // The extruder body's reach, and the clay just laid along the loop
     // that it may touch, as the checker counts them; columns where the
     // rim is, where collisions happen (docs/ALGORITHMS.md §8).
@@ -373,7 +386,20 @@ fn sample_vessel(
             [q[0], q[1]]
         })
         .collect();
-    if let Some((i, over)) = v.body_violation(&points, &heights, reach, exempt) {
+    // The first start whose seam the extruder body clears.
+    let mut violation = None;
+    for &st in &starts {
+        v.start = st;
+        violation = v.body_violation(&points, &heights, reach, exempt);
+        if violation.is_none() {
+            break;
+        }
+    }
+    if violation.is_some() {
+        v.start = starts[0];
+        violation = v.body_violation(&points, &heights, reach, exempt);
+    }
+    if let Some((i, over)) = violation {
         let c = &columns[i];
         return Err(Error::invalid(
             "interpolation",

@@ -256,23 +256,10 @@ pub const BODY_GRAZE_MM: f64 = 0.2;
 /// down its middle instead, an open [`FloorRing`].
 pub fn floor_rings(outer: &[[f64; 2]], pitch: f64, spacing: f64) -> Vec<FloorRing> {
     let ccw = signed_area2(outer) > 0.0;
-    let mut contour: Vec<[f64; 2]> = outer.to_vec();
-    if !ccw {
-        contour.reverse();
-    }
     let mut rings = Vec::new();
-    for depth in 1..=MAX_FLOOR_RINGS {
-        let style = OutlineStyle::new(-pitch * depth as f64).line_join(LineJoin::Round(0.25));
-        let shapes = contour.outline(&style);
-        let mut found = false;
-        for shape in &shapes {
-            // The first contour of a shape is its outside; an inward
-            // offset of a simple polygon has no holes.
-            let Some(ring) = shape.first() else { continue };
-            if is_speck(ring, pitch) {
-                continue;
-            }
-            let mut ring = resample_loop(ring, spacing);
+    for contours in inward_offsets(outer, pitch) {
+        for contour in contours {
+            let mut ring = resample_loop(&contour, spacing);
             if ring.len() < 3 {
                 continue;
             }
@@ -295,13 +282,54 @@ pub fn floor_rings(outer: &[[f64; 2]], pitch: f64, spacing: f64) -> Vec<FloorRin
                     open: false,
                 });
             }
-            found = true;
-        }
-        if !found {
-            break;
         }
     }
     rings
+}
+
+/// The contours (counter-clockwise, specks dropped) of the inward offsets
+/// of `outer` by `pitch`, 2 · `pitch`, … until nothing is left, one list a
+/// depth. Each depth is offset by one pitch from the one before, every
+/// contour resampled about half a millimetre a point (`i_overlay`'s cost grows
+/// with the points; the rings are resampled to the spacing anyway).
+fn inward_offsets(outer: &[[f64; 2]], pitch: f64) -> Vec<Vec<Vec<[f64; 2]>>> {
+    let coarse = (0.2 * pitch).max(0.5);
+    let mut first = resample_loop(outer, coarse);
+    if first.len() < 3 {
+        first = outer.to_vec();
+    }
+    if signed_area2(&first) < 0.0 {
+        first.reverse();
+    }
+    let style = OutlineStyle::new(-pitch).line_join(LineJoin::Bevel);
+    let mut out = Vec::new();
+    let mut current = vec![first];
+    for _ in 0..MAX_FLOOR_RINGS {
+        let next: Vec<Vec<[f64; 2]>> = current
+            .iter()
+            .flat_map(|c| c.outline(&style))
+            // The first contour of a shape is its outside; an inward
+            // offset of a simple polygon has no holes.
+            .filter_map(|shape| shape.into_iter().next())
+            .filter(|c| !is_speck(c, pitch))
+            // Each offset adds corners: resampled, the points stay about
+            // a millimetre apart, depth after depth.
+            .map(|c| {
+                let r = resample_loop(&c, coarse);
+                if r.len() >= 3 {
+                    r
+                } else {
+                    c
+                }
+            })
+            .collect();
+        if next.is_empty() {
+            break;
+        }
+        out.push(next.clone());
+        current = next;
+    }
+    out
 }
 
 /// The first depth (mm inside `outer`) at which its inward offsets by
@@ -310,25 +338,11 @@ pub fn floor_rings(outer: &[[f64; 2]], pitch: f64, spacing: f64) -> Vec<FloorRin
 /// the clay between them, so such a floor is refused (docs/ALGORITHMS.md
 /// §8).
 pub fn floor_split(outer: &[[f64; 2]], pitch: f64) -> Option<(f64, usize)> {
-    let mut contour: Vec<[f64; 2]> = outer.to_vec();
-    if signed_area2(outer) < 0.0 {
-        contour.reverse();
-    }
-    for depth in 1..=MAX_FLOOR_RINGS {
-        let d = pitch * depth as f64;
-        let style = OutlineStyle::new(-d).line_join(LineJoin::Round(0.25));
-        let islands = contour
-            .outline(&style)
-            .iter()
-            .filter(|shape| shape.first().is_some_and(|c| !is_speck(c, pitch)))
-            .count();
-        match islands {
-            0 => return None,
-            1 => {}
-            k => return Some((d, k)),
-        }
-    }
-    None
+    inward_offsets(outer, pitch)
+        .iter()
+        .enumerate()
+        .find(|(_, c)| c.len() > 1)
+        .map(|(d, c)| (pitch * (d + 1) as f64, c.len()))
 }
 
 /// Whether an offset contour encloses less than a pitch squared: a speck
@@ -433,9 +447,10 @@ fn nearest(ring: &[[f64; 2]], p: [f64; 3]) -> usize {
         .unwrap_or(0)
 }
 
-/// Where each floor element is entered, and the longest step into an open
-/// line (mm; a ring is entered at its nearest point, a line only at an
-/// end): each ring nearest the previous one's entry,
+/// Where each floor element is entered, and the longest step from one to
+/// the next (mm; a step into a ring counted at 2/3, as a ring is entered
+/// at its nearest point and a line only at an end, and refused above two
+/// pitches): each ring nearest the previous one's entry,
 /// the first nearest `start` (where the base ring begins); an open line at
 /// its nearer end.
 pub fn floor_entries(rings: &[FloorRing], start: [f64; 3]) -> (Vec<usize>, f64) {
@@ -455,9 +470,11 @@ pub fn floor_entries(rings: &[FloorRing], start: [f64; 3]) -> (Vec<usize>, f64) 
         } else {
             nearest(pts, at)
         };
-        if r.open {
-            longest = longest.max(d2(at, pts[e]).sqrt());
-        }
+        // A step into a line counts whole; into a ring, beyond the one
+        // pitch the rings lie apart (a ring far from the last entry is
+        // reached across the clay of the ring before).
+        let step = d2(at, pts[e]).sqrt();
+        longest = longest.max(if r.open { step } else { step * 2.0 / 3.0 });
         entry.push(e);
         at = [pts[e][0], pts[e][1], 0.0];
     }
