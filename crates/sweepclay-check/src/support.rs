@@ -395,17 +395,23 @@ pub(crate) fn follow_support(
     if beside <= 0.0 && block < best.z + cfg.min_layer_mm && block <= mid[2] - cfg.min_layer_mm {
         return Some(best);
     }
+    if beside > 0.0 {
+        for y in ys[0]..ys[1] + 1 {
+            for x in xs[0]..xs[1] + 1 {
+                let top = f64::from(tops.top[y * tops.n[0] + x]);
+                if top >= best.z - cfg.min_layer_mm
+                    && rect_distance(tops.rect(x, y), [mid[0], mid[1]]) < beside
+                {
+                    // Clay of about the answer's layer, nearer to the
+                    // middle: the nearest bead below may be there.
+                    return None;
+                }
+            }
+        }
+    }
     for y in ys[0]..ys[1] + 1 {
         for x in xs[0]..xs[1] + 1 {
             let top = f64::from(tops.top[y * tops.n[0] + x]);
-            if beside > 0.0
-                && top >= best.z - cfg.min_layer_mm
-                && rect_distance(tops.rect(x, y), [mid[0], mid[1]]) < beside
-            {
-                // Clay of about the answer's layer, nearer to the middle:
-                // the nearest bead below may be there.
-                return None;
-            }
             // Most cells: clay lower than both tests' thresholds (or none).
             if top < best.z + cfg.min_layer_mm && top <= mid[2] - cfg.min_layer_mm {
                 continue;

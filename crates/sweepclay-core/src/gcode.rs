@@ -109,20 +109,20 @@ pub fn emit<W: Write>(s: &Sliced, out: &mut W) -> io::Result<Vec<usize>> {
     let before = out.count;
     let points = &s.toolpath.points;
     let types = move_types(&s.toolpath);
-    let lines = emit_typed_moves(
-        out.inner,
-        points.len(),
-        |i| points[i].pos,
-        &s.extrusion,
-        &MoveFormat {
-            origin: o,
-            e_per_mm3: pr.e_per_mm3,
-            relative_e: pr.relative_e,
-            feed_mm_min: pa.feedrate,
-            travel_feed_mm_min: pr.travel_feedrate,
-        },
-        &types,
-    )?;
+    let format = MoveFormat {
+        origin: o,
+        e_per_mm3: pr.e_per_mm3,
+        relative_e: pr.relative_e,
+        feed_mm_min: pa.feedrate,
+        travel_feed_mm_min: pr.travel_feedrate,
+    };
+    let pos = |i: usize| points[i].pos;
+    // A wall's moves are untyped: the writer without the test a move.
+    let lines = if types.is_empty() {
+        emit_moves(out.inner, points.len(), pos, &s.extrusion, &format)?
+    } else {
+        emit_typed_moves(out.inner, points.len(), pos, &s.extrusion, &format, &types)?
+    };
     out.write_all(pr.end_gcode.as_bytes())?;
     if !pr.end_gcode.is_empty() && !pr.end_gcode.ends_with('\n') {
         writeln!(out)?;
@@ -233,6 +233,7 @@ pub fn emit_moves<W: Write>(
 /// [`emit_moves`] with a `;TYPE:` comment (PrusaSlicer's and Cura's way of
 /// telling a viewer what a move prints) before the move to point `i` for
 /// each `(i, name)` of `types`, sorted by `i`.
+#[inline]
 pub fn emit_typed_moves<W: Write>(
     out: &mut W,
     n: usize,
