@@ -94,8 +94,9 @@ def cura_definitions(tmp):
     return os.path.join(tmp, "cura", "usr", "share", "cura", "resources", "definitions")
 
 
-def cura(stl, out, defs):
-    clay = [
+def cura_settings():
+    """CuraEngine's clay settings for a spiralized vase."""
+    return [
         "magic_spiralize=true", f"layer_height={LAYER}", f"layer_height_0={LAYER}",
         f"line_width={WIDTH}", f"machine_nozzle_size={WIDTH}",
         f"material_diameter={FEED_DIA}", "bottom_layers=0", "top_layers=0",
@@ -113,6 +114,10 @@ def cura(stl, out, defs):
         "roofing_layer_count=0", "speed_layer_0=30", "speed_print_layer_0=30",
         "speed_travel=60", "retraction_hop_enabled=false",
     ]
+
+
+def cura(stl, out, defs):
+    clay = cura_settings()
     cmd = ["CuraEngine", "slice", "-j", os.path.join(defs, "fdmprinter.def.json")]
     for s in clay:
         cmd += ["-s", s]
