@@ -17,8 +17,8 @@ use std::io::{self, Write};
 /// of adjacent transition curves.
 pub fn surface_triangles(s: &Surface) -> Vec<[u32; 3]> {
     let mut tris = Vec::with_capacity(2 * s.samples.len());
-    for pair in s.columns.windows(2) {
-        let (a, b) = (pair[0].samples(), pair[1].samples());
+    for (ca, cb) in column_pairs(s) {
+        let (a, b) = (s.columns[ca].samples(), s.columns[cb].samples());
         let (mut i, mut j) = (a.start, b.start);
         while i + 1 < a.end || j + 1 < b.end {
             let advance_a = if i + 1 >= a.end {
@@ -38,6 +38,14 @@ pub fn surface_triangles(s: &Surface) -> Vec<[u32; 3]> {
         }
     }
     tris
+}
+
+/// Neighbouring columns `(a, b)`: along Ψ, and round a vessel's loop the
+/// last with the first.
+fn column_pairs(s: &Surface) -> impl Iterator<Item = (usize, usize)> {
+    let n = s.columns.len();
+    let pairs = if s.vessel.is_some() { n } else { n - 1 };
+    (0..pairs).map(move |a| (a, (a + 1) % n))
 }
 
 /// For each surface sample, the index of the toolpath point that prints it.
@@ -76,9 +84,14 @@ pub fn solid(s: &Sliced) -> Vec<[[f64; 3]; 3]> {
     let n = surface.samples.len();
     // Vertices: outer (0..n) then inner (n..2n).
     let mut v = vec![[0.0; 3]; 2 * n];
+    let closed = surface.vessel.is_some();
+    let m = cols.len();
     for (c, col) in cols.iter().enumerate() {
-        let prev = cols[c.saturating_sub(1)].p;
-        let next = cols[(c + 1).min(cols.len() - 1)].p;
+        let (prev, next) = if closed {
+            (cols[(c + m - 1) % m].p, cols[(c + 1) % m].p)
+        } else {
+            (cols[c.saturating_sub(1)].p, cols[(c + 1).min(m - 1)].p)
+        };
         let (tx, ty) = (next[0] - prev[0], next[1] - prev[1]);
         let len = tx.hypot(ty).max(1e-12);
         let normal = [ty / len, -tx / len];
@@ -104,8 +117,8 @@ pub fn solid(s: &Sliced) -> Vec<[[f64; 3]; 3]> {
         idx.push([o(a), o(b), o(c)]);
         idx.push([inner(c), inner(b), inner(a)]);
     }
-    for pair in cols.windows(2) {
-        let (a, b) = (pair[0].samples(), pair[1].samples());
+    for (ca, cb) in column_pairs(surface) {
+        let (a, b) = (cols[ca].samples(), cols[cb].samples());
         // Bottom and top edges.
         quad(
             &mut idx,
@@ -117,20 +130,70 @@ pub fn solid(s: &Sliced) -> Vec<[[f64; 3]; 3]> {
         let (ta, tb) = (a.end - 1, b.end - 1);
         quad(&mut idx, o(ta), o(tb), inner(tb), inner(ta));
     }
-    // The two end walls.
-    let first = cols[0].samples();
-    for s in first.start..first.end - 1 {
-        quad(&mut idx, o(s), o(s + 1), inner(s + 1), inner(s));
-    }
-    let last = cols[cols.len() - 1].samples();
-    for s in last.start..last.end - 1 {
-        quad(&mut idx, o(s + 1), o(s), inner(s), inner(s + 1));
+    if !closed {
+        // The two end walls.
+        let first = cols[0].samples();
+        for s in first.start..first.end - 1 {
+            quad(&mut idx, o(s), o(s + 1), inner(s + 1), inner(s));
+        }
+        let last = cols[cols.len() - 1].samples();
+        for s in last.start..last.end - 1 {
+            quad(&mut idx, o(s + 1), o(s), inner(s), inner(s + 1));
+        }
     }
     let mut tris: Vec<[[f64; 3]; 3]> = idx.iter().map(|t| t.map(|i| v[i])).collect();
-    if signed_volume(&tris) < 0.0 {
-        for t in &mut tris {
+    outward(&mut tris);
+    if let Some(v) = &surface.vessel {
+        if v.floor_layers > 0 {
+            // The floor: a slab inside the base ring, from the bed to the
+            // top of its layers (a second shell, overlapping the wall's).
+            let ring: Vec<[f64; 2]> = cols
+                .iter()
+                .map(|c| {
+                    let p = surface.position_of(c);
+                    [p[0], p[1]]
+                })
+                .collect();
+            let mut floor = slab(&ring, v.base_mm());
+            outward(&mut floor);
+            tris.extend(floor);
+        }
+    }
+    tris
+}
+
+/// Turns a closed shell's triangles so that their normals point out.
+fn outward(tris: &mut [[[f64; 3]; 3]]) {
+    if signed_volume(tris) < 0.0 {
+        for t in tris.iter_mut() {
             t.swap(1, 2);
         }
+    }
+}
+
+/// The closed prism over a simple polygon from z = 0 to `top`: its two
+/// faces triangulated by `earcut`, its sides as quads.
+fn slab(ring: &[[f64; 2]], top: f64) -> Vec<[[f64; 3]; 3]> {
+    let mut idx: Vec<u32> = Vec::new();
+    earcut::Earcut::new().earcut(ring.iter().copied(), &[] as &[u32], &mut idx);
+    let at = |i: u32, z: f64| {
+        let p = ring[i as usize];
+        [p[0], p[1], z]
+    };
+    let mut tris = Vec::with_capacity(2 * idx.len() / 3 + 2 * ring.len());
+    for t in idx.chunks_exact(3) {
+        tris.push([at(t[0], top), at(t[1], top), at(t[2], top)]);
+        tris.push([at(t[0], 0.0), at(t[2], 0.0), at(t[1], 0.0)]);
+    }
+    // Sides turn with the faces: earcut keeps the ring's order, so a side
+    // goes round the way the top's triangles do.
+    let ccw = crate::curves::signed_area2(ring) > 0.0;
+    let n = ring.len() as u32;
+    for i in 0..n {
+        let j = (i + 1) % n;
+        let (a, b) = if ccw { (i, j) } else { (j, i) };
+        tris.push([at(a, 0.0), at(b, 0.0), at(b, top)]);
+        tris.push([at(a, 0.0), at(b, top), at(a, top)]);
     }
     tris
 }
@@ -222,7 +285,7 @@ mod tests {
 
     #[test]
     fn the_thickened_solid_is_closed_and_outward() {
-        for name in ["t1", "t3", "t5"] {
+        for name in ["t1", "t3", "t5", "cup", "flower"] {
             let s = sliced(name);
             let tris = solid(&s);
             // Every directed edge is matched by its reverse exactly once.

@@ -115,6 +115,12 @@ impl Surface {
         }
     }
 
+    /// The position of a column's first sample (its base, on the bed).
+    pub fn position_of(&self, col: &Column) -> [f64; 3] {
+        let smp = self.samples[col.first as usize];
+        col.point(smp.xi, smp.z)
+    }
+
     /// The position of sample `s` of column `c`.
     pub fn position(&self, c: usize, s: usize) -> [f64; 3] {
         let smp = self.samples[s];

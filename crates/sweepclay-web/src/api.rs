@@ -401,13 +401,6 @@ pub fn gcode(design: &Design) -> Result<String, ApiError> {
 /// A binary STL of the surface thickened to the bead width.
 pub fn stl(design: &Design) -> Result<Vec<u8>, ApiError> {
     let s = sweepclay_core::slice(design)?;
-    if s.toolpath.vessel.is_some() {
-        // The thickened solid is built for open walls (docs/ALGORITHMS.md §8).
-        return Err(ApiError::new(
-            422,
-            "the STL of a vessel is not available yet; download its G-code, or export the wall as an open design".to_string(),
-        ));
-    }
     let mut out = Vec::new();
     mesh::write_stl(&s, &mut out).map_err(|e| ApiError::new(500, e.to_string()))?;
     Ok(out)
