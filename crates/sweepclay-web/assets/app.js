@@ -304,8 +304,15 @@ function render(data, fit) {
     ['size', `${s.size_mm.map((v) => v.toFixed(1)).join(' × ')} mm`],
     ['sample points', s.sample_points.toLocaleString('en')],
     ['transition curves', s.curves.toLocaleString('en')],
-    ['passes', `${s.passes} (${s.stages} stage${s.stages > 1 ? 's' : ''})`],
-    ['returning turns', s.returning_points],
+    ...(s.vessel
+      ? [
+        ['floor', `${s.vessel.floor_layers} layers × ${s.vessel.floor_rings} rings, ${s.vessel.floor_area_cm2.toFixed(1)} cm²`],
+        ['wall', `${s.vessel.wall_turns} spiral turns + rim`],
+      ]
+      : [
+        ['passes', `${s.passes} (${s.stages} stage${s.stages > 1 ? 's' : ''})`],
+        ['returning turns', s.returning_points],
+      ]),
     ['path length', `${(s.path_length_mm / 1000).toFixed(2)} m`],
     ['clay volume', `${s.volume_ml.toFixed(1)} ml`],
     ['printing time', `${s.time_min.toFixed(1)} min`],

@@ -253,6 +253,8 @@ export class CurveEditor {
     this.polyline(c, this.o.curve(this.points), '#b5653a', 2.2);
     const many = this.points.length > 150;
     this.points.forEach((p, i) => {
+      // A dense import is drawn as its curve: dots would hide it.
+      if (many && i !== this.selected) return;
       const [x, y] = this.toScreen(p);
       const pinned = this.o.pinned && this.o.pinned(i, this.points);
       c.beginPath();

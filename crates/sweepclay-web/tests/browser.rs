@@ -5,7 +5,8 @@
 //!
 //! The browser is required: without it the test fails and says how to
 //! install it. `SWEEPCLAY_SKIP_BROWSER=1` skips it on purpose (never set in
-//! CI). `SWEEPCLAY_SCREENSHOT=FILE.png` saves a screenshot of the page;
+//! CI). `SWEEPCLAY_SCREENSHOT=FILE.png` saves a screenshot of the page
+//! (`SWEEPCLAY_VESSEL_SCREENSHOT` one of the vessel it imports);
 //! `SWEEPCLAY_URL=http://127.0.0.1:PORT` tests a running `sweepclay serve`
 //! instead of an in-process server.
 
@@ -419,6 +420,11 @@ async fn draw_preview_and_download_verified_gcode() {
         "the verdict on the vessel",
     )
     .await;
+    if let Ok(path) = std::env::var("SWEEPCLAY_VESSEL_SCREENSHOT") {
+        tokio::time::sleep(Duration::from_millis(500)).await;
+        std::fs::write(&path, c.screenshot().await.unwrap()).unwrap();
+        eprintln!("vessel screenshot written to {path}");
+    }
     for f in std::fs::read_dir(&downloads).unwrap() {
         std::fs::remove_file(f.unwrap().path()).unwrap();
     }
