@@ -294,8 +294,8 @@ fn floor_start(
     start: &Profile,
     end: &Profile,
     first_layer: f64,
-) -> Result<Vec<usize>> {
-    use crate::vessel::{floor_entries, floor_rings, floor_split, FLOOR_OVERLAP};
+) -> Result<(Vec<usize>, crate::vessel::FloorOf)> {
+    use crate::vessel::{floor_entries, floor_plan, FLOOR_OVERLAP};
     // The base ring as its first layer lies (it stands straight through
     // the floor).
     let ring: Vec<[f64; 2]> = columns
@@ -308,18 +308,18 @@ fn floor_start(
         })
         .collect();
     let pitch = params.width_min * (1.0 - FLOOR_OVERLAP);
-    if let Some((depth, k)) = floor_split(&ring, pitch) {
-        return Err(Error::invalid(
+    let rings = match floor_plan(&ring, pitch, spacing) {
+        Ok(rings) => rings,
+        Err((depth, k)) => return Err(Error::invalid(
             "trajectory",
             format!(
                 "the floor's rings would split into {k} separate islands {depth:.1} mm inside the wall (a waist about {:.0} mm wide or narrower): one continuous path cannot go from one to the next without crossing clay; widen the waist, or print the vessel bottomless (params.floor_layers = 0)",
                 2.0 * depth
             ),
-        ));
-    }
-    let rings = floor_rings(&ring, pitch, spacing);
+        )),
+    };
     let Some(inner) = rings.last() else {
-        return Ok(vec![0]);
+        return Ok((vec![0], Some((ring, rings))));
     };
     let m = inner.pts.len() as f64;
     let c = inner
@@ -349,7 +349,7 @@ fn floor_start(
             ),
         ));
     }
-    Ok(ok)
+    Ok((ok, Some((ring, rings))))
 }
 
 /// The samples of a vessel (docs/ALGORITHMS.md §8): each column's base
@@ -372,7 +372,10 @@ fn sample_vessel(
     let mut v = VesselPlan::choose(&heights, &params, floor)?;
     let spacing = length / n as f64;
     let starts = if v.floor_layers > 0 {
-        floor_start(&columns, &params, spacing, &start, &end, v.base_layer_mm)?
+        let (starts, floor) =
+            floor_start(&columns, &params, spacing, &start, &end, v.base_layer_mm)?;
+        v.floor = floor;
+        starts
     } else {
         vec![0]
     };

@@ -52,7 +52,14 @@ pub struct VesselPlan {
     /// plan, chosen near the floor's centre so the rings join by short
     /// steps; docs/ALGORITHMS.md §8).
     pub start: usize,
+    /// The floor's rings as sampling found them, and the base ring they
+    /// fill: the path reuses them while the corrections leave that ring
+    /// as it was.
+    pub floor: FloorOf,
 }
+
+/// A base ring and the floor rings that fill it, if computed.
+pub type FloorOf = Option<(Vec<[f64; 2]>, Vec<FloorRing>)>;
 
 impl VesselPlan {
     /// z_base: the top of the base layers (mm).
@@ -110,6 +117,7 @@ impl VesselPlan {
             turns,
             turn_mm: [(lo - base) / k, (hi - base) / k],
             start: 0,
+            floor: None,
         })
     }
 
@@ -255,9 +263,32 @@ pub const BODY_GRAZE_MM: f64 = 0.2;
 /// 2A/P, area over half the perimeter: the last ring of a long ellipse) would lay its beads on each other; it becomes the line
 /// down its middle instead, an open [`FloorRing`].
 pub fn floor_rings(outer: &[[f64; 2]], pitch: f64, spacing: f64) -> Vec<FloorRing> {
+    rings_of(outer, &inward_offsets(outer, pitch), pitch, spacing)
+}
+
+/// [`floor_rings`] and [`floor_split`] from one set of offsets: the rings,
+/// or the depth (mm) and count of the islands the floor splits into.
+pub fn floor_plan(
+    outer: &[[f64; 2]],
+    pitch: f64,
+    spacing: f64,
+) -> std::result::Result<Vec<FloorRing>, (f64, usize)> {
+    let offsets = inward_offsets(outer, pitch);
+    match split_of(&offsets, pitch) {
+        Some(split) => Err(split),
+        None => Ok(rings_of(outer, &offsets, pitch, spacing)),
+    }
+}
+
+fn rings_of(
+    outer: &[[f64; 2]],
+    offsets: &[Vec<Vec<[f64; 2]>>],
+    pitch: f64,
+    spacing: f64,
+) -> Vec<FloorRing> {
     let ccw = signed_area2(outer) > 0.0;
     let mut rings = Vec::new();
-    for contours in inward_offsets(outer, pitch) {
+    for contours in offsets {
         for contour in contours {
             let mut ring = resample_loop(&contour, spacing);
             if ring.len() < 3 {
@@ -338,7 +369,11 @@ fn inward_offsets(outer: &[[f64; 2]], pitch: f64) -> Vec<Vec<Vec<[f64; 2]>>> {
 /// the clay between them, so such a floor is refused (docs/ALGORITHMS.md
 /// §8).
 pub fn floor_split(outer: &[[f64; 2]], pitch: f64) -> Option<(f64, usize)> {
-    inward_offsets(outer, pitch)
+    split_of(&inward_offsets(outer, pitch), pitch)
+}
+
+fn split_of(offsets: &[Vec<Vec<[f64; 2]>>], pitch: f64) -> Option<(f64, usize)> {
+    offsets
         .iter()
         .enumerate()
         .find(|(_, c)| c.len() > 1)
@@ -495,10 +530,10 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
         })
         .collect();
     let pitch = s.params.width_min * (1.0 - FLOOR_OVERLAP);
-    let rings = if v.floor_layers > 0 {
-        floor_rings(&base_ring, pitch, s.spacing)
-    } else {
-        Vec::new()
+    let rings = match &v.floor {
+        _ if v.floor_layers == 0 => Vec::new(),
+        Some((ring, rings)) if *ring == base_ring => rings.clone(),
+        _ => floor_rings(&base_ring, pitch, s.spacing),
     };
     // Where each ring is entered: nearest the previous ring's entry,
     // the first nearest column 0 (where the base ring starts).
