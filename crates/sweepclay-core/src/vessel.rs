@@ -290,7 +290,7 @@ fn rings_of(
     let mut rings = Vec::new();
     for contours in offsets {
         for contour in contours {
-            let mut ring = resample_loop(&contour, spacing);
+            let mut ring = resample_loop(contour, spacing);
             if ring.len() < 3 {
                 continue;
             }
