@@ -1,6 +1,7 @@
 //! The whole job, design → verified G-code (docs/PERFORMANCE.md): slice, write
 //! the G-code and check it in the same pass (`verify_into`, output
-//! discarded), on the six examples and on the scaling series of
+//! discarded), on the examples, on a 44k wall and a 44k vessel, and on the
+//! scaling series of
 //! `examples::scaled` (10 thousand to 10 million samples).
 //!
 //! `cargo bench -p sweepclay-web` (all), `-- verified/t1`, `-- verified_scaling`.
@@ -39,6 +40,14 @@ fn bench(c: &mut Criterion) {
     assert!(verified(&d));
     g.throughput(Throughput::Elements(43_724));
     g.bench_function("44k", |b| b.iter(|| verified(black_box(&d))));
+    // A vessel of about the same size: the vase at 0.4 mm spacing (45,738
+    // path points), floor and spiral (docs/ALGORITHMS.md §8).
+    let mut v = Design::from_json(examples::example("vase").unwrap()).unwrap();
+    v.params.spacing = 0.4;
+    assert!(verified(&v));
+    let n = sweepclay_core::slice(&v).unwrap().stats.sample_points;
+    g.throughput(Throughput::Elements(n as u64));
+    g.bench_function("vessel_44k", |b| b.iter(|| verified(black_box(&v))));
     g.finish();
     let max: usize = std::env::var("SWEEPCLAY_BENCH_MAX")
         .ok()
