@@ -67,9 +67,13 @@ struct ServeArgs {
     /// Refuse designs with more surface samples than this (estimated).
     #[arg(long, default_value_t = DEFAULT_MAX_SAMPLES)]
     max_samples: u64,
-    /// Longest a request may wait for a worker and run (seconds).
+    /// Longest a request may wait for a worker and run (seconds); a
+    /// connection silent for a minute longer is closed.
     #[arg(long, default_value_t = 60)]
     timeout: u64,
+    /// Most connections open at once (more wait to be accepted).
+    #[arg(long, default_value_t = 256)]
+    max_connections: usize,
 }
 
 #[derive(Args, Debug)]
@@ -412,10 +416,16 @@ fn serve(a: ServeArgs) -> Result<i32> {
             "sweepclay modeler: http://{host}:{}/  (Ctrl+C to stop)",
             addr.port()
         );
+        let defaults = sweepclay_web::api::Limits::default();
         let mut limits = sweepclay_web::api::Limits {
             max_samples: a.max_samples as f64,
             request_timeout: std::time::Duration::from_secs(a.timeout),
-            ..Default::default()
+            // Idle connections close a minute after the longest request.
+            connections: sweepclay_web::conn::Connections {
+                max: a.max_connections,
+                idle: std::time::Duration::from_secs(a.timeout + 60),
+            },
+            ..defaults
         };
         // Bound to every interface on purpose: any Host; else the names of
         // loopback and the address given.

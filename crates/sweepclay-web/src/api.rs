@@ -97,6 +97,10 @@ pub struct Limits {
     /// `127.0.0.1`, `localhost`, `[::1]` and the address it was started
     /// on. Empty: any (a server bound to every interface, on purpose).
     pub hosts: Vec<String>,
+    /// Connections open at once and their idle timeout (default 256 and
+    /// the request timeout plus a minute, so a slice in flight is never
+    /// cut).
+    pub connections: crate::conn::Connections,
 }
 
 impl Default for Limits {
@@ -107,6 +111,10 @@ impl Default for Limits {
             workers,
             queue: 4 * workers,
             request_timeout: std::time::Duration::from_secs(60),
+            connections: crate::conn::Connections {
+                max: 256,
+                idle: std::time::Duration::from_secs(120),
+            },
             hosts: ["127.0.0.1", "localhost", "[::1]"]
                 .map(String::from)
                 .to_vec(),

@@ -24,6 +24,7 @@
 //! a design's estimated sample count ([`api::Limits`]).
 
 pub mod api;
+pub mod conn;
 pub mod guard;
 pub mod verify;
 
@@ -363,8 +364,10 @@ async fn check(
         .map(Json)
 }
 
-/// Serves the modeler on `listener` until Ctrl+C.
+/// Serves the modeler on `listener` until Ctrl+C, within the limits'
+/// connection cap and idle timeout ([`conn`]).
 pub async fn run(listener: tokio::net::TcpListener, limits: Limits) -> std::io::Result<()> {
+    let listener = conn::Capped::new(listener, limits.connections);
     axum::serve(listener, router(limits))
         .with_graceful_shutdown(async {
             let _ = tokio::signal::ctrl_c().await;

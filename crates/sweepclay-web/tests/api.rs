@@ -381,3 +381,82 @@ async fn beyond_the_workers_and_the_queue_the_answer_is_503() {
     assert!(codes.contains(&(503, true)), "{codes:?}");
     assert!(codes.iter().all(|c| c.0 == 200 || c.0 == 503), "{codes:?}");
 }
+
+/// A server with `run`, the connection limits included.
+async fn capped(max: usize, idle_ms: u64) -> std::net::SocketAddr {
+    let listener = tokio::net::TcpListener::bind("127.0.0.1:0").await.unwrap();
+    let addr = listener.local_addr().unwrap();
+    let limits = Limits {
+        connections: sweepclay_web::conn::Connections {
+            max,
+            idle: std::time::Duration::from_millis(idle_ms),
+        },
+        ..Limits::default()
+    };
+    tokio::spawn(sweepclay_web::run(listener, limits));
+    addr
+}
+
+/// Sends one HTTP/1.1 request on `s` and reads the status line.
+async fn status_line(s: &mut tokio::net::TcpStream) -> String {
+    use tokio::io::{AsyncReadExt, AsyncWriteExt};
+    s.write_all(b"GET /api/meta HTTP/1.1\r\nHost: 127.0.0.1\r\n\r\n")
+        .await
+        .unwrap();
+    let mut buf = vec![0u8; 64];
+    let n = s.read(&mut buf).await.unwrap();
+    String::from_utf8_lossy(&buf[..n])
+        .lines()
+        .next()
+        .unwrap_or("")
+        .to_string()
+}
+
+#[tokio::test]
+async fn a_silent_connection_is_closed() {
+    use tokio::io::AsyncReadExt;
+    let addr = capped(8, 300).await;
+    // A client that connects and sends nothing (or stalls in its headers).
+    let mut s = tokio::net::TcpStream::connect(addr).await.unwrap();
+    let t = std::time::Instant::now();
+    let mut buf = [0u8; 16];
+    let n = tokio::time::timeout(std::time::Duration::from_secs(5), s.read(&mut buf))
+        .await
+        .expect("the server closes a silent connection")
+        .unwrap_or(0);
+    assert_eq!(n, 0, "closed without an answer");
+    assert!(
+        t.elapsed() >= std::time::Duration::from_millis(250),
+        "{:?}",
+        t.elapsed()
+    );
+    // A connection that talks is served, and kept while it talks.
+    let mut s = tokio::net::TcpStream::connect(addr).await.unwrap();
+    assert!(status_line(&mut s).await.contains("200"));
+}
+
+#[tokio::test]
+async fn connections_beyond_the_cap_wait_for_a_place() {
+    let addr = capped(2, 60_000).await;
+    let mut a = tokio::net::TcpStream::connect(addr).await.unwrap();
+    let mut b = tokio::net::TcpStream::connect(addr).await.unwrap();
+    assert!(status_line(&mut a).await.contains("200"));
+    assert!(status_line(&mut b).await.contains("200"));
+    // A third connection is not served while two are open (keep-alive)...
+    let mut c = tokio::net::TcpStream::connect(addr).await.unwrap();
+    let waiting =
+        tokio::time::timeout(std::time::Duration::from_millis(500), status_line(&mut c)).await;
+    assert!(waiting.is_err(), "served beyond the cap: {waiting:?}");
+    // ... and is once one closes.
+    drop(a);
+    let served = tokio::time::timeout(std::time::Duration::from_secs(5), async {
+        use tokio::io::AsyncReadExt;
+        let mut buf = vec![0u8; 64];
+        let n = c.read(&mut buf).await.unwrap();
+        String::from_utf8_lossy(&buf[..n]).to_string()
+    })
+    .await
+    .expect("served once a place is free");
+    assert!(served.contains("200"), "{served}");
+    drop(b);
+}
