@@ -13,7 +13,8 @@
 //! down) and the curve is centred on `o`.
 //!
 //! CSV: one `x, y` pair per line (comma, semicolon, tab or spaces), in mm;
-//! blank lines and `#` comments are skipped, and so is a header on line 1.
+//! blank lines and `#` comments are skipped, and so are header lines
+//! before the data; the points are centred on `o`, as an SVG's are.
 
 use crate::error::{Error, Result};
 use std::str::FromStr;
@@ -173,7 +174,7 @@ pub fn svg_path(text: &str) -> Result<ImportedPath> {
     Ok(pts)
 }
 
-/// Points of a CSV file as a trajectory (mm, as given: not centred).
+/// Points of a CSV file as a trajectory (mm, centred on `o` as an SVG's).
 pub fn csv_trajectory(text: &str) -> Result<Vec<[f64; 2]>> {
     csv_path(text).map(|p| p.points)
 }
@@ -192,8 +193,8 @@ pub fn csv_path(text: &str) -> Result<ImportedPath> {
             .filter(|f| !f.is_empty())
             .collect();
         let parsed: Vec<Option<f64>> = fields.iter().map(|f| f.parse().ok()).collect();
-        if i == 0 && parsed.iter().all(Option::is_none) {
-            continue; // a header
+        if pts.is_empty() && parsed.iter().all(Option::is_none) {
+            continue; // a header (or a title) before the data
         }
         let key = format!("csv line {}", i + 1);
         if fields.len() < 2 {
@@ -215,7 +216,11 @@ pub fn csv_path(text: &str) -> Result<ImportedPath> {
             .first()
             .zip(pts.last())
             .is_some_and(|(a, b)| (a[0] - b[0]).hypot(a[1] - b[1]) <= 1e-6);
-    finish_path(pts, closed, "csv")
+    let mut path = finish_path(pts, closed, "csv")?;
+    // Centred on o, as an SVG is: a CSV from a drawing starting at (0, 0)
+    // would otherwise land on the centre.
+    centre(&mut path.points);
+    Ok(path)
 }
 
 /// [`finish`] for a path that may be closed: a loop drops a repeated first
@@ -591,8 +596,16 @@ mod tests {
 
     #[test]
     fn csv_with_header_comments_and_separators() {
-        let p = csv_trajectory("x,y\n0,0\n\n# a comment\n10;0\n10\t10  # end\n20 20\n").unwrap();
-        assert_eq!(p, vec![[0.0, 0.0], [10.0, 0.0], [10.0, 10.0], [20.0, 20.0]]);
+        // Comments and a header before the data; centred on o (the box
+        // 0..20 × 0..20 moves by −10, −10).
+        let p = csv_trajectory(
+            "# exported from a drawing\nx,y\n0,0\n\n# a comment\n10;0\n10\t10  # end\n20 20\n",
+        )
+        .unwrap();
+        assert_eq!(
+            p,
+            vec![[-10.0, -10.0], [0.0, -10.0], [0.0, 0.0], [10.0, 10.0]]
+        );
         let e = csv_trajectory("0,0\n1,zz\n").unwrap_err().to_string();
         assert_eq!(e, "csv line 2: `zz` is not a number");
         let e = csv_trajectory("0,0\n5\n").unwrap_err().to_string();
@@ -612,11 +625,10 @@ mod tests {
     #[test]
     fn long_imports_are_resampled_and_centred() {
         let text: String = (0..5000).map(|i| format!("{i},{}\n", i % 2)).collect();
-        let mut p = csv_trajectory(&text).unwrap();
+        let p = csv_trajectory(&text).unwrap();
         assert_eq!(p.len(), MAX_POINTS);
-        assert_eq!(p[0], [0.0, 0.0]);
-        assert_eq!(p[MAX_POINTS - 1], [4999.0, 1.0]);
-        centre(&mut p);
-        assert!((p[0][0] + 2499.5).abs() < 1e-9);
+        // The box 0..4999 × 0..1, centred: its ends at ±2499.5.
+        assert_eq!(p[0], [-2499.5, -0.5]);
+        assert_eq!(p[MAX_POINTS - 1], [2499.5, 0.5]);
     }
 }

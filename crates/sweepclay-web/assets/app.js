@@ -477,8 +477,13 @@ function download(blob, name) {
   setTimeout(() => URL.revokeObjectURL(a.href), 10000);
 }
 
+/**
+ * The design's name as a file name: Unicode kept, only what no file
+ * system takes (/ \ : * ? " < > |, control characters) replaced, and
+ * dots and spaces at the ends dropped.
+ */
 function baseName() {
-  const n = (state.design.name || 'sweepclay').replace(/[^A-Za-z0-9-]+/g, '_').replace(/^_+|_+$/g, '');
+  const n = (state.design.name || '').replace(/[/\\:*?"<>|\u0000-\u001f]+/g, '_').replace(/^[\s.]+|[\s.]+$/g, '');
   return n || 'sweepclay';
 }
 

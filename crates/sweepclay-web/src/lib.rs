@@ -268,12 +268,33 @@ fn attachment(
         "" => "sweepclay",
         s => s,
     };
+    // The name itself, Unicode kept, as RFC 6266's `filename*` (an ASCII
+    // `filename` for old clients): only what no file system takes is
+    // replaced, as the page does.
+    let unsafe_char = |c: char| "/\\:*?\"<>|".contains(c) || c.is_control();
+    let full: String = design
+        .name
+        .chars()
+        .map(|c| if unsafe_char(c) { '_' } else { c })
+        .collect();
+    let full = full.trim_matches(|c: char| c.is_whitespace() || c == '.');
+    let full = if full.is_empty() { stem } else { full };
+    let encoded: String = format!("{full}.{ext}")
+        .bytes()
+        .map(|b| {
+            if b.is_ascii_alphanumeric() || b"-._~".contains(&b) {
+                (b as char).to_string()
+            } else {
+                format!("%{b:02X}")
+            }
+        })
+        .collect();
     (
         [
             (header::CONTENT_TYPE, content_type.to_string()),
             (
                 header::CONTENT_DISPOSITION,
-                format!("attachment; filename=\"{stem}.{ext}\""),
+                format!("attachment; filename=\"{stem}.{ext}\"; filename*=UTF-8''{encoded}"),
             ),
         ],
         body.into(),

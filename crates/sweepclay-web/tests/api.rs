@@ -106,6 +106,24 @@ async fn a_valid_design_gives_geometry_and_stats() {
     let report = sweepclay_check::check(&text, &sweepclay_check::CheckConfig::default());
     assert!(report.printable, "{:?}", report.failures);
 
+    // The design's name, Unicode kept, only path-unsafe characters
+    // replaced; an ASCII name for old clients.
+    let mut d: Value = serde_json::from_str(examples::example("t5").unwrap()).unwrap();
+    d["name"] = serde_json::json!("my sail édition #2 a/b");
+    let r = post(&format!("{base}/api/gcode"), d.to_string()).await;
+    let cd = r.headers()["content-disposition"]
+        .to_str()
+        .unwrap()
+        .to_string();
+    assert!(
+        cd.contains("filename=\"my_sail__dition__2_a_b.gcode\""),
+        "{cd}"
+    );
+    assert!(
+        cd.contains("filename*=UTF-8''my%20sail%20%C3%A9dition%20%232%20a_b.gcode"),
+        "{cd}"
+    );
+
     let r = post(&format!("{base}/api/stl"), examples::example("t5").unwrap()).await;
     assert_eq!(r.status(), 200);
     let bytes = r.bytes().await.unwrap();

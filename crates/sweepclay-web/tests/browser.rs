@@ -322,7 +322,8 @@ async fn draw_preview_and_download_verified_gcode() {
         assert!(Instant::now() < deadline, "no G-code was downloaded");
         tokio::time::sleep(Duration::from_millis(100)).await;
     };
-    assert_eq!(file.file_name().unwrap(), "t1_wave_ring.gcode");
+    // The design's own name, spaces kept.
+    assert_eq!(file.file_name().unwrap(), "t1 wave ring.gcode");
     let text = std::fs::read_to_string(&file).unwrap();
     let printer = sweepclay_core::Printer::preset("cerambot-plus").unwrap();
     let report = sweepclay_check::check(&text, &sweepclay_web::verify::printer_check(&printer));
