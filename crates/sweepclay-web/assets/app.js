@@ -128,6 +128,8 @@ function profileEditor(id, key, otherKey) {
     snap: 1,
     grid: 5,
     minPoints: 2,
+    // The base point (z = 0) slides along the bed but stays.
+    kept: (i) => i === 0,
     constrain: (i, [x, z], pts) => {
       // z = 0 for the first point, strictly increasing along the curve.
       if (i === 0) return [x, 0];

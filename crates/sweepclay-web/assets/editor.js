@@ -15,6 +15,7 @@ export class CurveEditor {
    *   curve(points): the polyline to draw through them
    *   constrain(i, p, points): the allowed position for point i near p
    *   pinned(i, points): the point can be neither moved nor deleted
+   *   kept(i, points): the point can be moved but not deleted
    *   minPoints: fewest points allowed
    *   snap: grid step for snapping; grid: grid line spacing
    *   fixed: [xmin, ymin, xmax, ymax]: a fixed view (no zoom or pan)
@@ -37,6 +38,9 @@ export class CurveEditor {
     canvas.addEventListener('pointermove', (e) => this.move(e));
     canvas.addEventListener('pointerup', (e) => this.up(e));
     canvas.addEventListener('pointercancel', (e) => this.up(e));
+    // A drag ends however the pointer lets go: released over another
+    // element, or its capture taken away.
+    canvas.addEventListener('lostpointercapture', (e) => this.up(e));
     canvas.addEventListener('dblclick', (e) => this.dbl(e));
     canvas.addEventListener('contextmenu', (e) => e.preventDefault());
     canvas.addEventListener('wheel', (e) => this.wheel(e), { passive: false });
@@ -142,7 +146,12 @@ export class CurveEditor {
 
   move(e) {
     const [px, py] = this.local(e);
-    const d = this.drag;
+    let d = this.drag;
+    if (d && e.buttons === 0 && e.pointerType === 'mouse') {
+      // The button came up where this canvas did not hear it.
+      this.up(e);
+      d = null;
+    }
     if (!d) {
       const over = this.hit(px, py) >= 0 || (this.o.centre && this.nearCentre(px, py));
       this.canvas.style.cursor = over ? 'grab' : this.o.fixed ? 'crosshair' : 'move';
@@ -221,6 +230,7 @@ export class CurveEditor {
   remove(i) {
     if (this.points.length <= (this.o.minPoints || 2)) return;
     if (this.o.pinned && this.o.pinned(i, this.points)) return;
+    if (this.o.kept && this.o.kept(i, this.points)) return;
     this.points.splice(i, 1);
     this.selected = -1;
     this.changed(true);

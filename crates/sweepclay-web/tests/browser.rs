@@ -378,6 +378,48 @@ async fn draw_preview_and_download_verified_gcode() {
         "{err}"
     );
 
+    // The base point of a profile stays: a real double-click on it (the
+    // delete gesture) leaves it, and the design, as they were.
+    let before = js(
+        &c,
+        "return JSON.stringify(window.sweepclay.design.profile_start)",
+    )
+    .await;
+    let base_pt = point_at(&c, 0, "0").await;
+    let click = |x: f64, y: f64| {
+        MouseActions::new("mouse".into())
+            .then(PointerAction::MoveTo {
+                duration: None,
+                x: x.round(),
+                y: y.round(),
+            })
+            .then(PointerAction::Down {
+                button: MOUSE_BUTTON_LEFT,
+            })
+            .then(PointerAction::Up {
+                button: MOUSE_BUTTON_LEFT,
+            })
+            .then(PointerAction::Down {
+                button: MOUSE_BUTTON_LEFT,
+            })
+            .then(PointerAction::Up {
+                button: MOUSE_BUTTON_LEFT,
+            })
+    };
+    c.perform_actions(click(base_pt.0, base_pt.1))
+        .await
+        .unwrap();
+    tokio::time::sleep(Duration::from_millis(300)).await;
+    assert_eq!(
+        js(
+            &c,
+            "return JSON.stringify(window.sweepclay.design.profile_start)"
+        )
+        .await,
+        before,
+        "the base point was deleted"
+    );
+
     // A vessel: from the low wall t5, import a circle from a drawing
     // program; the page closes the trajectory; three floor layers; the
     // verdict is printable and the downloaded G-code, floor and spiral in
