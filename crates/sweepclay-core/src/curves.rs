@@ -148,8 +148,24 @@ impl Interpolation {
     /// strictly and f weakly increasing between control points (which makes
     /// the B-spline a monotone function of u).
     pub fn new(spec: Option<&CurveSpec>) -> Result<Interpolation> {
+        Self::validated(spec, false)
+    }
+
+    /// f(u) round a closed Ψ: f(0) = f(1) = 0, values in [0, 1], u
+    /// strictly increasing between control points; f may rise and fall.
+    /// Omitted: [`Interpolation::Cosine`].
+    pub fn new_closed(spec: Option<&CurveSpec>) -> Result<Interpolation> {
+        Self::validated(spec, true)
+    }
+
+    /// [`Interpolation::new`] (open Ψ) or [`Interpolation::new_closed`].
+    fn validated(spec: Option<&CurveSpec>, closed: bool) -> Result<Interpolation> {
         let Some(spec) = spec else {
-            return Ok(Interpolation::Linear);
+            return Ok(if closed {
+                Interpolation::Cosine
+            } else {
+                Interpolation::Linear
+            });
         };
         let key = "interpolation.control_points";
         let pts = &spec.control_points;
@@ -161,10 +177,20 @@ impl Interpolation {
                 format!("must be [0, 0] (got {first:?})"),
             ));
         }
-        if last != [1.0, 1.0] {
+        let (end, named) = if closed {
+            ([1.0, 0.0], "[1, 0]")
+        } else {
+            ([1.0, 1.0], "[1, 1]")
+        };
+        if last != end {
+            let why = if closed {
+                " for a closed trajectory: the loop comes back to the start profile, so f(1) = f(0) = 0"
+            } else {
+                ""
+            };
             return Err(Error::invalid(
                 format!("{key}[{}]", pts.len() - 1),
-                format!("must be [1, 1] (got {last:?})"),
+                format!("must be {named}{why} (got {last:?})"),
             ));
         }
         for i in 1..pts.len() {
@@ -178,7 +204,13 @@ impl Interpolation {
                     ),
                 ));
             }
-            if pts[i][1] < pts[i - 1][1] {
+            if closed && !(0.0..=1.0).contains(&pts[i][1]) {
+                return Err(Error::invalid(
+                    format!("{key}[{i}]"),
+                    format!("f must lie between 0 and 1 (got {})", pts[i][1]),
+                ));
+            }
+            if !closed && pts[i][1] < pts[i - 1][1] {
                 return Err(Error::invalid(
                     format!("{key}[{i}]"),
                     format!(
@@ -190,59 +222,15 @@ impl Interpolation {
             }
         }
         let mut table = function_table(pts);
-        // Flattening error can break monotonicity by a rounding step; repair.
-        for k in 1..table.len() {
-            if table[k] < table[k - 1] {
-                table[k] = table[k - 1];
+        if !closed {
+            // Flattening error can break monotonicity by a rounding step;
+            // repair.
+            for k in 1..table.len() {
+                if table[k] < table[k - 1] {
+                    table[k] = table[k - 1];
+                }
             }
         }
-        Ok(Interpolation::Table(table))
-    }
-
-    /// f(u) round a closed Ψ: f(0) = f(1) = 0, values in [0, 1], u
-    /// strictly increasing between control points; f may rise and fall.
-    /// Omitted: [`Interpolation::Cosine`].
-    pub fn new_closed(spec: Option<&CurveSpec>) -> Result<Interpolation> {
-        let Some(spec) = spec else {
-            return Ok(Interpolation::Cosine);
-        };
-        let key = "interpolation.control_points";
-        let pts = &spec.control_points;
-        check_points(key, pts, 2)?;
-        let (first, last) = (pts[0], pts[pts.len() - 1]);
-        if first != [0.0, 0.0] {
-            return Err(Error::invalid(
-                format!("{key}[0]"),
-                format!("must be [0, 0] (got {first:?})"),
-            ));
-        }
-        if last != [1.0, 0.0] {
-            return Err(Error::invalid(
-                format!("{key}[{}]", pts.len() - 1),
-                format!(
-                    "must be [1, 0] for a closed trajectory: the loop comes back to the start profile, so f(1) = f(0) = 0 (got {last:?})"
-                ),
-            ));
-        }
-        for i in 1..pts.len() {
-            if pts[i][0] <= pts[i - 1][0] {
-                return Err(Error::invalid(
-                    format!("{key}[{i}]"),
-                    format!(
-                        "u must increase strictly ({} after {})",
-                        pts[i][0],
-                        pts[i - 1][0]
-                    ),
-                ));
-            }
-            if !(0.0..=1.0).contains(&pts[i][1]) {
-                return Err(Error::invalid(
-                    format!("{key}[{i}]"),
-                    format!("f must lie between 0 and 1 (got {})", pts[i][1]),
-                ));
-            }
-        }
-        let table = function_table(pts);
         Ok(Interpolation::Table(table))
     }
 

@@ -79,6 +79,17 @@ pub enum Offset {
     Normal,
 }
 
+impl TrajectorySpec {
+    /// The points as given: the control points of a B-spline or the
+    /// vertices of a polyline (none when neither is given).
+    pub fn given_points(&self) -> &[[f64; 2]] {
+        self.control_points
+            .as_deref()
+            .or(self.points.as_deref())
+            .unwrap_or(&[])
+    }
+}
+
 impl Offset {
     /// Whether this is the default, radial frame.
     pub fn is_radial(&self) -> bool {
@@ -307,11 +318,7 @@ impl Design {
         }
         let pr = self.printer.resolve()?;
         let t = &self.trajectory;
-        let pts = t
-            .control_points
-            .as_deref()
-            .or(t.points.as_deref())
-            .unwrap_or(&[]);
+        let pts = t.given_points();
         let top = |c: &CurveSpec| c.control_points.last().map_or(0.0, |p| p[1]);
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
@@ -348,11 +355,7 @@ impl Design {
     pub fn estimated_samples(&self) -> f64 {
         use crate::bspline::polyline_length as poly;
         let t = &self.trajectory;
-        let pts = t
-            .control_points
-            .as_deref()
-            .or(t.points.as_deref())
-            .unwrap_or(&[]);
+        let pts = t.given_points();
         let mut length = poly(pts);
         let mut floor = 0.0;
         let p = &self.params;

@@ -565,6 +565,17 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
             kind,
         });
     };
+    // Sample `local` of every column, round the loop from the start.
+    let visit_turn = |points: &mut Vec<PathPoint>,
+                      below: &mut Vec<Option<u32>>,
+                      path_of: &mut Vec<u32>,
+                      local: usize,
+                      pass: u32| {
+        for m in 0..n {
+            let i = (v.start + m) % n;
+            visit_column(points, below, path_of, i, local, pass, PointKind::Pass);
+        }
+    };
     let base = v.base_layers;
     for layer in 1..=base {
         let z = f64::from(layer) * v.base_layer_mm;
@@ -592,56 +603,26 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
                 });
             }
         };
-        let floor_here = layer <= v.floor_layers;
+        // A floor layer that runs inward starts on the base ring; one that
+        // runs outward ends on it.
+        let floor_order: Vec<usize> = match layer <= v.floor_layers {
+            false => Vec::new(),
+            true if outward => (0..rings.len()).rev().collect(),
+            true => (0..rings.len()).collect(),
+        };
+        if !outward {
+            visit_turn(&mut points, &mut below, &mut path_of, local, layer);
+        }
+        for r in floor_order {
+            floor(&mut points, &mut below, r);
+        }
         if outward {
-            if floor_here {
-                for r in (0..rings.len()).rev() {
-                    floor(&mut points, &mut below, r);
-                }
-            }
-            for m in 0..n {
-                visit_column(
-                    &mut points,
-                    &mut below,
-                    &mut path_of,
-                    (v.start + m) % n,
-                    local,
-                    layer,
-                    PointKind::Pass,
-                );
-            }
-        } else {
-            for m in 0..n {
-                visit_column(
-                    &mut points,
-                    &mut below,
-                    &mut path_of,
-                    (v.start + m) % n,
-                    local,
-                    layer,
-                    PointKind::Pass,
-                );
-            }
-            if floor_here {
-                for r in 0..rings.len() {
-                    floor(&mut points, &mut below, r);
-                }
-            }
+            visit_turn(&mut points, &mut below, &mut path_of, local, layer);
         }
     }
     for k in 1..=v.turns {
-        for m in 0..n {
-            let local = (base + k) as usize - 1;
-            visit_column(
-                &mut points,
-                &mut below,
-                &mut path_of,
-                (v.start + m) % n,
-                local,
-                base + k,
-                PointKind::Pass,
-            );
-        }
+        let local = (base + k) as usize - 1;
+        visit_turn(&mut points, &mut below, &mut path_of, local, base + k);
     }
     let rim = base + v.turns + 1;
     for i in (0..n).map(|m| (v.start + m) % n) {
@@ -676,7 +657,6 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
         vessel: Some(VesselPath {
             floor_layers: v.floor_layers,
             floor_rings: rings.len() as u32,
-            floor_points: (floor_points * v.floor_layers as usize) as u32,
             floor_area_mm2: floor_area,
             turns: v.turns,
         }),
@@ -690,8 +670,6 @@ pub struct VesselPath {
     pub floor_layers: u32,
     /// Inner rings of each floor layer (the base ring not counted).
     pub floor_rings: u32,
-    /// Points of the floor's inner rings, all layers.
-    pub floor_points: u32,
     /// Area inside the base ring (mm²), 0 for a bottomless vessel.
     pub floor_area_mm2: f64,
     /// Spiral turns of the wall.

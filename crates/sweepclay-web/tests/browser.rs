@@ -133,6 +133,29 @@ async fn point_at(c: &Client, e: usize, i: &str) -> (f64, f64) {
     (v[0].as_f64().unwrap(), v[1].as_f64().unwrap())
 }
 
+/// Clicks "Download G-code" and waits (30 s at most, else fails with
+/// `missing`) for a `.gcode` file in `downloads`.
+async fn download_gcode(c: &Client, downloads: &Path, missing: &str) -> std::path::PathBuf {
+    c.find(fantoccini::Locator::Id("download-gcode"))
+        .await
+        .unwrap()
+        .click()
+        .await
+        .unwrap();
+    let deadline = Instant::now() + Duration::from_secs(30);
+    loop {
+        let done = std::fs::read_dir(downloads)
+            .unwrap()
+            .filter_map(|e| e.ok().map(|e| e.path()))
+            .find(|p| p.extension().is_some_and(|x| x == "gcode"));
+        if let Some(p) = done {
+            return p;
+        }
+        assert!(Instant::now() < deadline, "{missing}");
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    }
+}
+
 async fn drag(c: &Client, from: (f64, f64), by: (f64, f64), steps: usize) {
     let mut m = MouseActions::new("mouse".into())
         .then(PointerAction::MoveTo {
@@ -304,24 +327,7 @@ async fn draw_preview_and_download_verified_gcode() {
     }
 
     // Download the G-code and check it independently.
-    c.find(fantoccini::Locator::Id("download-gcode"))
-        .await
-        .unwrap()
-        .click()
-        .await
-        .unwrap();
-    let deadline = Instant::now() + Duration::from_secs(30);
-    let file = loop {
-        let done = std::fs::read_dir(&downloads)
-            .unwrap()
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .find(|p| p.extension().is_some_and(|x| x == "gcode"));
-        if let Some(p) = done {
-            break p;
-        }
-        assert!(Instant::now() < deadline, "no G-code was downloaded");
-        tokio::time::sleep(Duration::from_millis(100)).await;
-    };
+    let file = download_gcode(&c, &downloads, "no G-code was downloaded").await;
     // The design's own name, spaces kept.
     assert_eq!(file.file_name().unwrap(), "t1 wave ring.gcode");
     let text = std::fs::read_to_string(&file).unwrap();
@@ -471,24 +477,7 @@ async fn draw_preview_and_download_verified_gcode() {
     for f in std::fs::read_dir(&downloads).unwrap() {
         std::fs::remove_file(f.unwrap().path()).unwrap();
     }
-    c.find(fantoccini::Locator::Id("download-gcode"))
-        .await
-        .unwrap()
-        .click()
-        .await
-        .unwrap();
-    let deadline = Instant::now() + Duration::from_secs(30);
-    let file = loop {
-        let done = std::fs::read_dir(&downloads)
-            .unwrap()
-            .filter_map(|e| e.ok().map(|e| e.path()))
-            .find(|p| p.extension().is_some_and(|x| x == "gcode"));
-        if let Some(p) = done {
-            break p;
-        }
-        assert!(Instant::now() < deadline, "no vessel G-code was downloaded");
-        tokio::time::sleep(Duration::from_millis(100)).await;
-    };
+    let file = download_gcode(&c, &downloads, "no vessel G-code was downloaded").await;
     let text = std::fs::read_to_string(&file).unwrap();
     assert!(text.contains(";TYPE:Bottom solid infill") && text.contains("floor_layers=3"));
     let report = sweepclay_check::check(&text, &sweepclay_web::verify::printer_check(&printer));
