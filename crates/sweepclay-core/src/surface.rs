@@ -395,18 +395,19 @@ fn sample_vessel(
             [q[0], q[1]]
         })
         .collect();
+    let near = crate::vessel::Neighbours::new(&points, reach);
     // The first start whose seam the extruder body clears.
     let mut violation = None;
     for &st in &starts {
         v.start = st;
-        violation = v.body_violation(&points, &heights, reach, exempt);
+        violation = v.body_violation(&near, &heights, exempt);
         if violation.is_none() {
             break;
         }
     }
     if violation.is_some() {
         v.start = starts[0];
-        violation = v.body_violation(&points, &heights, reach, exempt);
+        violation = v.body_violation(&near, &heights, exempt);
     }
     if let Some((i, over)) = violation {
         let c = &columns[i];
@@ -418,7 +419,7 @@ fn sample_vessel(
             ),
         ));
     }
-    let rim = v.rim_beads(&points, &heights, reach, exempt);
+    let rim = v.rim_beads(&near, &heights, exempt);
     let layers = v.base_layers + v.turns;
     let plan = LayerPlan {
         passes: layers + 1,

@@ -147,20 +147,9 @@ impl VesselPlan {
     /// clears the last turn's clay within `reach` in plan and the rim
     /// beads laid more than `exempt` columns before (a rim that rises
     /// steeply ahead ends the run early: the rim is then level to within
-    /// a layer there). `points` and `h` as for
-    /// [`VesselPlan::body_violation`].
-    pub fn rim_beads(
-        &self,
-        points: &[[f64; 2]],
-        h: &[f64],
-        reach: f64,
-        exempt: usize,
-    ) -> Vec<bool> {
-        let n = points.len();
-        let mut grid = crate::grid::Grid2::new(reach.max(1e-3));
-        for (i, p) in points.iter().enumerate() {
-            grid.insert_segment(*p, *p, i as u32);
-        }
+    /// a layer there). `h` as for [`VesselPlan::body_violation`].
+    pub fn rim_beads(&self, near: &Neighbours, h: &[f64], exempt: usize) -> Vec<bool> {
+        let n = near.len();
         let mut rim: Vec<bool> = (0..n).map(|i| self.has_rim(i, n, h[i])).collect();
         // The rim turn is one run from the turn's start: once a bead is
         // left out, so are the rest (a gap would be a jump across).
@@ -172,14 +161,8 @@ impl VesselPlan {
                 ended = true;
                 continue;
             }
-            let p = points[i];
             let mut clear = true;
-            grid.for_each_near_segment(p, p, reach, |j| {
-                let j = j as usize;
-                let q = points[j];
-                if (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) > reach * reach {
-                    return;
-                }
+            near.each(i, |j| {
                 let mut top = self.spiral_z(self.turns, j, n, h[j]);
                 let (oi, oj) = (self.order(i, n), self.order(j, n));
                 if oj < oi && oi - oj > exempt && rim[j] {
@@ -197,30 +180,23 @@ impl VesselPlan {
 
     /// The first column where the extruder body would meet clay already
     /// laid (docs/ALGORITHMS.md §8): for every pair of columns `i`, `j`
-    /// within `reach` in plan, the turn below at `j` (or, more than
+    /// within reach in plan (`near`), the turn below at `j` (or, more than
     /// `exempt` columns back along the loop, this turn at `j`) must not
     /// stand more than [`BODY_GRAZE_MM`] above the nozzle at `i`. Checked
     /// at the turns where the difference is largest (it is linear in the
-    /// turn). `points` are the columns in plan, `h` their rims.
+    /// turn). `h` are the columns' rims.
     pub fn body_violation(
         &self,
-        points: &[[f64; 2]],
+        near: &Neighbours,
         h: &[f64],
-        reach: f64,
         exempt: usize,
     ) -> Option<(usize, f64)> {
-        let n = points.len();
-        let mut grid = crate::grid::Grid2::new(reach.max(1e-3));
-        for (i, p) in points.iter().enumerate() {
-            grid.insert_segment(*p, *p, i as u32);
-        }
+        let n = near.len();
         let turns = [1.max(self.turns.min(2)), self.turns];
         let mut worst: Option<(usize, f64)> = None;
-        for (i, p) in points.iter().enumerate() {
-            grid.for_each_near_segment(*p, *p, reach, |j| {
-                let j = j as usize;
-                let q = points[j];
-                if (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) > reach * reach || j == i {
+        for i in 0..n {
+            near.each(i, |j| {
+                if j == i {
                     return;
                 }
                 for k in turns {
@@ -245,6 +221,50 @@ impl VesselPlan {
             });
         }
         worst
+    }
+}
+
+/// The columns of a loop within a reach of each other in plan, found by
+/// a grid built once: what the extruder body can touch.
+pub struct Neighbours<'a> {
+    points: &'a [[f64; 2]],
+    grid: crate::grid::Grid2,
+    reach: f64,
+}
+
+impl<'a> Neighbours<'a> {
+    /// The columns at `points` (in plan), `reach` apart or nearer.
+    pub fn new(points: &'a [[f64; 2]], reach: f64) -> Neighbours<'a> {
+        let mut grid = crate::grid::Grid2::new(reach.max(1e-3));
+        for (i, p) in points.iter().enumerate() {
+            grid.insert_segment(*p, *p, i as u32);
+        }
+        Neighbours {
+            points,
+            grid,
+            reach,
+        }
+    }
+
+    /// The number of columns.
+    pub fn len(&self) -> usize {
+        self.points.len()
+    }
+
+    /// Whether there are no columns.
+    pub fn is_empty(&self) -> bool {
+        self.points.is_empty()
+    }
+
+    /// Calls `f` with every column within reach of column `i` (`i` too).
+    pub fn each(&self, i: usize, mut f: impl FnMut(usize)) {
+        let (p, r) = (self.points[i], self.reach);
+        self.grid.for_each_near_segment(p, p, r, |j| {
+            let q = self.points[j as usize];
+            if (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) <= r * r {
+                f(j as usize);
+            }
+        });
     }
 }
 
