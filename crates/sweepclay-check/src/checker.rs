@@ -10,7 +10,7 @@ use crate::grid::{settle, BeadGrid};
 use crate::parse::{Diagnostic, Line, LineParser};
 use crate::replay::{Event, Move, Replayer};
 use crate::report::{Finding, Report, Segment};
-use crate::support::{follow_support, search_support, Query, Recent, Scratch, Walk};
+use crate::support::{follow_support, on_bare_bed, search_support, Query, Recent, Scratch, Walk};
 use crate::tops::TopGrid;
 use crate::verdict::verdict;
 use crate::verdict::WIDTH_TOLERANCE;
@@ -336,7 +336,11 @@ impl<'a> Checker<'a> {
             lo: [f64::MAX; 3],
             hi: [f64::MIN; 3],
             layer_heights: Vec::new(),
-            support_tops: TopGrid::new([cfg.build_volume[0], cfg.build_volume[1]], 2.0),
+            support_tops: TopGrid::layered(
+                [cfg.build_volume[0], cfg.build_volume[1]],
+                2.0,
+                cfg.min_layer_mm,
+            ),
             support_settled: 0,
             recent: Recent::default(),
             prev_support: None,
@@ -782,23 +786,33 @@ impl<'a> Checker<'a> {
             // The shortcut needs the clay of the last 2 w_max of path not to
             // be clay below: the bound of `clear_of` says so for most beads;
             // for the rest (reversals, drops) each such bead is asked.
-            let fast = prev_support
-                .filter(|_| {
-                    *walk == Walk::Auto
-                        && (recent.clear_of(m, mid, cfg.min_layer_mm, turn, xy)
-                            || q.none_below(&beads[*support_settled..], *support_settled))
-                })
-                .and_then(|j| {
-                    follow_support(beads, bent_before, *support_settled, support_tops, j, &q)
-                });
+            // The shortcuts: along the pass below (`prev_support`), or on
+            // the bare bed (a first layer: nothing below to follow).
+            let near_bed = mid[2] <= cfg.first_layer_max_mm;
+            let fast = (*walk == Walk::Auto
+                && (prev_support.is_some() || near_bed)
+                && (recent.clear_of(m, mid, cfg.min_layer_mm, turn, xy)
+                    || q.none_below(&beads[*support_settled..], *support_settled)))
+            .then(|| match *prev_support {
+                Some(j) => follow_support(
+                    beads,
+                    grid,
+                    bent_before,
+                    *support_settled,
+                    support_tops,
+                    j,
+                    &q,
+                )
+                .map(Some),
+                None => on_bare_bed(beads, grid, support_tops, &q).then_some(None),
+            })
+            .flatten();
             r.support.beads += 1;
-            let (support, own) = if fast.is_some() {
-                (fast, None)
-            } else {
-                search_support(beads, grid, blocks, scratch, &q, *walk)
+            let (support, own) = match fast {
+                Some(fast) => (fast, None),
+                None => search_support(beads, grid, blocks, scratch, &q, *walk),
             };
             *prev_support = support.map(|c| c.id);
-            let near_bed = mid[2] <= cfg.first_layer_max_mm;
             if let Some(z_own) = own {
                 // Clay at its own height under its middle: the bead is
                 // pressed onto it. Its clay has the gap above that clay to

@@ -342,6 +342,7 @@ fn alone_past_bends(
 #[inline]
 pub(crate) fn follow_support(
     beads: &[Bead],
+    grid: &BeadGrid,
     bent_before: &[u32],
     settled: usize,
     tops: &TopGrid,
@@ -384,48 +385,138 @@ pub(crate) fn follow_support(
         return None;
     }
     let (xs, ys) = tops.range([mid[0] - r, mid[1] - r], [mid[0] + r, mid[1] + r]);
-    // Most beads: no clay that high in the blocks around, and the answer
-    // right under the middle, so no other bead can be nearer. (Beside a
-    // bead of the same height, as the rings of a floor lie, the answer
-    // may not be the nearest: the cells say.)
+    // Another pass of the layer below nearer the middle would be the
+    // support. Passes of a layer may lie less than a bead apart (the
+    // rings of a floor), and near a bend the pass may step across to the
+    // next: unless the answer is right under the middle the beads
+    // themselves are asked.
+    let kb = best.id as usize;
+    let bend = bent_before
+        .get(kb + 3)
+        .zip(bent_before.get(kb.saturating_sub(2)));
+    let near_bend = bend.is_none_or(|(h, l)| h != l);
+    if best.d > NEAR_BEND * cfg.width_min
+        && (best.d > RIGHT_UNDER * cfg.width_min || near_bend)
+        && nearer_below(beads, grid, q, &best)
+    {
+        return None;
+    }
+    // Most beads: no clay that high in the blocks around.
     let block = f64::from(tops.block_max((xs, ys)));
-    // Another pass of the answer's layer lies at least half a bead beside
-    // it; nearer than that to the middle, it would be the support.
-    let beside = best.d - 0.5 * cfg.width_min;
-    if beside <= 0.0 && block < best.z + cfg.min_layer_mm && block <= mid[2] - cfg.min_layer_mm {
+    if block < best.z + cfg.min_layer_mm && block <= mid[2] - cfg.min_layer_mm {
         return Some(best);
     }
-    if beside > 0.0 {
-        for y in ys[0]..ys[1] + 1 {
-            for x in xs[0]..xs[1] + 1 {
-                let top = f64::from(tops.top[y * tops.n[0] + x]);
-                if top >= best.z - cfg.min_layer_mm
-                    && rect_distance(tops.rect(x, y), [mid[0], mid[1]]) < beside
-                {
-                    // Clay of about the answer's layer, nearer to the
-                    // middle: the nearest bead below may be there.
-                    return None;
-                }
-            }
-        }
-    }
+    // Only beads below the new one can be climbed to: below that, the
+    // highest clay a cell can hold (not its top layer, if that is the
+    // new bead's own, as the rings of a floor's upper layer lie).
+    let lim = mid[2] - cfg.min_layer_mm;
+    let mut own = false;
     for y in ys[0]..ys[1] + 1 {
         for x in xs[0]..xs[1] + 1 {
-            let top = f64::from(tops.top[y * tops.n[0] + x]);
+            let i = y * tops.n[0] + x;
+            let (top, under) = (f64::from(tops.top[i]), tops.highest_under(i, lim));
             // Most cells: clay lower than both tests' thresholds (or none).
-            if top < best.z + cfg.min_layer_mm && top <= mid[2] - cfg.min_layer_mm {
+            if under < best.z + cfg.min_layer_mm && top <= lim {
                 continue;
             }
             let rect = tops.rect(x, y);
             let climb = best.z + cfg.min_layer_mm.max(0.5 * rect_distance(rect, best.at));
-            let own = rect_distance(rect, [mid[0], mid[1]]) < 0.5 * cfg.width_min
-                && top > mid[2] - cfg.min_layer_mm;
-            if top >= climb || own {
+            if under >= climb {
                 return None;
             }
+            own |= top > lim && rect_distance(rect, [mid[0], mid[1]]) < 0.5 * cfg.width_min;
         }
     }
+    if own && laid_twice(beads, grid, q) {
+        return None;
+    }
     Some(best)
+}
+
+/// Within this many `w_min` of the middle, the shortcut's answer is taken
+/// as the nearest bead below without asking the beads around: passes of
+/// one layer lie at least 3/4 `w_min` apart (a floor's rings 0.85 `w_min`),
+/// so a nearer one would lie farther out than this. Where passes lie
+/// closer (other slicers' heavily overlapping lines), the answer is the
+/// farther pass, whose overlap is smaller: the check errs toward
+/// refusing (docs/CHECKER.md, "Speed").
+const RIGHT_UNDER: f64 = 0.375;
+
+/// The same within two beads of a bend of the pass below, where it may
+/// step across to the next pass (a floor's ring to the next) or close a
+/// loop beside its own start: a nearer pass lies farther out than this.
+const NEAR_BEND: f64 = 0.1;
+
+/// Whether a bead below other than `best` covers the middle and is
+/// nearer to it ([`Candidate::nearer`]): then the full search starts from
+/// that one.
+#[cold]
+#[inline(never)]
+fn nearer_below(beads: &[Bead], grid: &BeadGrid, q: &Query, best: &Candidate) -> bool {
+    let (mid, cfg) = (q.mid, q.cfg);
+    let mut found = false;
+    grid.in_box(
+        mid,
+        best.d,
+        mid[2] - cfg.max_gap_mm,
+        mid[2] - cfg.min_layer_mm,
+        |r| {
+            found = found
+                || (r.first..=r.last).any(|j| {
+                    matches!(q.classify(&beads[j as usize], j),
+                        Class::Below(c) if c.covers && c.nearer(best).is_lt())
+                })
+        },
+    );
+    found
+}
+
+/// Whether a bead lies at the new bead's own height under its middle
+/// ([`Class::Double`]): asked of the beads themselves where a cell too
+/// coarse to tell holds clay that high near it (beside the rings of a
+/// floor's layer, the next ring of the same layer).
+#[cold]
+#[inline(never)]
+fn laid_twice(beads: &[Bead], grid: &BeadGrid, q: &Query) -> bool {
+    let (mid, ml) = (q.mid, q.cfg.min_layer_mm);
+    let mut found = false;
+    grid.in_box(mid, 0.5 * q.cfg.width_min, mid[2] - ml, mid[2] + ml, |r| {
+        found = found
+            || (r.first..=r.last)
+                .any(|j| matches!(q.classify(&beads[j as usize], j), Class::Double(_)));
+    });
+    found
+}
+
+/// Whether the full search would find nothing under a bead near the bed
+/// (it rests on the bed) and no clay at its own height under it, without
+/// the search: no cell within reach of it holds clay low enough to be
+/// below it. The caller asks first, as for [`follow_support`], that none
+/// of the clay laid in the last 2 w_max of path is below.
+#[inline]
+pub(crate) fn on_bare_bed(beads: &[Bead], grid: &BeadGrid, tops: &TopGrid, q: &Query) -> bool {
+    let (mid, cfg) = (q.mid, q.cfg);
+    let r = cfg.width_max.max(f64::from(tops.widest) / 2.0);
+    if mid[2] > cfg.first_layer_max_mm || r > 2.0 * cfg.width_max {
+        return false;
+    }
+    let (lim, low) = (mid[2] - cfg.min_layer_mm, mid[2] - cfg.max_gap_mm);
+    let (xs, ys) = tops.range([mid[0] - r, mid[1] - r], [mid[0] + r, mid[1] + r]);
+    if f64::from(tops.block_max((xs, ys))) < low {
+        return true;
+    }
+    let mut own = false;
+    for y in ys[0]..ys[1] + 1 {
+        for x in xs[0]..xs[1] + 1 {
+            let i = y * tops.n[0] + x;
+            if tops.highest_under(i, lim) >= low {
+                return false;
+            }
+            own |= f64::from(tops.top[i]) > lim
+                && rect_distance(tops.rect(x, y), [mid[0], mid[1]]) < 0.5 * cfg.width_min;
+        }
+    }
+    !(own && laid_twice(beads, grid, q))
 }
 
 /// How the support of a bead is found. Each way gives the same answer;

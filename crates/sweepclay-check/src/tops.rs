@@ -24,6 +24,15 @@ pub(crate) struct TopGrid {
     pub(crate) bx: usize,
     /// The widest bead raised.
     pub(crate) widest: f32,
+    /// With [`TopGrid::layered`], what lies under each cell's top layer,
+    /// so a cell holding one layer over another (a floor's second layer
+    /// on its first) still tells how high the clay under the top layer
+    /// reaches: every bead raised in cell i lies wholly at or above
+    /// `layer_lo[i]`, which is more than `layer` under `top[i]` (the top
+    /// layer), or has its top at most `under[i]`. Empty otherwise.
+    pub(crate) under: Vec<f32>,
+    pub(crate) layer_lo: Vec<f32>,
+    pub(crate) layer: f32,
 }
 
 impl TopGrid {
@@ -55,6 +64,56 @@ impl TopGrid {
             coarse: vec![f32::NEG_INFINITY; n[0].div_ceil(4) * n[1].div_ceil(4)],
             bx: n[0].div_ceil(4),
             widest: 0.0,
+            under: Vec::new(),
+            layer_lo: Vec::new(),
+            layer: 0.0,
+        }
+    }
+
+    /// [`TopGrid::new`] that also keeps what lies under each cell's top
+    /// layer, `layer` mm thick ([`TopGrid::under`]).
+    pub(crate) fn layered(extent: [f64; 2], base: f64, layer: f64) -> TopGrid {
+        let mut g = TopGrid::new(extent, base);
+        g.under = vec![f32::NEG_INFINITY; g.top.len()];
+        g.layer_lo = vec![f32::INFINITY; g.top.len()];
+        g.layer = layer as f32;
+        g
+    }
+
+    /// Raises cell `i` to a bead from `bot` to `top` high. A bead that
+    /// rises past the top layer starts a new one, the old layer moving
+    /// under it unless all of it still lies in the new layer.
+    #[inline]
+    fn lift(&mut self, i: usize, bot: f32, top: f32) {
+        let old = self.top[i];
+        self.top[i] = larger(old, top);
+        if self.under.is_empty() {
+            return;
+        }
+        let (under, lo) = (&mut self.under[i], &mut self.layer_lo[i]);
+        let new = self.top[i];
+        // Also when either is NaN: moving clay under is always safe.
+        if (*lo).partial_cmp(&(new - self.layer)) != Some(std::cmp::Ordering::Greater) {
+            *under = under.max(old);
+            *lo = f32::INFINITY;
+        }
+        if bot > new - self.layer {
+            *lo = lo.min(bot);
+        } else {
+            *under = under.max(top);
+        }
+    }
+
+    /// The highest any point of a bead raised in cell `i` can be while at
+    /// most `lim`: at most the cell's top, and only the clay under its
+    /// top layer if all of the top layer lies above `lim`. A
+    /// [`TopGrid::new`] grid knows only its tops.
+    #[inline]
+    pub(crate) fn highest_under(&self, i: usize, lim: f64) -> f64 {
+        let top = f64::from(self.top[i]).min(lim);
+        match self.layer_lo.get(i) {
+            Some(&lo) if f64::from(lo) > lim => f64::from(self.under[i]).min(top),
+            _ => top,
         }
     }
 
@@ -77,11 +136,11 @@ impl TopGrid {
         )
     }
 
-    pub(crate) fn raise_box(&mut self, (xs, ys): ([usize; 2], [usize; 2]), top: f32) {
+    pub(crate) fn raise_box(&mut self, (xs, ys): ([usize; 2], [usize; 2]), bot: f32, top: f32) {
         let nx = self.n[0];
         for y in ys[0]..ys[1] + 1 {
-            for v in &mut self.top[y * nx + xs[0]..y * nx + xs[1] + 1] {
-                *v = larger(*v, top);
+            for x in xs[0]..xs[1] + 1 {
+                self.lift(y * nx + x, bot, top);
             }
         }
         for row in self.blocks((xs, ys)) {
@@ -122,6 +181,7 @@ impl TopGrid {
     pub(crate) fn raise(&mut self, b: &Bead) {
         let (f, t) = (b.from(), b.to());
         let top = b.top32();
+        let bot = b.from32[2].min(b.to32[2]);
         self.widest = self.widest.max(b.width32);
         let (xs, ys) = self.range(
             [f[0].min(t[0]), f[1].min(t[1])],
@@ -142,20 +202,20 @@ impl TopGrid {
                 (xs[0], ys[1]),
                 (xs[1], ys[1]),
             ] {
-                self.top[y * nx + x] = larger(self.top[y * nx + x], top);
+                self.lift(y * nx + x, bot, top);
                 let c = &mut self.coarse[y / 4 * self.bx + x / 4];
                 *c = larger(*c, top);
             }
             if xs[1] - xs[0] == 2 || ys[1] - ys[0] == 2 {
                 let (xm, ym) = ((xs[0] + xs[1]) / 2, (ys[0] + ys[1]) / 2);
                 for (x, y) in [(xm, ys[0]), (xm, ym), (xm, ys[1]), (xs[0], ym), (xs[1], ym)] {
-                    self.top[y * nx + x] = larger(self.top[y * nx + x], top);
+                    self.lift(y * nx + x, bot, top);
                 }
             }
             return;
         }
         if (xs[1] - xs[0] + 1) * (ys[1] - ys[0] + 1) <= 16 {
-            return self.raise_box((xs, ys), top);
+            return self.raise_box((xs, ys), bot, top);
         }
         let len = len2(t[0] - f[0], t[1] - f[1]);
         let steps = ((2.0 * len / self.cell).ceil() as usize).min(1 << 20);
@@ -166,7 +226,7 @@ impl TopGrid {
             // of these, so in its cell or a neighbour.
             let r = 0.5 * self.cell;
             let cells = self.range([p[0] - r, p[1] - r], [p[0] + r, p[1] + r]);
-            self.raise_box(cells, top);
+            self.raise_box(cells, bot, top);
         }
     }
 
@@ -198,6 +258,74 @@ impl TopGrid {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn layered_cells_bound_the_clay_under_their_top_layer() {
+        // Short beads of random heights and slopes, in layers and not, in
+        // a small grid (many beads a cell): every bead through a cell is
+        // either wholly in its top layer or under its `under` bound, and
+        // `highest_under` bounds every point of every bead under a limit.
+        let mut seed = 0x2545_f491_4f6c_dd1du64;
+        let mut rand = move |hi: f64| (crate::xorshift(&mut seed) % 1_000_000) as f64 / 1e6 * hi;
+        let mut flat_tops = 0;
+        for round in 0..40 {
+            let mut g = TopGrid::layered([20.0, 20.0], 2.0, 0.3);
+            let mut beads = Vec::new();
+            for k in 0..400 {
+                let z = if round % 2 == 0 {
+                    1.25 * (1 + k / 100) as f64
+                } else {
+                    rand(6.0)
+                };
+                let from = [rand(20.0), rand(20.0), z];
+                let rise = if round % 2 == 0 || rand(1.0) < 0.7 {
+                    0.0
+                } else {
+                    rand(1.0) - 0.5
+                };
+                let to = [
+                    from[0] + rand(3.0) - 1.5,
+                    from[1] + rand(3.0) - 1.5,
+                    z + rise,
+                ];
+                let b = Bead::new(from, to, 3.0, 0.0, false);
+                g.raise(&b);
+                beads.push(b);
+            }
+            for b in &beads {
+                let (f, t) = (b.from(), b.to());
+                for k in 0..=50 {
+                    let u = f64::from(k) / 50.0;
+                    let p = [0, 1, 2].map(|a| f[a] + u * (t[a] - f[a]));
+                    let i = g.index(p[1], 1) * g.n[0] + g.index(p[0], 0);
+                    let (bot, top) = (f[2].min(t[2]) as f32, b.top32());
+                    assert!(
+                        (bot >= g.layer_lo[i] && g.layer_lo[i] > g.top[i] - g.layer)
+                            || top <= g.under[i],
+                        "round {round}: bead {bot}..{top}, cell {} {} {}",
+                        g.top[i],
+                        g.layer_lo[i],
+                        g.under[i]
+                    );
+                    for lim in [0.5, 1.0, 2.2, 3.45, 5.0] {
+                        if p[2] <= lim {
+                            assert!(g.highest_under(i, lim) >= f64::from(p[2] as f32) - 1e-6);
+                        }
+                    }
+                }
+            }
+            if round % 2 == 0 {
+                // Flat layers: under the top layer's own limit, only the
+                // layer below counts.
+                let i = g.index(10.0, 1) * g.n[0] + g.index(10.0, 0);
+                if g.top[i] == 5.0 {
+                    flat_tops += 1;
+                    assert!(g.highest_under(i, 5.0 - 0.3) <= 3.75 + 1e-6);
+                }
+            }
+        }
+        assert!(flat_tops > 5, "{flat_tops}");
+    }
 
     #[test]
     fn column_top_blocks_bound_their_cells() {

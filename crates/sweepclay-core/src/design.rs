@@ -307,7 +307,9 @@ impl Design {
     /// ([`Error::TooLarge`]), or that cannot fit its printer: the surface
     /// starts and ends at Ψ's first and last points on the bed and is as
     /// tall there as the profiles, so if those leave the build volume the
-    /// whole does ([`Error::DoesNotFit`], as slicing would say).
+    /// whole does ([`Error::DoesNotFit`], as slicing would say). A closed
+    /// B-spline Ψ does not pass through its control points, so for a
+    /// closed Ψ only the height is checked here (slicing checks the rest).
     pub fn check_size(&self, max_samples: f64) -> crate::Result<()> {
         let estimate = self.estimated_samples();
         if estimate > max_samples {
@@ -322,7 +324,11 @@ impl Design {
         let top = |c: &CurveSpec| c.control_points.last().map_or(0.0, |p| p[1]);
         let mut lo = [f64::INFINITY; 3];
         let mut hi = [f64::NEG_INFINITY; 3];
-        let ends = pts.first().into_iter().chain(pts.last());
+        let ends = pts
+            .first()
+            .into_iter()
+            .chain(pts.last())
+            .filter(|_| !t.closed);
         for p in ends {
             for a in 0..2 {
                 lo[a] = lo[a].min(pr.origin[a] + p[a]);
@@ -394,6 +400,29 @@ mod tests {
             let est = d.estimated_samples();
             assert!(est >= real && est < 3.0 * real, "{name}: {est} vs {real}");
         }
+    }
+
+    #[test]
+    fn a_closed_spline_is_not_sized_by_its_control_points() {
+        // A periodic B-spline over a square's corners (±40 mm) runs inside
+        // ±27 mm: it fits a 70 mm bed its corners leave. The same points
+        // as an open spline start and end outside it.
+        let text = |closed: bool| {
+            format!(
+                r#"{{"sweepclay": 1,
+                "profile_start": {{ "control_points": [[0, 0], [0, 20]] }},
+                "profile_end": {{ "control_points": [[0, 0], [0, 20]] }},
+                "trajectory": {{ "control_points": [[40, 40], [-40, 40], [-40, -40], [40, -40]], "closed": {closed} }},
+                "printer": {{ "name": "small", "build_volume": [70, 70, 70], "origin": [35, 35] }}}}"#
+            )
+        };
+        let closed = Design::from_json(&text(true)).unwrap();
+        closed.check_size(1e6).unwrap();
+        let open = Design::from_json(&text(false)).unwrap();
+        assert!(matches!(
+            open.check_size(1e6),
+            Err(Error::DoesNotFit { .. })
+        ));
     }
 
     #[test]

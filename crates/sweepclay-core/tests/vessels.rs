@@ -152,11 +152,15 @@ proptest! {
         let top = t.points.iter().map(|q| q.pos[2]).fold(0.0, f64::max);
         let rim = s.corrected.surface.columns.iter().map(|c| c.height).fold(0.0, f64::max);
         prop_assert!((rim - top).abs() <= p.max_layer_height + 1e-9);
-        // The independent checker's full search agrees (its fast path,
-        // which `slice` runs, can refuse a good vessel: docs/CHECKER.md,
-        // "Known gaps").
+        // The independent checker, as `slice` runs it and by its full
+        // search, says printable with the same findings (the two may name
+        // a different support for a few beads: docs/CHECKER.md, "Known
+        // gaps").
         let r = common::check_full(&s);
         prop_assert!(r.printable, "{}\ndesign:\n{}", r.render(), d.to_json());
+        let fast = common::check_fast(&s);
+        prop_assert!(fast.printable, "{}\ndesign:\n{}", fast.render(), d.to_json());
+        prop_assert_eq!(&fast.findings, &r.findings);
         prop_assert_eq!(r.extrusion_runs, 1);
         prop_assert_eq!(r.findings[sweepclay_check::Finding::UnderMinOverlap].count, 0);
     }

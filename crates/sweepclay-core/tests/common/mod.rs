@@ -43,6 +43,12 @@ pub fn check_sliced(s: &Sliced) -> Report {
     report
 }
 
+/// The checker alone, as `slice` runs it.
+#[allow(dead_code)]
+pub fn check_fast(s: &Sliced) -> Report {
+    check(&gcode::to_string(s), &config(s))
+}
+
 /// The checker's plain full search, the reference its fast path must
 /// agree with (for vessels it does not always: docs/CHECKER.md, "Known
 /// gaps").
