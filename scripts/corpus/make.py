@@ -19,6 +19,7 @@ snapshot. Run from anywhere: `python3 scripts/corpus/make.py`.
 
 import glob
 import math
+import re
 import os
 import shutil
 import subprocess
@@ -314,6 +315,13 @@ def edits():
             again.append(f"G1 X{x:.3f} Y100.000 Z{z:.3f} E{2.0 * WIDTH * LAYER * e_mm3:.5f} F1500")
     w[end:end] = again
     save("twice", w)
+    # Clay piled at the turns: each of the python wall's 1.25 mm steps up
+    # extrudes the clay of 4 mm of full bead (a cuboid as the paper's
+    # tall ends got), not the rounded end of the new layer.
+    w = load("python-wall")
+    pile = f"E{4.0 * WIDTH * LAYER * e_mm3:.5f}"
+    w = [re.sub(r"E[0-9.]+", pile, l) if l.startswith("G1 Z") and " E" in l else l for l in w]
+    save("turn-pile", w)
 
 
 def main():

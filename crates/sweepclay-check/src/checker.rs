@@ -9,7 +9,7 @@ use crate::geom::{larger, len2, minmax, overlap_fraction, smaller};
 use crate::grid::{settle, BeadGrid};
 use crate::parse::{Diagnostic, Line, LineParser};
 use crate::replay::{Event, Move, Replayer};
-use crate::report::{Finding, Report, Segment};
+use crate::report::{Finding, Report, Segment, TURN_FACTOR};
 use crate::support::{follow_support, on_bare_bed, search_support, Query, Recent, Scratch, Walk};
 use crate::tops::TopGrid;
 use crate::verdict::verdict;
@@ -266,6 +266,10 @@ struct Checker<'a> {
     /// [`MAX_FAILURES`]).
     failures: usize,
     deep: bool,
+    /// Turnaround steps since the last bead: their first line, their clay
+    /// (mm³) and their rise (mm), judged by the width of the bead after
+    /// them (docs/CHECKER.md, "Turns").
+    turn: Option<(usize, f64, f64)>,
     stretch: Stretch,
     /// The last judged bead was a stub, and its overlap.
     prev_stub: bool,
@@ -323,6 +327,7 @@ impl<'a> Checker<'a> {
             min_area: 0.01 * cfg.width_min * cfg.min_layer_mm,
             failures: 0,
             deep: true,
+            turn: None,
             stretch: Stretch::default(),
             prev_stub: false,
             prev_overlap: 0.0,
@@ -727,6 +732,7 @@ impl<'a> Checker<'a> {
             prev_overlap,
             lead,
             bent_before,
+            turn: pending_turn,
             ..
         } = self;
         // Its failures, recorded once the borrows below end (at most one
@@ -771,6 +777,9 @@ impl<'a> Checker<'a> {
         let mut on_clay = false;
         if step {
             r.support.steps += 1;
+            let t = pending_turn.get_or_insert((m.line, 0.0, 0.0));
+            t.1 += volume;
+            t.2 += rise;
         } else if *deep {
             let mid = [
                 0.5 * (m.from[0] + m.to[0]),
@@ -933,6 +942,25 @@ impl<'a> Checker<'a> {
                 }
             }
         }
+        let mut pile = None;
+        // The steps before this bead make the end of its layer: they need
+        // the half disc of a bead as wide as this one, as high as they
+        // climbed.
+        if !step {
+            if let Some((line, laid, rise)) = pending_turn.take() {
+                let w = if width.is_finite() {
+                    width.clamp(cfg.width_min, cfg.width_max)
+                } else {
+                    cfg.width_min
+                };
+                let need = std::f64::consts::PI / 8.0 * w * w * rise;
+                r.support.turn_clay_mm3[0] += laid;
+                r.support.turn_clay_mm3[1] += need;
+                if laid > TURN_FACTOR * need {
+                    pile = Some((line, laid / need));
+                }
+            }
+        }
         let mut bead = Bead::new(
             m.from,
             m.to,
@@ -965,6 +993,9 @@ impl<'a> Checker<'a> {
         }
         for &(kind, v) in &held[..n_held] {
             self.record(kind, m.line, v, false);
+        }
+        if let Some((line, ratio)) = pile {
+            self.record(Finding::TurnPile, line, ratio, false);
         }
         if self.lead.print_run.is_some() {
             return;

@@ -64,11 +64,19 @@ pub enum Finding {
     Overhang,
     /// A number firmwares read differently (`Z5e-05`).
     AmbiguousNumber,
+    /// A turnaround step carrying more than [`TURN_FACTOR`] times the clay
+    /// the end of the bead after it needs: clay piles up at the turn
+    /// (docs/CHECKER.md, "Turns"). Worst: that ratio.
+    TurnPile,
 }
+
+/// How much more clay than the end of the next bead needs a turnaround
+/// step may carry before it counts as a pile (docs/CHECKER.md, "Turns").
+pub const TURN_FACTOR: f64 = 2.0;
 
 impl Finding {
     /// Every kind, in the order reports list them.
-    pub const ALL: [Finding; 14] = [
+    pub const ALL: [Finding; 15] = [
         Finding::TravelMove,
         Finding::Retraction,
         Finding::Pause,
@@ -83,6 +91,7 @@ impl Finding {
         Finding::UnderMinOverlap,
         Finding::Overhang,
         Finding::AmbiguousNumber,
+        Finding::TurnPile,
     ];
 
     /// The row of the text report (with the unit of the worst value).
@@ -102,6 +111,7 @@ impl Finding {
             Finding::UnderMinOverlap => "overlap < minimum",
             Finding::Overhang => "overhang > limit (deg)",
             Finding::AmbiguousNumber => "ambiguous numbers",
+            Finding::TurnPile => "clay piled at turns (x)",
         }
     }
 
@@ -122,6 +132,9 @@ impl Finding {
             Finding::UnderMinOverlap => "bead(s) overlapping the bead below by less than half",
             Finding::Overhang => "overhang(s) beyond the limit",
             Finding::AmbiguousNumber => "number(s) that firmwares read differently",
+            Finding::TurnPile => {
+                "turnaround step(s) carrying more than twice the clay the end of the next bead needs (it piles up at the turn)"
+            }
         }
     }
 }
@@ -205,6 +218,9 @@ pub struct SupportStats {
     pub on_bed: usize,
     /// Vertical steps (turnarounds): extruding moves steeper than 1:2.
     pub steps: usize,
+    /// Clay laid on the steps and what they need, the half-disc end of
+    /// the bead after each (mm³; docs/CHECKER.md, "Turns").
+    pub turn_clay_mm3: [f64; 2],
     /// Beads laid on clay at about their own height (a vase's first turn
     /// rising from its flat first loop, a seam): pressed into the clay
     /// below rather than resting a layer above it.
@@ -325,7 +341,10 @@ impl Report {
             if c.count > 0
                 || !matches!(
                     f,
-                    Finding::IntoBed | Finding::FirstLayerHigh | Finding::AmbiguousNumber
+                    Finding::IntoBed
+                        | Finding::FirstLayerHigh
+                        | Finding::AmbiguousNumber
+                        | Finding::TurnPile
                 )
             {
                 row(&mut s, f.label(), format!("{} {}", c.count, at(c)));
@@ -340,6 +359,19 @@ impl Report {
                 sp.beads, sp.on_bed, sp.steps
             ),
         );
+        if sp.steps > 0 {
+            let [laid, need] = sp.turn_clay_mm3;
+            row(
+                &mut s,
+                "clay at turns",
+                format!(
+                    "{:.2} ml laid, {:.2} ml needed ({:.2}x; at most {TURN_FACTOR}x a step)",
+                    laid / 1000.0,
+                    need / 1000.0,
+                    if need > 0.0 { laid / need } else { 0.0 }
+                ),
+            );
+        }
         if let Some((v, l)) = sp.min_overlap {
             row(
                 &mut s,

@@ -120,6 +120,7 @@ fn each_hand_made_fault_fails_for_its_fault() {
             "laid on clay at their own height",
             &[][..],
         ),
+        ("fault-turn-pile.gcode", "piles up at the turn", &[][..]),
     ] {
         println!("{file}");
         let r = report(file);

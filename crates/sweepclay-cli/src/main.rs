@@ -364,8 +364,30 @@ fn slice(a: SliceArgs) -> Result<i32> {
             say!("                     thicker than asked because {why}");
         }
         say!("  path length        {:.1} m", st.path_length_mm / 1000.0);
-        say!("  clay volume        {:.1} ml", st.volume_ml);
+        say!(
+            "  clay               {:.1} ml, {:.0} g",
+            st.volume_ml,
+            st.clay_g
+        );
+        if st.print_scale != [1.0, 1.0] {
+            say!(
+                "  firing shrinkage   printed {:.1} % larger across and {:.1} % taller, so the fired piece has the designed size",
+                (st.print_scale[0] - 1.0) * 100.0,
+                (st.print_scale[1] - 1.0) * 100.0
+            );
+        }
+        if st.turn_steps > 0 {
+            say!(
+                "  clay at turns      {:.2} ml at {} turnaround steps, each the rounded end of its layer ({:.2} ml as cuboids)",
+                st.turn_clay_ml,
+                st.turn_steps,
+                st.turn_clay_cuboid_ml
+            );
+        }
         say!("  estimated time     {:.1} min", st.time_min);
+        for w in &st.warnings {
+            say!("  warning            {w}");
+        }
         let corr = sliced.corrected.report.summary();
         if corr.is_empty() {
             say!("  corrections        none");

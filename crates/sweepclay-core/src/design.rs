@@ -125,6 +125,16 @@ pub struct Params {
     /// Omitted: [`DEFAULT_FLOOR_LAYERS`] for a vessel.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub floor_layers: Option<u32>,
+    /// Slow the nozzle on a turnaround step that lays more clay a
+    /// millimetre than the bead before it, so the extruder's flow stays
+    /// even through the turn (docs/ALGORITHMS.md §6). Default on.
+    pub even_turn_flow: bool,
+    /// Firing shrinkage across (x, y), a fraction: the piece is printed
+    /// 1 / (1 − s) larger so that it has the designed size after the
+    /// kiln (docs/ALGORITHMS.md §6). Default 0.
+    pub shrinkage_xy: f64,
+    /// Firing shrinkage in height, the same way. Default 0.
+    pub shrinkage_z: f64,
 }
 
 /// Floor layers of a vessel when `params.floor_layers` is omitted.
@@ -146,6 +156,9 @@ impl Default for Params {
             max_overhang_deg: 57.0,
             feedrate: 2000.0,
             floor_layers: None,
+            even_turn_flow: true,
+            shrinkage_xy: 0.0,
+            shrinkage_z: 0.0,
         }
     }
 }
@@ -180,6 +193,9 @@ impl Params {
         range("params.overlap", self.overlap, 0.5, 0.95)?;
         range("params.max_overhang_deg", self.max_overhang_deg, 1.0, 80.0)?;
         range("params.feedrate", self.feedrate, 1.0, 100_000.0)?;
+        // Clay bodies shrink 5–20 % in the kiln; past a half, a typo.
+        range("params.shrinkage_xy", self.shrinkage_xy, 0.0, 0.5)?;
+        range("params.shrinkage_z", self.shrinkage_z, 0.0, 0.5)?;
         if let Some(f) = self.floor_layers {
             if f > MAX_FLOOR_LAYERS {
                 return Err(Error::invalid(
@@ -224,6 +240,9 @@ impl Params {
         "max_overhang_deg",
         "feedrate",
         "floor_layers",
+        "even_turn_flow",
+        "shrinkage_xy",
+        "shrinkage_z",
     ];
 
     /// Sets one parameter by name (`--set key=value`).
@@ -238,6 +257,16 @@ impl Params {
             self.floor_layers = Some(value as u32);
             return Ok(());
         }
+        if key == "even_turn_flow" {
+            if value != 0.0 && value != 1.0 {
+                return Err(Error::invalid(
+                    "params.even_turn_flow",
+                    format!("must be 1 (on) or 0 (off) (got {value})"),
+                ));
+            }
+            self.even_turn_flow = value == 1.0;
+            return Ok(());
+        }
         let slot = match key {
             "layer_height" => &mut self.layer_height,
             "max_layer_height" => &mut self.max_layer_height,
@@ -248,6 +277,8 @@ impl Params {
             "overlap" => &mut self.overlap,
             "max_overhang_deg" => &mut self.max_overhang_deg,
             "feedrate" => &mut self.feedrate,
+            "shrinkage_xy" => &mut self.shrinkage_xy,
+            "shrinkage_z" => &mut self.shrinkage_z,
             _ => {
                 return Err(Error::invalid(
                     format!("params.{key}"),
@@ -297,6 +328,43 @@ impl Design {
         Ok(d)
     }
 
+    /// The piece as printed: the geometry enlarged by 1 / (1 − s) across
+    /// (profiles' offsets, Ψ) and in height (profiles' z) for the firing
+    /// shrinkages `params.shrinkage_xy` and `shrinkage_z`, so that it has
+    /// the designed size after the kiln (docs/ALGORITHMS.md §6). Layer
+    /// heights, bead widths and the printer are not scaled: they are the
+    /// process, not the piece. Without shrinkage, the design itself.
+    pub fn printed(&self) -> Design {
+        let mut d = self.clone();
+        let (sxy, sz) = (self.params.shrinkage_xy, self.params.shrinkage_z);
+        let scale = |s: f64| {
+            if s > 0.0 && s < 1.0 {
+                1.0 / (1.0 - s)
+            } else {
+                1.0
+            }
+        };
+        let (kxy, kz) = (scale(sxy), scale(sz));
+        if kxy == 1.0 && kz == 1.0 {
+            return d;
+        }
+        for c in [&mut d.profile_start, &mut d.profile_end] {
+            for p in &mut c.control_points {
+                *p = [p[0] * kxy, p[1] * kz];
+            }
+        }
+        let t = &mut d.trajectory;
+        for pts in [t.control_points.as_mut(), t.points.as_mut()]
+            .into_iter()
+            .flatten()
+        {
+            for p in pts.iter_mut() {
+                *p = [p[0] * kxy, p[1] * kxy];
+            }
+        }
+        d
+    }
+
     /// The design as pretty JSON (the format [`Design::from_json`] reads).
     pub fn to_json(&self) -> String {
         serde_json::to_string_pretty(self).expect("a design always serialises")
@@ -311,7 +379,9 @@ impl Design {
     /// B-spline Ψ does not pass through its control points, so for a
     /// closed Ψ only the height is checked here (slicing checks the rest).
     pub fn check_size(&self, max_samples: f64) -> crate::Result<()> {
-        let estimate = self.estimated_samples();
+        let printed = self.printed();
+        let this = &printed;
+        let estimate = this.estimated_samples();
         if estimate > max_samples {
             return Err(Error::TooLarge {
                 estimate,
@@ -319,7 +389,7 @@ impl Design {
             });
         }
         let pr = self.printer.resolve()?;
-        let t = &self.trajectory;
+        let t = &this.trajectory;
         let pts = t.given_points();
         let top = |c: &CurveSpec| c.control_points.last().map_or(0.0, |p| p[1]);
         let mut lo = [f64::INFINITY; 3];
@@ -336,7 +406,7 @@ impl Design {
             }
         }
         lo[2] = 0.0;
-        hi[2] = top(&self.profile_start).max(top(&self.profile_end));
+        hi[2] = top(&this.profile_start).max(top(&this.profile_end));
         for a in 0..3 {
             let (min, max) = (pr.bed_min[a], pr.bed_min[a] + pr.build_volume[a]);
             if lo[a] < min - 1e-9 || hi[a] > max + 1e-9 {

@@ -10,7 +10,10 @@
 //! s ≤ w_max (1 − overlap) from the support-free correction, every bead then
 //! overlaps the one below by at least the target fraction of its width.
 //!
-//! The volume of a move is the cuboid L · w̄ · Δz̄ (paper Fig. 5).
+//! The volume of a move is the cuboid L · w̄ · Δz̄ (paper Fig. 5), except
+//! a turnaround step, which climbs its own column to start the next layer:
+//! it gets the clay the end of that layer needs, the half disc
+//! (π/8) · w² · Δz of the new bead's rounded end (docs/ALGORITHMS.md §6).
 
 use crate::design::Params;
 use crate::toolpath::Toolpath;
@@ -27,9 +30,23 @@ pub struct Extrusion {
     pub volume: Vec<f64>,
     /// Sum of `volume` (mm³).
     pub total_volume: f64,
+    /// Of it, the clay of the turnaround steps (mm³).
+    pub turn_volume: f64,
+    /// What the steps would get as cuboids, as the paper extrudes them
+    /// (mm³): the clay that piled up at the turns.
+    pub turn_volume_cuboid: f64,
     /// Sum of move lengths (mm).
     pub path_length: f64,
+    /// Moves printed slower than the feedrate, in order: the move's index
+    /// (the point it ends at) and the fraction of the feedrate (a step
+    /// laying more clay a millimetre than the bead before it, with
+    /// `params.even_turn_flow`).
+    pub slow: Vec<(u32, f64)>,
 }
+
+/// The slowest a step is printed, as a fraction of the feedrate: a
+/// screw or piston cannot slow much further without stalling the clay.
+pub const MIN_TURN_FEED: f64 = 0.25;
 
 /// Overlap of a bead of width `wa` with one of width `wb` whose centre is
 /// `s` to the side, as a fraction of `wa`.
@@ -75,12 +92,33 @@ pub fn plan_extrusion(path: &Toolpath, params: &Params) -> Extrusion {
         }
     }
     let mut volume = Vec::with_capacity(n);
-    let (mut total, mut length) = (0.0, 0.0);
+    let (mut total, mut length, mut turn, mut turn_cuboid) = (0.0, 0.0, 0.0, 0.0);
+    let mut slow = Vec::new();
+    // Clay a millimetre of the last bead that was no step.
+    let mut bead_rate = f64::NAN;
     volume.push(0.0);
     for i in 1..n {
         let (a, b) = (path.points[i - 1].pos, path.points[i].pos);
         let l = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
-        let v = l * 0.5 * (width[i] + width[i - 1]) * 0.5 * (layer_height[i] + layer_height[i - 1]);
+        let cuboid =
+            l * 0.5 * (width[i] + width[i - 1]) * 0.5 * (layer_height[i] + layer_height[i - 1]);
+        let v = if is_step(path, i) {
+            turn_cuboid += cuboid;
+            let v = step_volume(width[i], b[2] - a[2]);
+            turn += v;
+            // The extruder keeps the bead's flow: the nozzle slows where
+            // the step lays more clay a millimetre.
+            let rate = v / l.max(1e-9);
+            if params.even_turn_flow && rate > bead_rate {
+                slow.push((i as u32, (bead_rate / rate).max(MIN_TURN_FEED)));
+            }
+            v
+        } else {
+            if l > 1e-9 {
+                bead_rate = cuboid / l;
+            }
+            cuboid
+        };
         volume.push(v);
         total += v;
         length += l;
@@ -90,8 +128,33 @@ pub fn plan_extrusion(path: &Toolpath, params: &Params) -> Extrusion {
         layer_height,
         volume,
         total_volume: total,
+        turn_volume: turn,
+        turn_volume_cuboid: turn_cuboid,
         path_length: length,
+        slow,
     }
+}
+
+/// Whether the move into point `i` is a step: it climbs (or drops) at
+/// least half as much as it runs in plan, as the checker reads a step
+/// (docs/CHECKER.md, "Turns"). Such a move does not lie on the bead below
+/// (its clay would run down it): the turnarounds of the zig-zag, which
+/// climb their own column, and the steepest stretches of a top edge.
+pub fn is_step(path: &Toolpath, i: usize) -> bool {
+    let Some(prev) = i.checked_sub(1) else {
+        return false;
+    };
+    let (p, q) = (path.points[i].pos, path.points[prev].pos);
+    let rise = (p[2] - q[2]).abs();
+    rise > 0.0 && (p[0] - q[0]).hypot(p[1] - q[1]) <= 2.0 * rise
+}
+
+/// The clay a step lays (mm³): the rounded end of the new layer's bead, a
+/// half disc of its width `w` as high as the step climbs (`dz`), so E
+/// keeps rising and the turn gets what it needs, not the cuboid of a bead
+/// as long as the climb.
+pub fn step_volume(w: f64, dz: f64) -> f64 {
+    std::f64::consts::PI / 8.0 * w * w * dz.abs()
 }
 
 #[cfg(test)]
@@ -161,10 +224,64 @@ mod tests {
     }
 
     #[test]
-    fn volume_is_the_cuboid() {
+    fn a_beads_volume_is_the_cuboid() {
+        // Two points 10 mm apart on the bed, 1.25 mm high, 3 mm wide.
+        let mut t = column(&[0.0, 10.0], 1.25);
+        t.points[1].pos[2] = 1.25;
+        t.below = vec![None, None];
+        let e = plan_extrusion(&t, &Params::default());
+        assert!((e.total_volume - 10.0 * 3.0 * 1.25).abs() < 1e-12);
+        assert_eq!(e.turn_volume, 0.0);
+    }
+
+    #[test]
+    fn a_step_laying_more_clay_a_millimetre_than_its_bead_is_slowed() {
+        // A 10 mm bead on the bed, then a 1.25 mm step up its end.
+        let mut t = column(&[0.0, 10.0, 10.0], 1.25);
+        t.points[1].pos[2] = 1.25;
+        t.points[2].pos[2] = 2.5;
+        t.below = vec![None, None, Some(1)];
+        // 3 mm beads: 3.75 mm³ a mm on the bead, π/8 · 9 = 3.53 on the
+        // step: even already.
+        let e = plan_extrusion(&t, &Params::default());
+        assert!(e.slow.is_empty(), "{:?}", e.slow);
+        // 6 mm beads: 7.5 on the bead, π/8 · 36 = 14.1 on the step.
+        let wide = Params {
+            width_min: 6.0,
+            ..Params::default()
+        };
+        let e = plan_extrusion(&t, &wide);
+        assert_eq!(e.slow.len(), 1);
+        let (at, k) = e.slow[0];
+        assert_eq!(at, 2);
+        assert!(
+            (k - 7.5 / (std::f64::consts::PI / 8.0 * 36.0)).abs() < 1e-12,
+            "{k}"
+        );
+        let off = Params {
+            even_turn_flow: false,
+            ..wide
+        };
+        assert!(plan_extrusion(&t, &off).slow.is_empty());
+    }
+
+    #[test]
+    fn a_steps_volume_is_the_half_disc_end_of_the_new_layer() {
+        // One vertical step of 1.25 mm up its own column, width 3: the
+        // half disc π/8 · 3² · 1.25, where the cuboid gave 1.25 · 3 · 1.25.
         let t = column(&[0.0, 0.0], 1.25);
         let e = plan_extrusion(&t, &Params::default());
-        // One vertical move of 1.25 mm, width 3, layer 1.25.
-        assert!((e.total_volume - 1.25 * 3.0 * 1.25).abs() < 1e-12);
+        let half_disc = std::f64::consts::PI / 8.0 * 9.0 * 1.25;
+        assert!((e.total_volume - half_disc).abs() < 1e-12);
+        assert!((e.turn_volume - half_disc).abs() < 1e-12);
+        assert!((e.turn_volume_cuboid - 1.25 * 3.0 * 1.25).abs() < 1e-12);
+        // A climb of 2.5 mm over 2 mm of plan at w = 6 (the pile):
+        // the cuboid is a 3.2 mm bead, 48 mm³; the step needs 35 mm³.
+        assert!((step_volume(6.0, 2.5) - std::f64::consts::PI / 8.0 * 36.0 * 2.5).abs() < 1e-12);
+        // A move that runs more than twice as far as it climbs is a bead,
+        // not a step.
+        let slant = column(&[0.0, 3.0], 1.25);
+        assert!(!is_step(&slant, 1));
+        assert!(is_step(&t, 1));
     }
 }

@@ -82,6 +82,22 @@ pub fn emit<W: Write>(s: &Sliced, out: &mut W) -> io::Result<Vec<usize>> {
     }
     writeln!(out, "; path_length_mm: {:.1}", st.path_length_mm)?;
     writeln!(out, "; clay_volume_ml: {:.2}", st.volume_ml)?;
+    writeln!(out, "; clay_mass_g: {:.0}", st.clay_g)?;
+    for w in &st.warnings {
+        writeln!(out, "; warning: {w}")?;
+    }
+    if st.print_scale != [1.0, 1.0] {
+        writeln!(
+            out,
+            "; firing_shrinkage: printed {:.4}x across, {:.4}x in height, to fire to the designed size",
+            st.print_scale[0], st.print_scale[1]
+        )?;
+    }
+    writeln!(
+        out,
+        "; turn_clay_ml: {:.3} at {} steps (cuboid rule: {:.3})",
+        st.turn_clay_ml, st.turn_steps, st.turn_clay_cuboid_ml
+    )?;
     writeln!(out, "; estimated_time_min: {:.1}", st.time_min)?;
     for line in s.corrected.report.summary() {
         writeln!(out, "; correction: {line}")?;
@@ -274,6 +290,8 @@ pub fn emit_typed_moves<W: Write>(
     let mut e_total = 0.0f64;
     let mut e_printed = 0.0f64;
     let (mut last_w, mut last_h) = (i64::MIN, i64::MIN);
+    let mut slow = ex.slow.iter().peekable();
+    let mut was_slow = false;
     for i in 1..n {
         let w = 0.5 * (ex.width[i] + ex.width[i - 1]);
         let h = 0.5 * (ex.layer_height[i] + ex.layer_height[i - 1]);
@@ -309,11 +327,24 @@ pub fn emit_typed_moves<W: Write>(
             e_printed
         };
         buf.extend_from_slice(b"G1 ");
-        if i == 1 {
+        // The feedrate on the first move, and around each slowed step.
+        let slowed = match slow.peek() {
+            Some(&&(at, k)) if at as usize == i => {
+                slow.next();
+                Some(k)
+            }
+            _ => None,
+        };
+        if let Some(k) = slowed {
+            buf.push(b'F');
+            push_fixed(&mut buf, f.feed_mm_min * k, 1);
+            buf.push(b' ');
+        } else if i == 1 || was_slow {
             buf.push(b'F');
             buf.extend_from_slice(f.feed_mm_min.to_string().as_bytes());
             buf.push(b' ');
         }
+        was_slow = slowed.is_some();
         xyz(&mut buf, pos(i));
         buf.extend_from_slice(b" E");
         push_fixed(&mut buf, e, 5);
@@ -364,7 +395,10 @@ mod tests {
             layer_height,
             volume,
             total_volume,
+            turn_volume: 0.0,
+            turn_volume_cuboid: 0.0,
             path_length: 0.0,
+            slow: Vec::new(),
         }
     }
 
@@ -401,6 +435,30 @@ mod tests {
              G1 X102.000 Y50.000 Z1.250 E0.75000\n\
              ;WIDTH:3.500\n\
              G1 X103.000 Y50.000 Z2.500 E1.25000\n"
+        );
+    }
+
+    #[test]
+    fn a_slowed_step_has_its_feedrate_and_the_next_move_the_print_one() {
+        let pts = [
+            [0.0, 0.0, 1.25],
+            [1.0, 0.0, 1.25],
+            [1.0, 0.0, 2.5],
+            [0.0, 0.0, 2.5],
+        ];
+        let mut e = ex(vec![3.0; 4], vec![1.25; 4], vec![0.0, 3.75, 3.5, 3.75]);
+        e.slow = vec![(2, 0.5)];
+        let mut out = Vec::new();
+        emit_moves(&mut out, pts.len(), |i| pts[i], &e, &FMT).unwrap();
+        let text = String::from_utf8(out).unwrap();
+        let g1: Vec<&str> = text.lines().filter(|l| l.starts_with("G1")).collect();
+        assert_eq!(
+            g1,
+            [
+                "G1 F2000 X101.000 Y50.000 Z1.250 E0.37500",
+                "G1 F1000.0 X101.000 Y50.000 Z2.500 E0.72500",
+                "G1 F2000 X100.000 Y50.000 Z2.500 E1.10000",
+            ]
         );
     }
 

@@ -81,12 +81,28 @@ pub struct Stats {
     pub path_length_mm: f64,
     /// Clay volume (ml).
     pub volume_ml: f64,
+    /// Clay mass (g), at the printer's `clay_density_g_ml`.
+    pub clay_g: f64,
+    /// Of it, the clay of the turnaround steps (ml): the rounded ends of
+    /// the layers (docs/ALGORITHMS.md §6).
+    pub turn_clay_ml: f64,
+    /// What the steps would have got as cuboids, a bead as long as each
+    /// climb (ml): the clay the paper saw pile up at the turns.
+    pub turn_clay_cuboid_ml: f64,
+    /// Turnaround steps.
+    pub turn_steps: usize,
+    /// How much larger than designed the piece is printed, across and in
+    /// height, for the firing shrinkage (1 without).
+    pub print_scale: [f64; 2],
     /// Printing time at the feedrate, plus the first rapid move (min).
     pub time_min: f64,
     /// Bed coordinates of the bounding box: `[[xmin, ymin, zmin], [xmax, ymax, zmax]]`.
     pub bounds_mm: [[f64; 3]; 2],
     /// The layer heights the path really uses.
     pub layers: LayerStats,
+    /// What a potter should know before printing: more clay than the
+    /// cartridge holds, a piece that may topple or sag while wet.
+    pub warnings: Vec<String>,
     /// A vessel's floor and wall, else `None`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub vessel: Option<VesselStats>,
@@ -291,6 +307,15 @@ fn stats(c: &Corrected, t: &Toolpath, e: &Extrusion) -> Stats {
         curves: c.surface.columns.len(),
         path_length_mm: e.path_length,
         volume_ml: e.total_volume / 1000.0,
+        clay_g: e.total_volume / 1000.0 * pr.clay_density_g_ml,
+        warnings: warnings(pr, e),
+        turn_clay_ml: e.turn_volume / 1000.0,
+        turn_clay_cuboid_ml: e.turn_volume_cuboid / 1000.0,
+        print_scale: [c.surface.params.shrinkage_xy, c.surface.params.shrinkage_z]
+            .map(|s| 1.0 / (1.0 - s)),
+        turn_steps: (1..t.points.len())
+            .filter(|&i| extrude::is_step(t, i))
+            .count(),
         time_min: e.path_length / c.surface.params.feedrate + travel / pr.travel_feedrate,
         bounds_mm: [lo, hi],
         layers: layer_stats(c),
@@ -301,6 +326,19 @@ fn stats(c: &Corrected, t: &Toolpath, e: &Extrusion) -> Stats {
             wall_turns: v.turns,
         }),
     }
+}
+
+/// The warnings of [`Stats::warnings`].
+fn warnings(pr: &Printer, e: &Extrusion) -> Vec<String> {
+    let mut w = Vec::new();
+    let ml = e.total_volume / 1000.0;
+    if let Some(c) = pr.cartridge_ml.filter(|&c| ml > c) {
+        w.push(format!(
+            "the print needs {ml:.0} ml of clay, more than printer `{}`'s cartridge holds ({c:.0} ml): it cannot print in one continuous extrusion; make it smaller or thinner, or use a larger cartridge",
+            pr.name
+        ));
+    }
+    w
 }
 
 #[cfg(test)]
@@ -314,6 +352,78 @@ mod tests {
                 "trajectory":{{"control_points":[[-60,40],[0,70],[60,40]]}}}}"#
         ))
         .unwrap()
+    }
+
+    #[test]
+    fn clay_is_weighed_and_a_print_larger_than_the_cartridge_is_warned_of() {
+        let with = |cartridge: Option<f64>| {
+            let mut d = examples::scaled(10_000);
+            if let PrinterRef::Inline(p) = &mut d.printer {
+                p.cartridge_ml = cartridge;
+                p.clay_density_g_ml = 2.0;
+            }
+            slice(&d).unwrap().stats
+        };
+        let st = with(None);
+        assert!((st.clay_g - 2.0 * st.volume_ml).abs() < 1e-9);
+        assert!(st.warnings.is_empty(), "{:?}", st.warnings);
+        assert!(with(Some(st.volume_ml + 1.0)).warnings.is_empty());
+        let small = with(Some(st.volume_ml / 2.0));
+        assert_eq!(small.warnings.len(), 1);
+        assert!(
+            small.warnings[0].contains("cartridge"),
+            "{:?}",
+            small.warnings
+        );
+    }
+
+    #[test]
+    fn firing_shrinkage_prints_a_cylinder_larger_by_one_over_one_minus_s() {
+        // A cylinder: a 64-gon of radius 30 mm, profiles straight up 40 mm.
+        let ring: Vec<String> = (0..64)
+            .map(|k| {
+                let a = std::f64::consts::TAU * f64::from(k) / 64.0;
+                format!("[{:.6}, {:.6}]", 30.0 * a.cos(), 30.0 * a.sin())
+            })
+            .collect();
+        let design = |sxy: f64, sz: f64| {
+            Design::from_json(&format!(
+                r#"{{"sweepclay":1,"profile_start":{{"control_points":[[0,0],[0,40]]}},
+                    "profile_end":{{"control_points":[[0,0],[0,40]]}},
+                    "trajectory":{{"points":[{}],"closed":true}},
+                    "params":{{"shrinkage_xy":{sxy},"shrinkage_z":{sz}}}}}"#,
+                ring.join(",")
+            ))
+            .unwrap()
+        };
+        let reach = |s: &Sliced| {
+            let r = s
+                .toolpath
+                .points
+                .iter()
+                .map(|p| p.pos[0].hypot(p.pos[1]))
+                .fold(0.0, f64::max);
+            let z = s
+                .toolpath
+                .points
+                .iter()
+                .map(|p| p.pos[2])
+                .fold(0.0, f64::max);
+            (r, z)
+        };
+        let (r0, z0) = reach(&slice(&design(0.0, 0.0)).unwrap());
+        assert!(
+            (r0 - 30.0).abs() < 0.01 && (z0 - 40.0).abs() < 1e-6,
+            "{r0} {z0}"
+        );
+        let shrunk = slice(&design(0.2, 0.1)).unwrap();
+        let (r, z) = reach(&shrunk);
+        assert!((r - 30.0 / 0.8).abs() < 0.01, "{r}");
+        assert!((z - 40.0 / 0.9).abs() < 1e-6, "{z}");
+        assert_eq!(shrunk.stats.print_scale, [1.25, 1.0 / 0.9]);
+        // Layers are the process, not the piece: within the bounds asked.
+        let [lo, hi] = shrunk.stats.layers.lower_mm;
+        assert!(lo >= 1.25 - 1e-9 && hi <= 2.5 + 1e-9, "{lo} {hi}");
     }
 
     #[test]

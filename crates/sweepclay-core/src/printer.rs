@@ -31,6 +31,16 @@ pub struct Printer {
     pub nozzle_radius: f64,
     /// Feedrate of the single rapid move to the first point, mm/min.
     pub travel_feedrate: f64,
+    /// Density of the clay body as printed (g/ml), for the clay's mass.
+    /// Default 1.9: a plastic clay body of about 22 % water by mass whose
+    /// mineral solids are 2.6 g/cm³ (kaolinite 2.6, quartz 2.65) has
+    /// 1 / (0.22 / 1.0 + 0.78 / 2.6) = 1.92 g/ml (docs/FORMATS.md).
+    pub clay_density_g_ml: f64,
+    /// How much clay the cartridge, tank or tube holds (ml); a print
+    /// that needs more is warned of (it cannot be continuous). Omitted:
+    /// not known.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cartridge_ml: Option<f64>,
     /// G-code sent before the first move.
     pub start_gcode: String,
     /// G-code sent after the last move.
@@ -48,6 +58,8 @@ impl Default for Printer {
             relative_e: false,
             nozzle_radius: 5.0,
             travel_feedrate: 2400.0,
+            clay_density_g_ml: 1.9,
+            cartridge_ml: None,
             start_gcode: "G28 ; home all axes\nG92 E0\n".into(),
             end_gcode: "M84 ; motors off\n".into(),
         }
@@ -109,6 +121,10 @@ impl Printer {
         }
         positive(&format!("{key}.e_per_mm3"), self.e_per_mm3)?;
         positive(&format!("{key}.travel_feedrate"), self.travel_feedrate)?;
+        positive(&format!("{key}.clay_density_g_ml"), self.clay_density_g_ml)?;
+        if let Some(c) = self.cartridge_ml {
+            positive(&format!("{key}.cartridge_ml"), c)?;
+        }
         if !self.nozzle_radius.is_finite() || self.nozzle_radius < 0.0 {
             return Err(Error::invalid(
                 format!("{key}.nozzle_radius"),

@@ -149,8 +149,11 @@ fn normal(pts: &[[f64; 2]], i: usize, closed: bool) -> [f64; 2] {
 
 /// Samples the design's surface. Validates every part of the design first.
 pub fn sample_surface(design: &Design) -> Result<Surface> {
+    design.params.validate()?;
+    // What is printed: the design enlarged for the kiln's shrinkage.
+    let printed = design.printed();
+    let design = &printed;
     let params = design.params.clone();
-    params.validate()?;
     let printer = design.printer.resolve()?;
     let start = Profile::new("profile_start", &design.profile_start)?;
     let end = Profile::new("profile_end", &design.profile_end)?;

@@ -316,7 +316,7 @@ function render(data, fit) {
         ['returning turns', s.returning_points],
       ]),
     ['path length', `${(s.path_length_mm / 1000).toFixed(2)} m`],
-    ['clay volume', `${s.volume_ml.toFixed(1)} ml`],
+    ['clay', `${s.volume_ml.toFixed(1)} ml, ${s.clay_g.toFixed(0)} g`],
     ['printing time', `${s.time_min.toFixed(1)} min`],
   ];
   $('stats').innerHTML = rows.map(([k, v]) => `<tr><td>${k}</td><td data-stat="${k}">${v}</td></tr>`).join('');

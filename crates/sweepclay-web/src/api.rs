@@ -320,6 +320,7 @@ fn view(s: &Sliced, moved: Vec<u32>, slice_ms: f64) -> SliceView {
             s.toolpath.returning_points
         ));
     }
+    warnings.extend(s.stats.warnings.iter().cloned());
     let pr = &surf.printer;
     let b = &s.stats.bounds_mm;
     let fill = (0..3)
