@@ -267,9 +267,11 @@ struct Checker<'a> {
     failures: usize,
     deep: bool,
     /// Turnaround steps since the last bead: their first line, their clay
-    /// (mm³) and their rise (mm), judged by the width of the bead after
-    /// them (docs/CHECKER.md, "Turns").
-    turn: Option<(usize, f64, f64)>,
+    /// (mm³), their rise (mm) and the width of the bead before them,
+    /// judged with the bead after them (docs/CHECKER.md, "Turns").
+    turn: Option<(usize, f64, f64, f64)>,
+    /// The width of the last bead that was no step (mm).
+    last_width: f64,
     stretch: Stretch,
     /// The last judged bead was a stub, and its overlap.
     prev_stub: bool,
@@ -328,6 +330,7 @@ impl<'a> Checker<'a> {
             failures: 0,
             deep: true,
             turn: None,
+            last_width: 0.0,
             stretch: Stretch::default(),
             prev_stub: false,
             prev_overlap: 0.0,
@@ -595,10 +598,14 @@ impl<'a> Checker<'a> {
             self.in_run = false;
         }
         // Bounds (the machine cannot go there, start code or not).
-        let out =
+        let mut out =
             m.to.iter()
                 .zip(cfg.build_volume)
                 .fold(0.0f64, |o, (&v, lim)| larger(larger(o, -v), v - lim));
+        if let Some(d) = cfg.bed_diameter {
+            let c = [cfg.build_volume[0] / 2.0, cfg.build_volume[1] / 2.0];
+            out = larger(out, (m.to[0] - c[0]).hypot(m.to[1] - c[1]) - d / 2.0);
+        }
         if out > 1e-3 {
             self.failures += 1;
             self.r.findings[Finding::OutOfBounds].add(m.line, out);
@@ -733,6 +740,7 @@ impl<'a> Checker<'a> {
             lead,
             bent_before,
             turn: pending_turn,
+            last_width,
             ..
         } = self;
         // Its failures, recorded once the borrows below end (at most one
@@ -777,7 +785,7 @@ impl<'a> Checker<'a> {
         let mut on_clay = false;
         if step {
             r.support.steps += 1;
-            let t = pending_turn.get_or_insert((m.line, 0.0, 0.0));
+            let t = pending_turn.get_or_insert((m.line, 0.0, 0.0, *last_width));
             t.1 += volume;
             t.2 += rise;
         } else if *deep {
@@ -944,15 +952,17 @@ impl<'a> Checker<'a> {
         }
         let mut pile = None;
         // The steps before this bead make the end of its layer: they need
-        // the half disc of a bead as wide as this one, as high as they
-        // climbed.
+        // the half disc of a bead as wide as the wider of the two they join
+        // (a thin top-edge bead after a step still ends a wide layer), as
+        // high as they climbed.
         if !step {
-            if let Some((line, laid, rise)) = pending_turn.take() {
-                let w = if width.is_finite() {
-                    width.clamp(cfg.width_min, cfg.width_max)
-                } else {
-                    cfg.width_min
-                };
+            let w = if width.is_finite() {
+                width.clamp(cfg.width_min, cfg.width_max)
+            } else {
+                cfg.width_min
+            };
+            if let Some((line, laid, rise, before)) = pending_turn.take() {
+                let w = w.max(before.min(cfg.width_max));
                 let need = std::f64::consts::PI / 8.0 * w * w * rise;
                 r.support.turn_clay_mm3[0] += laid;
                 r.support.turn_clay_mm3[1] += need;
@@ -960,6 +970,7 @@ impl<'a> Checker<'a> {
                     pile = Some((line, laid / need));
                 }
             }
+            *last_width = w;
         }
         let mut bead = Bead::new(
             m.from,

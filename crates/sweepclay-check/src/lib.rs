@@ -75,6 +75,9 @@ pub struct CheckConfig {
     /// (the default) for a bed with its origin at a corner, `[-R, -R, 0]`
     /// for a delta or a WASP with the origin at the bed's centre.
     pub bed_min: [f64; 3],
+    /// A round bed's diameter (a delta's), centred in the box's plan: a
+    /// move farther from its centre is out of bounds too. Default none.
+    pub bed_diameter: Option<f64>,
     /// The printer the file is judged for, as the report names it
     /// (default `generic`).
     pub printer: String,
@@ -122,6 +125,7 @@ impl Default for CheckConfig {
         CheckConfig {
             build_volume: [200.0, 200.0, 200.0],
             bed_min: [0.0, 0.0, 0.0],
+            bed_diameter: None,
             printer: "generic".into(),
             firmware: Firmware::Marlin,
             e_per_mm3: 0.13,
@@ -220,6 +224,12 @@ impl CheckConfig {
         }
         if let Some(v) = bad(&self.bed_min, f64::is_finite) {
             return err("bed_min", format!("must be finite numbers (got {v})"));
+        }
+        if let Some(d) = self.bed_diameter.filter(|d| !(d.is_finite() && *d > 0.0)) {
+            return err(
+                "bed_diameter",
+                format!("must be a positive number of mm (got {d})"),
+            );
         }
         for (field, v) in [
             ("e_per_mm3", self.e_per_mm3),

@@ -720,6 +720,46 @@ fn a_centred_bed_is_the_box_from_bed_min() {
 }
 
 #[test]
+fn a_round_bed_refuses_the_corners_of_its_box() {
+    // A delta's Ø 200 mm bed centred on the origin (the box from −100):
+    // the wall from x = −90 reaches 103 mm from the centre at (−90, −50),
+    // inside the box.
+    let centre = |text: &str| -> String {
+        text.lines()
+            .map(|l| {
+                l.split(' ')
+                    .map(|w| {
+                        let shift = |p: char| {
+                            w.strip_prefix(p)
+                                .and_then(|v| v.parse::<f64>().ok())
+                                .map(|v| format!("{p}{:.3}", v - 100.0))
+                        };
+                        shift('X')
+                            .or_else(|| shift('Y'))
+                            .unwrap_or_else(|| w.to_string())
+                    })
+                    .collect::<Vec<_>>()
+                    .join(" ")
+            })
+            .collect::<Vec<_>>()
+            .join("\n")
+    };
+    let boxed = CheckConfig {
+        bed_min: [-100.0, -100.0, 0.0],
+        ..CheckConfig::default()
+    };
+    let round = CheckConfig {
+        bed_diameter: Some(200.0),
+        ..boxed.clone()
+    };
+    let corner = centre(&wall_from(10.0, 60.0, 6).out);
+    assert!(check(&corner, &boxed).printable);
+    only(&check(&corner, &round), "outside the build volume");
+    let r = check(&centre(&wall(6).out), &round);
+    assert!(r.printable, "{}", r.render());
+}
+
+#[test]
 fn options_out_of_range_are_refused_by_name() {
     let with = |set: fn(&mut CheckConfig)| {
         let mut c = CheckConfig::default();

@@ -54,6 +54,13 @@ enum Command {
     /// Start the modeler: a local web page to draw, preview and print
     /// designs. Prints its URL; Ctrl+C stops it.
     Serve(ServeArgs),
+    /// List the printer presets: build volume, bed, extruder body,
+    /// motion limits and cartridge (`--json` for every value).
+    Printers {
+        /// Every preset as JSON (the keys a design's `printer` takes).
+        #[arg(long)]
+        json: bool,
+    },
 }
 
 #[derive(Args, Debug)]
@@ -222,6 +229,41 @@ fn run(cli: Cli) -> Result<i32> {
         Command::Slice(a) => slice(a),
         Command::Check(a) => check_cmd(a),
         Command::Serve(a) => serve(a),
+        Command::Printers { json } => {
+            let all: Vec<Printer> = PRESETS.iter().filter_map(|n| Printer::preset(n)).collect();
+            if json {
+                say!("{}", serde_json::to_string_pretty(&all)?);
+                return Ok(0);
+            }
+            for p in &all {
+                let bed = match p.bed_diameter {
+                    Some(d) => format!("round, Ø {d:.0} mm, {:.0} mm high", p.build_volume[2]),
+                    None => format!(
+                        "{:.0} × {:.0} × {:.0} mm",
+                        p.build_volume[0], p.build_volume[1], p.build_volume[2]
+                    ),
+                };
+                say!(
+                    "{:<16} {bed}; o at ({}, {}), box from ({}, {}, {}); body r {} mm; {:.0} mm/s², corners {} mm{}{}",
+                    p.name,
+                    p.origin[0],
+                    p.origin[1],
+                    p.bed_min[0],
+                    p.bed_min[1],
+                    p.bed_min[2],
+                    p.nozzle_radius,
+                    p.acceleration_mm_s2,
+                    p.junction_deviation_mm,
+                    p.max_flow_mm3_s
+                        .map(|f| format!("; extruder ≤ {f} mm³/s"))
+                        .unwrap_or_default(),
+                    p.cartridge_ml
+                        .map(|c| format!("; cartridge {c:.0} ml"))
+                        .unwrap_or_default(),
+                );
+            }
+            Ok(0)
+        }
         Command::Examples { dir } => {
             std::fs::create_dir_all(&dir).with_context(|| format!("creating {}", dir.display()))?;
             for (name, text) in examples::EXAMPLES {
@@ -268,7 +310,7 @@ fn slice(a: SliceArgs) -> Result<i32> {
     }
     let mut design = Design::from_json(&text).with_context(|| source.clone())?;
     if let Some(p) = &a.printer {
-        design.printer = PrinterRef::Inline(load_printer(p)?);
+        design.printer = PrinterRef::Inline(Box::new(load_printer(p)?));
     }
     for s in &a.sets {
         let (k, v) = s

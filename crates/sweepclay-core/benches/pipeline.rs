@@ -53,7 +53,13 @@ fn stages(c: &mut Criterion, group: &str, name: &str, d: &Design, samples: u64) 
         b.iter(|| toolpath::plan_path(black_box(&corrected)))
     });
     g.bench_function(BenchmarkId::new("extrusion", name), |b| {
-        b.iter(|| extrude::plan_extrusion(black_box(&path), &corrected.surface.params))
+        b.iter(|| {
+            extrude::plan_extrusion(
+                black_box(&path),
+                &corrected.surface.params,
+                corrected.surface.printer.origin,
+            )
+        })
     });
     g.bench_function(BenchmarkId::new("gcode", name), |b| {
         b.iter(|| {

@@ -51,6 +51,16 @@ pub enum Error {
         /// The build volume's highest coordinate along the axis.
         limit: f64,
     },
+    /// The printed object would leave a round bed (a delta's).
+    #[error("the design does not fit printer `{printer}`: it reaches {reach:.1} mm from the bed's centre but the round bed is {diameter:.0} mm across")]
+    OffRoundBed {
+        /// Printer name.
+        printer: String,
+        /// Farthest plan distance from the bed's centre, bead edge included.
+        reach: f64,
+        /// The bed's diameter.
+        diameter: f64,
+    },
     /// The design has more surface samples than the caller allows
     /// (estimated from its control polygons before anything is sampled).
     #[error("params.spacing / params.layer_height: the design would have about {:.1} million samples, over the limit of {:.1} million; raise the spacing or the layer height", .estimate / 1e6, .limit / 1e6)]

@@ -50,12 +50,12 @@ pub fn scaled(samples: usize) -> crate::Design {
             .iter_mut()
             .for_each(|q| q[1] *= 240.0 / top);
     }
-    d.printer = PrinterRef::Inline(Printer {
+    d.printer = PrinterRef::Inline(Box::new(Printer {
         name: "bench-400".into(),
         build_volume: [400.0, 400.0, 400.0],
         origin: [200.0, 200.0],
         ..Printer::preset("generic").expect("generic is a preset")
-    });
+    }));
     // About 110,000 samples at 1.1 mm × 1.25 mm; samples ∝ 1 / (spacing ·
     // layer height).
     let base = 110_000.0 * 1.1 * 1.25;

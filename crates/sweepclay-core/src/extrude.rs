@@ -35,6 +35,8 @@ pub struct Extrusion {
     /// What the steps would get as cuboids, as the paper extrudes them
     /// (mm³): the clay that piled up at the turns.
     pub turn_volume_cuboid: f64,
+    /// How many moves are steps ([`is_step`]).
+    pub turn_steps: usize,
     /// Sum of move lengths (mm).
     pub path_length: f64,
     /// Moves printed slower than the feedrate, in order: the move's index
@@ -56,8 +58,10 @@ pub fn overlap_fraction(wa: f64, wb: f64, s: f64) -> f64 {
     ((hi - lo).max(0.0) / wa).min(1.0)
 }
 
-/// Computes widths and volumes.
-pub fn plan_extrusion(path: &Toolpath, params: &Params) -> Extrusion {
+/// Computes widths and volumes. `origin` is where the path's origin lands
+/// on the bed (the printer's): steps are told from beads on the
+/// coordinates the G-code will carry, as the checker reads them.
+pub fn plan_extrusion(path: &Toolpath, params: &Params, origin: [f64; 2]) -> Extrusion {
     let n = path.points.len();
     let (wmin, wmax, ov) = (params.width_min, params.width_max, params.overlap);
     let mut width = vec![wmin; n];
@@ -93,17 +97,27 @@ pub fn plan_extrusion(path: &Toolpath, params: &Params) -> Extrusion {
     }
     let mut volume = Vec::with_capacity(n);
     let (mut total, mut length, mut turn, mut turn_cuboid) = (0.0, 0.0, 0.0, 0.0);
+    let mut turn_steps = 0;
     let mut slow = Vec::new();
     // Clay a millimetre of the last bead that was no step.
     let mut bead_rate = f64::NAN;
     volume.push(0.0);
     for i in 1..n {
         let (a, b) = (path.points[i - 1].pos, path.points[i].pos);
-        let l = ((a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2) + (a[2] - b[2]).powi(2)).sqrt();
+        let xy2 = (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2);
+        let l = (xy2 + (a[2] - b[2]).powi(2)).sqrt();
         let cuboid =
             l * 0.5 * (width[i] + width[i - 1]) * 0.5 * (layer_height[i] + layer_height[i - 1]);
-        let v = if is_step(path, i) {
+        // Most moves run far more than they climb: no step, as is_step
+        // would find at once.
+        let v = if xy2 > (2.0 * (b[2] - a[2]).abs() + 0.01).powi(2) {
+            if l > 1e-9 {
+                bead_rate = cuboid / l;
+            }
+            cuboid
+        } else if is_step(path, i, origin) {
             turn_cuboid += cuboid;
+            turn_steps += 1;
             let v = step_volume(width[i], b[2] - a[2]);
             turn += v;
             // The extruder keeps the bead's flow: the nozzle slows where
@@ -130,6 +144,7 @@ pub fn plan_extrusion(path: &Toolpath, params: &Params) -> Extrusion {
         total_volume: total,
         turn_volume: turn,
         turn_volume_cuboid: turn_cuboid,
+        turn_steps,
         path_length: length,
         slow,
     }
@@ -137,14 +152,35 @@ pub fn plan_extrusion(path: &Toolpath, params: &Params) -> Extrusion {
 
 /// Whether the move into point `i` is a step: it climbs (or drops) at
 /// least half as much as it runs in plan, as the checker reads a step
-/// (docs/CHECKER.md, "Turns"). Such a move does not lie on the bead below
-/// (its clay would run down it): the turnarounds of the zig-zag, which
-/// climb their own column, and the steepest stretches of a top edge.
-pub fn is_step(path: &Toolpath, i: usize) -> bool {
+/// (docs/CHECKER.md, "Turns"), on the coordinates the G-code carries
+/// (3 decimals, with the path's `origin` on the bed added) so the two
+/// agree on a move at the boundary. Such a move does not lie on the bead
+/// below (its clay would run down it): the turnarounds of the zig-zag,
+/// which climb their own column, and the steepest stretches of a top
+/// edge.
+pub fn is_step(path: &Toolpath, i: usize, origin: [f64; 2]) -> bool {
     let Some(prev) = i.checked_sub(1) else {
         return false;
     };
+    let at = |k: usize| {
+        let p = path.points[k].pos;
+        let r = |v: f64| (v * 1000.0).round() / 1000.0;
+        [r(p[0] + origin[0]), r(p[1] + origin[1]), r(p[2])]
+    };
+    // Rounding moves each coordinate by at most 0.0005 mm: away from the
+    // boundary the exact coordinates answer (in squares: no root).
     let (p, q) = (path.points[i].pos, path.points[prev].pos);
+    let (xy2, two_rise) = (
+        (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2),
+        2.0 * (p[2] - q[2]).abs(),
+    );
+    if xy2 > (two_rise + 0.01).powi(2) {
+        return false;
+    }
+    if two_rise > 0.01 && xy2 < (two_rise - 0.01).powi(2) {
+        return true;
+    }
+    let (p, q) = (at(i), at(prev));
     let rise = (p[2] - q[2]).abs();
     rise > 0.0 && (p[0] - q[0]).hypot(p[1] - q[1]) <= 2.0 * rise
 }
@@ -197,7 +233,7 @@ mod tests {
     #[test]
     fn vertical_wall_keeps_minimum_width() {
         let t = column(&[0.0, 0.0, 0.0], 1.25);
-        let e = plan_extrusion(&t, &Params::default());
+        let e = plan_extrusion(&t, &Params::default(), [0.0; 2]);
         assert_eq!(e.width, vec![3.0; 3]);
         assert_eq!(e.layer_height, vec![1.25; 3]);
     }
@@ -207,7 +243,7 @@ mod tests {
         // Offsets 0, 1.5 (w = 3·1.5 = 4.5), then 1.5 + 0.5 (w stays 4.5 from below link).
         let t = column(&[0.0, 1.5, 2.0], 1.25);
         let p = Params::default();
-        let e = plan_extrusion(&t, &p);
+        let e = plan_extrusion(&t, &p, [0.0; 2]);
         assert!((e.width[1] - 4.5).abs() < 1e-12, "{:?}", e.width);
         assert!(
             (e.width[0] - 4.5).abs() < 1e-12,
@@ -229,7 +265,7 @@ mod tests {
         let mut t = column(&[0.0, 10.0], 1.25);
         t.points[1].pos[2] = 1.25;
         t.below = vec![None, None];
-        let e = plan_extrusion(&t, &Params::default());
+        let e = plan_extrusion(&t, &Params::default(), [0.0; 2]);
         assert!((e.total_volume - 10.0 * 3.0 * 1.25).abs() < 1e-12);
         assert_eq!(e.turn_volume, 0.0);
     }
@@ -243,14 +279,14 @@ mod tests {
         t.below = vec![None, None, Some(1)];
         // 3 mm beads: 3.75 mm³ a mm on the bead, π/8 · 9 = 3.53 on the
         // step: even already.
-        let e = plan_extrusion(&t, &Params::default());
+        let e = plan_extrusion(&t, &Params::default(), [0.0; 2]);
         assert!(e.slow.is_empty(), "{:?}", e.slow);
         // 6 mm beads: 7.5 on the bead, π/8 · 36 = 14.1 on the step.
         let wide = Params {
             width_min: 6.0,
             ..Params::default()
         };
-        let e = plan_extrusion(&t, &wide);
+        let e = plan_extrusion(&t, &wide, [0.0; 2]);
         assert_eq!(e.slow.len(), 1);
         let (at, k) = e.slow[0];
         assert_eq!(at, 2);
@@ -262,7 +298,7 @@ mod tests {
             even_turn_flow: false,
             ..wide
         };
-        assert!(plan_extrusion(&t, &off).slow.is_empty());
+        assert!(plan_extrusion(&t, &off, [0.0; 2]).slow.is_empty());
     }
 
     #[test]
@@ -270,7 +306,7 @@ mod tests {
         // One vertical step of 1.25 mm up its own column, width 3: the
         // half disc π/8 · 3² · 1.25, where the cuboid gave 1.25 · 3 · 1.25.
         let t = column(&[0.0, 0.0], 1.25);
-        let e = plan_extrusion(&t, &Params::default());
+        let e = plan_extrusion(&t, &Params::default(), [0.0; 2]);
         let half_disc = std::f64::consts::PI / 8.0 * 9.0 * 1.25;
         assert!((e.total_volume - half_disc).abs() < 1e-12);
         assert!((e.turn_volume - half_disc).abs() < 1e-12);
@@ -281,7 +317,7 @@ mod tests {
         // A move that runs more than twice as far as it climbs is a bead,
         // not a step.
         let slant = column(&[0.0, 3.0], 1.25);
-        assert!(!is_step(&slant, 1));
-        assert!(is_step(&t, 1));
+        assert!(!is_step(&slant, 1, [0.0; 2]));
+        assert!(is_step(&t, 1, [0.0; 2]));
     }
 }

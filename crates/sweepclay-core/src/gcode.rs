@@ -60,6 +60,9 @@ pub fn emit<W: Write>(s: &Sliced, out: &mut W) -> io::Result<Vec<usize>> {
         pr.build_volume[0], pr.build_volume[1], pr.build_volume[2], pr.bed_min[0], pr.bed_min[1],
         pr.bed_min[2], o[0], o[1], pr.e_per_mm3, pr.relative_e, pr.nozzle_radius
     )?;
+    if let Some(d) = pr.bed_diameter {
+        writeln!(out, "; printer_params: bed_diameter={d}")?;
+    }
     writeln!(
         out,
         "; size_mm: {:.1} x {:.1} x {:.1}",
@@ -397,6 +400,7 @@ mod tests {
             total_volume,
             turn_volume: 0.0,
             turn_volume_cuboid: 0.0,
+            turn_steps: 0,
             path_length: 0.0,
             slow: Vec::new(),
         }

@@ -46,8 +46,10 @@ pub mod grid;
 pub mod import;
 pub mod layers;
 pub mod mesh;
+pub mod motion;
 pub mod preview;
 pub mod printer;
+pub mod stability;
 pub mod surface;
 pub mod toolpath;
 pub mod vessel;
@@ -94,8 +96,12 @@ pub struct Stats {
     /// How much larger than designed the piece is printed, across and in
     /// height, for the firing shrinkage (1 without).
     pub print_scale: [f64; 2],
-    /// Printing time at the feedrate, plus the first rapid move (min).
+    /// Printing time as the firmware's planner spends it (acceleration,
+    /// corners, axis and extruder limits; docs/ALGORITHMS.md §9), plus the
+    /// first rapid move (min).
     pub time_min: f64,
+    /// The path at the feedrate alone, as the paper's model (min).
+    pub time_at_feedrate_min: f64,
     /// Bed coordinates of the bounding box: `[[xmin, ymin, zmin], [xmax, ymax, zmax]]`.
     pub bounds_mm: [[f64; 3]; 2],
     /// The layer heights the path really uses.
@@ -257,9 +263,31 @@ pub fn slice(design: &Design) -> Result<Sliced> {
 /// compute the statistics and check that the result fits the printer.
 pub fn finish(corrected: Corrected) -> Result<Sliced> {
     let toolpath = toolpath::plan_path(&corrected);
-    let extrusion = extrude::plan_extrusion(&toolpath, &corrected.surface.params);
+    let extrusion = extrude::plan_extrusion(
+        &toolpath,
+        &corrected.surface.params,
+        corrected.surface.printer.origin,
+    );
     let stats = stats(&corrected, &toolpath, &extrusion);
     let pr = &corrected.surface.printer;
+    if let Some(d) = pr.bed_diameter {
+        let c = pr.bed_centre();
+        let reach = toolpath
+            .points
+            .iter()
+            .zip(&extrusion.width)
+            .map(|(p, w)| {
+                (p.pos[0] + pr.origin[0] - c[0]).hypot(p.pos[1] + pr.origin[1] - c[1]) + w / 2.0
+            })
+            .fold(0.0, f64::max);
+        if reach > d / 2.0 + 1e-9 {
+            return Err(Error::OffRoundBed {
+                printer: pr.name.clone(),
+                reach,
+                diameter: d,
+            });
+        }
+    }
     for axis in 0..3 {
         let (lo, hi) = (stats.bounds_mm[0][axis], stats.bounds_mm[1][axis]);
         let min = pr.bed_min[axis];
@@ -308,15 +336,18 @@ fn stats(c: &Corrected, t: &Toolpath, e: &Extrusion) -> Stats {
         path_length_mm: e.path_length,
         volume_ml: e.total_volume / 1000.0,
         clay_g: e.total_volume / 1000.0 * pr.clay_density_g_ml,
-        warnings: warnings(pr, e),
+        warnings: warnings(pr, e)
+            .into_iter()
+            .chain(stability::warnings(t, e, c.surface.params.max_layer_height))
+            .collect(),
         turn_clay_ml: e.turn_volume / 1000.0,
         turn_clay_cuboid_ml: e.turn_volume_cuboid / 1000.0,
         print_scale: [c.surface.params.shrinkage_xy, c.surface.params.shrinkage_z]
             .map(|s| 1.0 / (1.0 - s)),
-        turn_steps: (1..t.points.len())
-            .filter(|&i| extrude::is_step(t, i))
-            .count(),
-        time_min: e.path_length / c.surface.params.feedrate + travel / pr.travel_feedrate,
+        turn_steps: e.turn_steps,
+        time_min: planned_min(c, t, e) + travel / pr.travel_feedrate,
+        time_at_feedrate_min: e.path_length / c.surface.params.feedrate
+            + travel / pr.travel_feedrate,
         bounds_mm: [lo, hi],
         layers: layer_stats(c),
         vessel: t.vessel.as_ref().map(|v| VesselStats {
@@ -326,6 +357,29 @@ fn stats(c: &Corrected, t: &Toolpath, e: &Extrusion) -> Stats {
             wall_turns: v.turns,
         }),
     }
+}
+
+/// The planner's time of the path (min): the moves at the feedrate (the
+/// slowed steps slower), from rest at the first point.
+fn planned_min(c: &Corrected, t: &Toolpath, e: &Extrusion) -> f64 {
+    let feed = c.surface.params.feedrate / 60.0;
+    let mut slow = e.slow.iter().peekable();
+    let moves = (1..t.points.len()).map(|i| {
+        let k = match slow.peek() {
+            Some(&&(at, k)) if at as usize == i => {
+                slow.next();
+                k
+            }
+            _ => 1.0,
+        };
+        motion::Move {
+            to: t.points[i].pos,
+            feed: feed * k,
+            volume: e.volume[i],
+        }
+    });
+    let start = t.points.first().map_or([0.0; 3], |p| p.pos);
+    motion::print_time(start, moves, &motion::Limits::of(&c.surface.printer)) / 60.0
 }
 
 /// The warnings of [`Stats::warnings`].
@@ -352,6 +406,32 @@ mod tests {
                 "trajectory":{{"control_points":[[-60,40],[0,70],[60,40]]}}}}"#
         ))
         .unwrap()
+    }
+
+    #[test]
+    fn a_round_bed_refuses_what_leaves_its_circle() {
+        // A 100 mm straight wall on the WASP 2040 Clay's Ø 200 mm bed: at
+        // y = −50 its ends are 71 mm from the centre; at y = −90, 103 mm,
+        // though still inside the 200 mm box.
+        let at = |y: f64| {
+            Design::from_json(&format!(
+                r#"{{"sweepclay":1,"profile_start":{{"control_points":[[0,0],[0,10]]}},
+                    "profile_end":{{"control_points":[[0,0],[0,10]]}},
+                    "trajectory":{{"control_points":[[-50,{y}],[50,{y}]],"offset":"normal"}},
+                    "printer":"wasp-2040-clay"}}"#
+            ))
+            .unwrap()
+        };
+        slice(&at(-50.0)).unwrap();
+        match slice(&at(-90.0)) {
+            Err(Error::OffRoundBed {
+                reach, diameter, ..
+            }) => {
+                assert_eq!(diameter, 200.0);
+                assert!(reach > 100.0 && reach < 106.0, "{reach}");
+            }
+            other => panic!("{:?}", other.map(|s| s.stats.size_mm)),
+        }
     }
 
     #[test]

@@ -20,6 +20,10 @@ pub struct Printer {
     /// 0]` by default; a delta or a WASP with its origin at the bed's
     /// centre is `[-R, -R, 0]`.
     pub bed_min: [f64; 3],
+    /// A round bed's diameter (mm; a delta's): the print must also stay
+    /// within it, centred in the box's plan. Omitted: the box's rectangle.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub bed_diameter: Option<f64>,
     /// Where the design's centre `o` lands on the bed, `[x, y]` in mm.
     pub origin: [f64; 2],
     /// Extrusion calibration: E units per mm³ of clay. Default 0.13.
@@ -31,6 +35,23 @@ pub struct Printer {
     pub nozzle_radius: f64,
     /// Feedrate of the single rapid move to the first point, mm/min.
     pub travel_feedrate: f64,
+    /// Acceleration of printing moves (mm/s², `M204 P`), for the print
+    /// time (docs/ALGORITHMS.md §9). Default 3000, Marlin's
+    /// `DEFAULT_ACCELERATION`.
+    pub acceleration_mm_s2: f64,
+    /// Fastest speed of the x, y and z axes (mm/s, `M203`). Default
+    /// Marlin's `DEFAULT_MAX_FEEDRATE`, 300, 300, 5.
+    pub max_speed_mm_s: [f64; 3],
+    /// Fastest acceleration of the x, y and z axes (mm/s², `M201`).
+    /// Default Marlin's `DEFAULT_MAX_ACCELERATION`, 3000, 3000, 100.
+    pub max_acceleration_mm_s2: [f64; 3],
+    /// Junction deviation (mm), which sets the speed of a corner. Default
+    /// 0.013, Marlin's `JUNCTION_DEVIATION_MM`.
+    pub junction_deviation_mm: f64,
+    /// Most clay the extruder pushes a second (mm³/s); a screw or piston
+    /// is often the slowest axis. Omitted: not limited.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub max_flow_mm3_s: Option<f64>,
     /// Density of the clay body as printed (g/ml), for the clay's mass.
     /// Default 1.9: a plastic clay body of about 22 % water by mass whose
     /// mineral solids are 2.6 g/cm³ (kaolinite 2.6, quartz 2.65) has
@@ -53,11 +74,17 @@ impl Default for Printer {
             name: "generic".into(),
             build_volume: [200.0, 200.0, 200.0],
             bed_min: [0.0, 0.0, 0.0],
+            bed_diameter: None,
             origin: [100.0, 100.0],
             e_per_mm3: 0.13,
             relative_e: false,
             nozzle_radius: 5.0,
             travel_feedrate: 2400.0,
+            acceleration_mm_s2: 3000.0,
+            max_speed_mm_s: [300.0, 300.0, 5.0],
+            max_acceleration_mm_s2: [3000.0, 3000.0, 100.0],
+            junction_deviation_mm: 0.013,
+            max_flow_mm3_s: None,
             clay_density_g_ml: 1.9,
             cartridge_ml: None,
             start_gcode: "G28 ; home all axes\nG92 E0\n".into(),
@@ -67,7 +94,13 @@ impl Default for Printer {
 }
 
 /// Names of the built-in presets, in the order `--help` lists them.
-pub const PRESETS: &[&str] = &["cerambot-plus", "cerambot-mini", "generic"];
+pub const PRESETS: &[&str] = &[
+    "cerambot-plus",
+    "cerambot-mini",
+    "wasp-2040-clay",
+    "wasp-40100-clay",
+    "generic",
+];
 
 impl Printer {
     /// A built-in preset by name.
@@ -89,8 +122,39 @@ impl Printer {
                 origin: [60.0, 67.5],
                 ..base
             }),
+            // WASP's published printing volume of the DeltaWASP 2040
+            // Clay, Ø 200 × 400 mm (www.3dwasp.com, DeltaWASP 2040 Clay,
+            // technical data); a delta with its origin at the bed's
+            // centre.
+            "wasp-2040-clay" => Some(Printer {
+                name: name.into(),
+                build_volume: [200.0, 200.0, 400.0],
+                bed_min: [-100.0, -100.0, 0.0],
+                bed_diameter: Some(200.0),
+                origin: [0.0, 0.0],
+                ..base
+            }),
+            // WASP's published printing volume of the DeltaWASP 40100
+            // Clay, Ø 400 × 1000 mm (www.3dwasp.com, DeltaWASP 40100
+            // Clay, technical data).
+            "wasp-40100-clay" => Some(Printer {
+                name: name.into(),
+                build_volume: [400.0, 400.0, 1000.0],
+                bed_min: [-200.0, -200.0, 0.0],
+                bed_diameter: Some(400.0),
+                origin: [0.0, 0.0],
+                ..base
+            }),
             _ => None,
         }
+    }
+
+    /// The plan centre of the bed: the middle of the box.
+    pub fn bed_centre(&self) -> [f64; 2] {
+        [
+            self.bed_min[0] + self.build_volume[0] / 2.0,
+            self.bed_min[1] + self.build_volume[1] / 2.0,
+        ]
     }
 
     /// Checks every value; `key` is the dotted path used in messages.
@@ -120,8 +184,32 @@ impl Printer {
             }
         }
         positive(&format!("{key}.e_per_mm3"), self.e_per_mm3)?;
+        if let Some(d) = self.bed_diameter {
+            positive(&format!("{key}.bed_diameter"), d)?;
+        }
         positive(&format!("{key}.travel_feedrate"), self.travel_feedrate)?;
         positive(&format!("{key}.clay_density_g_ml"), self.clay_density_g_ml)?;
+        positive(
+            &format!("{key}.acceleration_mm_s2"),
+            self.acceleration_mm_s2,
+        )?;
+        positive(
+            &format!("{key}.junction_deviation_mm"),
+            self.junction_deviation_mm,
+        )?;
+        for i in 0..3 {
+            positive(
+                &format!("{key}.max_speed_mm_s[{i}]"),
+                self.max_speed_mm_s[i],
+            )?;
+            positive(
+                &format!("{key}.max_acceleration_mm_s2[{i}]"),
+                self.max_acceleration_mm_s2[i],
+            )?;
+        }
+        if let Some(f) = self.max_flow_mm3_s {
+            positive(&format!("{key}.max_flow_mm3_s"), f)?;
+        }
         if let Some(c) = self.cartridge_ml {
             positive(&format!("{key}.cartridge_ml"), c)?;
         }
@@ -140,8 +228,9 @@ impl Printer {
 pub enum PrinterRef {
     /// One of [`PRESETS`].
     Preset(String),
-    /// An inline object; missing keys took the `generic` values.
-    Inline(Printer),
+    /// An inline object; missing keys took the `generic` values (boxed:
+    /// a profile is large beside a name).
+    Inline(Box<Printer>),
 }
 
 impl Default for PrinterRef {
@@ -162,7 +251,7 @@ impl PrinterRef {
             }),
             PrinterRef::Inline(p) => {
                 p.validate("printer")?;
-                Ok(p.clone())
+                Ok((**p).clone())
             }
         }
     }
@@ -183,7 +272,7 @@ impl<'de> Deserialize<'de> for PrinterRef {
         match serde_json::Value::deserialize(d)? {
             serde_json::Value::String(s) => Ok(PrinterRef::Preset(s)),
             v @ serde_json::Value::Object(_) => serde_json::from_value(v)
-                .map(PrinterRef::Inline)
+                .map(|p| PrinterRef::Inline(Box::new(p)))
                 .map_err(|e| D::Error::custom(format!("printer: {e}"))),
             other => Err(D::Error::custom(format!(
                 "printer: expected a preset name or an object, got {other}"

@@ -13,6 +13,7 @@ pub fn printer_check(p: &Printer) -> CheckConfig {
     CheckConfig {
         build_volume: p.build_volume,
         bed_min: p.bed_min,
+        bed_diameter: p.bed_diameter,
         printer: p.name.clone(),
         e_per_mm3: p.e_per_mm3,
         nozzle_radius: p.nozzle_radius,
