@@ -217,6 +217,19 @@ async fn draw_preview_and_download_verified_gcode() {
     )
     .await;
     assert_eq!(js(&c, "return window.sweepclayErrors").await, json!([]));
+    // The clay in ml and g, and the planner's time.
+    let clay = js(
+        &c,
+        "return document.querySelector('[data-stat=\"clay\"]').textContent",
+    )
+    .await;
+    assert_eq!(clay, json!("88.8 ml, 169 g"));
+    let time = js(
+        &c,
+        "return document.querySelector('[data-stat=\"printing time\"]').textContent",
+    )
+    .await;
+    assert_eq!(time, json!("10.7 min"));
 
     // Drag the top point of the end profile 40 px up: the design grows.
     let top = point_at(&c, 1, "ed.points.length - 1").await;
