@@ -2,7 +2,8 @@
 //! plain serialisable answers out. Every function is a thin composition of
 //! the library's stages (`sweepclay-core`) and the checker.
 
-use crate::verify::{verify, Verified};
+use crate::guard::{Cancel, CancelWriter};
+use crate::verify::{verify_into, Verified};
 use serde::Serialize;
 use sweepclay_core::mesh;
 use sweepclay_core::toolpath::PointKind;
@@ -257,10 +258,12 @@ fn round2(x: f64) -> f32 {
 /// Slices a design and keeps what the preview shows, including which
 /// samples the corrections moved (the stages run one by one to keep the
 /// uncorrected surface).
-pub fn slice_view(design: &Design) -> Result<SliceView, ApiError> {
+pub fn slice_view(design: &Design, cancel: &Cancel) -> Result<SliceView, ApiError> {
     let t0 = std::time::Instant::now();
     let sampled = surface::sample_surface(design)?;
+    cancel.check()?;
     let corrected = correct::correct(&sampled)?;
+    cancel.check()?;
     let moved: Vec<u32> = sampled
         .samples
         .iter()
@@ -371,9 +374,35 @@ pub struct Verdict {
     pub lines: usize,
 }
 
-/// Slices, emits and checks a design.
-pub fn verified(design: &Design) -> Result<Verified, ApiError> {
-    Ok(verify(&sweepclay_core::slice(design)?, 0.5))
+/// Slices a design stage by stage, stopping between them once `cancel`
+/// is set.
+pub fn sliced(design: &Design, cancel: &Cancel) -> Result<Sliced, ApiError> {
+    let sampled = surface::sample_surface(design)?;
+    cancel.check()?;
+    let corrected = correct::correct(&sampled)?;
+    drop(sampled);
+    cancel.check()?;
+    let s = sweepclay_core::finish(corrected)?;
+    cancel.check()?;
+    Ok(s)
+}
+
+/// Slices, emits and checks a design (stopping once `cancel` is set).
+pub fn verified(design: &Design, cancel: &Cancel) -> Result<Verified, ApiError> {
+    let s = sliced(design, cancel)?;
+    let mut text = Vec::with_capacity(sweepclay_core::gcode::size_hint(&s));
+    let (report, locations) = verify_into(&s, 0.5, CancelWriter(&mut text, cancel.clone()))
+        .map_err(|e| {
+            cancel
+                .check()
+                .err()
+                .unwrap_or_else(|| ApiError::new(500, format!("writing G-code: {e}")))
+        })?;
+    Ok(Verified {
+        gcode: String::from_utf8(text).expect("G-code is ASCII"),
+        report,
+        locations,
+    })
 }
 
 /// The verdict of [`verified`].
@@ -389,12 +418,12 @@ pub fn verdict(v: &Verified) -> Verdict {
 
 /// The G-code of a design, only if it passes the check; otherwise a 422
 /// that says why and where.
-pub fn gcode(design: &Design) -> Result<String, ApiError> {
+pub fn gcode(design: &Design, cancel: &Cancel) -> Result<String, ApiError> {
     let Verified {
         gcode,
         report,
         locations,
-    } = verified(design)?;
+    } = verified(design, cancel)?;
     if report.printable {
         Ok(gcode)
     } else {
@@ -408,8 +437,8 @@ pub fn gcode(design: &Design) -> Result<String, ApiError> {
 }
 
 /// A binary STL of the surface thickened to the bead width.
-pub fn stl(design: &Design) -> Result<Vec<u8>, ApiError> {
-    let s = sweepclay_core::slice(design)?;
+pub fn stl(design: &Design, cancel: &Cancel) -> Result<Vec<u8>, ApiError> {
+    let s = sliced(design, cancel)?;
     let mut out = Vec::new();
     mesh::write_stl(&s, &mut out).map_err(|e| ApiError::new(500, e.to_string()))?;
     Ok(out)
@@ -476,7 +505,7 @@ mod tests {
 
     #[test]
     fn slice_view_indexes_every_sample_once() {
-        let v = slice_view(&design("t2")).unwrap();
+        let v = slice_view(&design("t2"), &Cancel::new()).unwrap();
         let n = v.surface.positions.len() / 3;
         assert_eq!(v.stats.sample_points, n);
         let mut seen = vec![false; n];
@@ -496,7 +525,7 @@ mod tests {
 
     #[test]
     fn binary_form_carries_the_same_arrays() {
-        let v = slice_view(&design("t2")).unwrap();
+        let v = slice_view(&design("t2"), &Cancel::new()).unwrap();
         let b = v.to_binary();
         assert_eq!(&b[..4], b"SWCL");
         let u32_at = |o: usize| u32::from_le_bytes(b[o..o + 4].try_into().unwrap()) as usize;
@@ -540,13 +569,13 @@ mod tests {
 
     #[test]
     fn corrections_mark_moved_samples() {
-        let plain = slice_view(&design("t4")).unwrap();
+        let plain = slice_view(&design("t4"), &Cancel::new()).unwrap();
         assert!(plain.corrections.is_empty() && plain.surface.moved.is_empty());
         // An end profile leaning 45 mm over 20 mm of height overhangs far
         // beyond 57°: the support correction moves its upper samples.
         let mut d = design("t4");
         d.profile_end.control_points = vec![[0.0, 0.0], [45.0, 20.0], [45.0, 40.0]];
-        let v = slice_view(&d).unwrap();
+        let v = slice_view(&d, &Cancel::new()).unwrap();
         assert!(!v.corrections.is_empty());
         assert!(!v.surface.moved.is_empty());
         let n = (v.surface.positions.len() / 3) as u32;
@@ -570,7 +599,7 @@ mod tests {
         assert_eq!(e.status, 400);
         let mut d = design("t1");
         d.params.layer_height = 0.1;
-        let e = slice_view(&d).unwrap_err();
+        let e = slice_view(&d, &Cancel::new()).unwrap_err();
         assert_eq!(
             (e.status, e.key.as_deref()),
             (422, Some("params.layer_height"))
@@ -580,7 +609,7 @@ mod tests {
 
     #[test]
     fn gcode_is_verified() {
-        let text = gcode(&design("t5")).unwrap();
+        let text = gcode(&design("t5"), &Cancel::new()).unwrap();
         assert!(text.contains("G1"));
     }
 }

@@ -19,6 +19,81 @@ use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 use tokio::sync::Semaphore;
 
+/// Set when the request that asked for some work is gone (its client
+/// disconnected, or its time ran out): the work stops at its next check,
+/// between the pipeline's stages and every 64 KiB of G-code written or
+/// read (docs/MODELER.md, "Limits and safety").
+#[derive(Clone, Debug, Default)]
+pub struct Cancel(Arc<std::sync::atomic::AtomicBool>);
+
+impl Cancel {
+    /// A flag not yet set.
+    pub fn new() -> Cancel {
+        Cancel::default()
+    }
+
+    /// Whether the work should stop.
+    pub fn is_set(&self) -> bool {
+        self.0.load(Ordering::Relaxed)
+    }
+
+    /// Asks the work to stop.
+    pub fn set(&self) {
+        self.0.store(true, Ordering::Relaxed);
+    }
+
+    /// An error to end the work with once the flag is set.
+    pub fn check(&self) -> Result<(), ApiError> {
+        if self.is_set() {
+            Err(ApiError::new(
+                503,
+                "the work was stopped: its request went away or ran out of time".to_string(),
+            ))
+        } else {
+            Ok(())
+        }
+    }
+}
+
+/// Sets its flag when dropped: when the request's future is dropped (the
+/// client disconnected) or returns (its time ran out, or it is done).
+struct SetOnDrop(Cancel);
+
+impl Drop for SetOnDrop {
+    fn drop(&mut self) {
+        self.0.set();
+    }
+}
+
+/// A writer that fails once its [`Cancel`] is set, so a long emission or
+/// check stops between chunks.
+pub struct CancelWriter<W>(pub W, pub Cancel);
+
+impl<W: std::io::Write> std::io::Write for CancelWriter<W> {
+    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
+        if self.1.is_set() {
+            return Err(std::io::Error::other("cancelled"));
+        }
+        self.0.write(buf)
+    }
+
+    fn flush(&mut self) -> std::io::Result<()> {
+        self.0.flush()
+    }
+}
+
+/// A reader that fails once its [`Cancel`] is set.
+pub struct CancelReader<R>(pub R, pub Cancel);
+
+impl<R: std::io::Read> std::io::Read for CancelReader<R> {
+    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
+        if self.1.is_set() {
+            return Err(std::io::Error::other("cancelled"));
+        }
+        self.0.read(buf)
+    }
+}
+
 /// The body types the work routes take: both need a CORS preflight.
 pub const BODY_TYPES: [&str; 2] = ["application/json", "application/octet-stream"];
 
@@ -45,12 +120,16 @@ impl Pool {
 
     /// Runs `f` on a blocking thread once a worker is free. Too many
     /// waiting, or no worker within the time limit: 503 with `Retry-After`.
-    /// The worker stays taken until `f` ends, even if the client has gone,
-    /// so the pool bounds the work really running.
+    /// When the request goes away (this future is dropped, or the time
+    /// limit passes) `f`'s [`Cancel`] is set and it stops at its next
+    /// check; the worker stays taken until it has, so the pool bounds the
+    /// work really running.
     pub async fn run<T: Send + 'static>(
         &self,
-        f: impl FnOnce() -> Result<T, ApiError> + Send + 'static,
+        f: impl FnOnce(&Cancel) -> Result<T, ApiError> + Send + 'static,
     ) -> Result<T, ApiError> {
+        let cancel = Cancel::new();
+        let _stop = SetOnDrop(cancel.clone());
         let busy = || {
             ApiError::new(503, "the server is busy: try again in a moment".to_string())
                 .retry_after(2)
@@ -67,7 +146,7 @@ impl Pool {
         };
         let left = self.timeout.saturating_sub(start.elapsed());
         let task = tokio::task::spawn_blocking(move || {
-            let out = f();
+            let out = f(&cancel);
             drop(permit);
             out
         });

@@ -36,6 +36,7 @@ use axum::http::{header, StatusCode};
 use axum::response::{IntoResponse, Response};
 use axum::routing::{get, post};
 use axum::{Json, Router};
+use guard::Cancel;
 use serde::Deserialize;
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -192,13 +193,13 @@ fn text(body: Result<Bytes, BytesRejection>) -> Result<String, ApiError> {
 async fn with_design<T: Send + 'static>(
     limits: Shared,
     body: Result<Bytes, BytesRejection>,
-    f: impl FnOnce(sweepclay_core::Design) -> Result<T, ApiError> + Send + 'static,
+    f: impl FnOnce(sweepclay_core::Design, &Cancel) -> Result<T, ApiError> + Send + 'static,
 ) -> Result<T, ApiError> {
     let text = text(body)?;
     let state = limits.clone();
     state
         .pool
-        .run(move || f(api::parse_design(&text, &limits.limits)?))
+        .run(move |cancel| f(api::parse_design(&text, &limits.limits)?, cancel))
         .await
 }
 
@@ -225,7 +226,7 @@ async fn slice(
             )
         }
     };
-    let view = with_design(limits, body, |d| api::slice_view(&d)).await?;
+    let view = with_design(limits, body, |d, c| api::slice_view(&d, c)).await?;
     Ok(if binary {
         (
             [(header::CONTENT_TYPE, "application/octet-stream")],
@@ -241,9 +242,11 @@ async fn verify_design(
     State(limits): State<Shared>,
     body: Result<Bytes, BytesRejection>,
 ) -> Result<Json<api::Verdict>, ApiError> {
-    with_design(limits, body, |d| Ok(api::verdict(&api::verified(&d)?)))
-        .await
-        .map(Json)
+    with_design(limits, body, |d, c| {
+        Ok(api::verdict(&api::verified(&d, c)?))
+    })
+    .await
+    .map(Json)
 }
 
 /// A file download: the design's name (made safe) with `ext`.
@@ -306,8 +309,8 @@ async fn gcode(
     State(limits): State<Shared>,
     body: Result<Bytes, BytesRejection>,
 ) -> Result<Response, ApiError> {
-    with_design(limits, body, |d| {
-        let text = api::gcode(&d)?;
+    with_design(limits, body, |d, c| {
+        let text = api::gcode(&d, c)?;
         Ok(attachment(&d, "gcode", "text/x-gcode; charset=utf-8", text))
     })
     .await
@@ -317,8 +320,8 @@ async fn stl(
     State(limits): State<Shared>,
     body: Result<Bytes, BytesRejection>,
 ) -> Result<Response, ApiError> {
-    with_design(limits, body, |d| {
-        let bytes = api::stl(&d)?;
+    with_design(limits, body, |d, c| {
+        let bytes = api::stl(&d, c)?;
         Ok(attachment(&d, "stl", "model/stl", bytes))
     })
     .await
@@ -332,7 +335,7 @@ async fn import(
     let text = text(body)?;
     state
         .pool
-        .run(move || api::import(&format, &text))
+        .run(move |_| api::import(&format, &text))
         .await
         .map(Json)
 }
@@ -368,7 +371,7 @@ async fn check(
     let text = text(body)?;
     state
         .pool
-        .run(move || {
+        .run(move |cancel| {
             // Without `printer`, a sweepclay file is checked for the printer
             // its header names, any other for `generic` (as the CLI does).
             let cfg = match printer {
@@ -379,7 +382,16 @@ async fn check(
                         ..CheckConfig::default()
                     }),
             };
-            Ok(sweepclay_check::check(&text, &cfg))
+            let read = std::io::BufReader::with_capacity(
+                1 << 16,
+                guard::CancelReader(text.as_bytes(), cancel.clone()),
+            );
+            sweepclay_check::check_reader(read, &cfg).map_err(|e| {
+                cancel
+                    .check()
+                    .err()
+                    .unwrap_or_else(|| ApiError::new(500, format!("checking: {e}")))
+            })
         })
         .await
         .map(Json)
