@@ -3,7 +3,10 @@
 //! the kernel's backlog until one closes), and a connection on which
 //! nothing is read or written for [`Connections::idle`] is closed — a
 //! client that stalls while sending its headers or body, or an idle
-//! keep-alive connection, no longer holds a place for ever.
+//! keep-alive connection, no longer holds a place for ever. A request
+//! must also be answered (its answer begun) within twice that of its
+//! first byte, so a client trickling a byte now and then cannot hold a
+//! place either.
 
 use std::future::Future;
 use std::io;
@@ -21,7 +24,8 @@ use tokio::time::{sleep, Instant, Sleep};
 pub struct Connections {
     /// Most connections open at once.
     pub max: usize,
-    /// Longest a connection may go without a byte read or written.
+    /// Longest a connection may go without a byte read or written; a
+    /// request must be answered within twice this of its first byte.
     pub idle: Duration,
 }
 
@@ -62,6 +66,7 @@ impl axum::serve::Listener for Capped {
             _permit: permit,
             idle: self.idle,
             timer: Box::pin(sleep(self.idle)),
+            request: None,
         };
         (guarded, addr)
     }
@@ -77,11 +82,17 @@ pub struct Guarded {
     _permit: OwnedSemaphorePermit,
     idle: Duration,
     timer: Pin<Box<Sleep>>,
+    /// When the request being read must be answered by: set by its first
+    /// byte, cleared when the answer is written.
+    request: Option<Instant>,
 }
 
 impl Guarded {
     fn touch(&mut self) {
-        let at = Instant::now() + self.idle;
+        let mut at = Instant::now() + self.idle;
+        if let Some(d) = self.request {
+            at = at.min(d);
+        }
         self.timer.as_mut().reset(at);
     }
 
@@ -101,6 +112,9 @@ impl AsyncRead for Guarded {
         match Pin::new(&mut self.io).poll_read(cx, buf) {
             Poll::Ready(r) => {
                 if buf.filled().len() > before {
+                    if self.request.is_none() {
+                        self.request = Some(Instant::now() + 2 * self.idle);
+                    }
                     self.touch();
                 }
                 Poll::Ready(r)
@@ -120,6 +134,8 @@ impl AsyncWrite for Guarded {
     ) -> Poll<io::Result<usize>> {
         let r = Pin::new(&mut self.io).poll_write(cx, data);
         if matches!(r, Poll::Ready(Ok(n)) if n > 0) {
+            // The answer has begun: the next request starts its own clock.
+            self.request = None;
             self.touch();
         }
         r

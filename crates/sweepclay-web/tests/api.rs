@@ -454,6 +454,39 @@ async fn a_silent_connection_is_closed() {
 }
 
 #[tokio::test]
+async fn a_request_trickled_a_byte_at_a_time_is_cut_off() {
+    use tokio::io::{AsyncReadExt, AsyncWriteExt};
+    // Idle limit 400 ms, so a request must be answered within 800 ms of
+    // its first byte; this client sends a header byte every 100 ms, never
+    // silent long enough to be idle.
+    let addr = capped(8, 400).await;
+    let mut s = tokio::net::TcpStream::connect(addr).await.unwrap();
+    let t = std::time::Instant::now();
+    let head = b"GET /api/meta HTTP/1.1\r\nHost: 127.0.0.1\r\nX-Slow: aaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaaa\r\n\r\n";
+    let mut cut = None;
+    for &byte in head.iter() {
+        if s.write_all(&[byte]).await.is_err() {
+            cut = Some(t.elapsed());
+            break;
+        }
+        tokio::time::sleep(std::time::Duration::from_millis(100)).await;
+        // Closed under it: reading gives the end of the stream.
+        let mut buf = [0u8; 64];
+        if let Ok(Ok(0)) =
+            tokio::time::timeout(std::time::Duration::from_millis(1), s.read(&mut buf)).await
+        {
+            cut = Some(t.elapsed());
+            break;
+        }
+    }
+    let cut = cut.expect("the server cut the trickling request off");
+    assert!(
+        cut >= std::time::Duration::from_millis(700) && cut < std::time::Duration::from_secs(3),
+        "{cut:?}"
+    );
+}
+
+#[tokio::test]
 async fn connections_beyond_the_cap_wait_for_a_place() {
     let addr = capped(2, 60_000).await;
     let mut a = tokio::net::TcpStream::connect(addr).await.unwrap();
