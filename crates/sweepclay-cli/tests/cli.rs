@@ -569,7 +569,8 @@ fn designs_too_large_or_far_outside_the_printer_are_refused_before_slicing() {
         p[0] *= 100.0;
         p[1] *= 100.0;
     }
-    d.params.spacing = 110.0;
+    // (The coarsest spacing allowed, so the size is what is refused.)
+    d.params.spacing = 50.0;
     std::fs::write(tmp.path().join("huge.json"), d.to_json()).unwrap();
     sweepclay(tmp.path())
         .args(["slice", "huge.json"])

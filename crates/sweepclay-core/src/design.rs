@@ -379,6 +379,9 @@ impl Design {
     /// B-spline Ψ does not pass through its control points, so for a
     /// closed Ψ only the height is checked here (slicing checks the rest).
     pub fn check_size(&self, max_samples: f64) -> crate::Result<()> {
+        // A parameter out of its range is that, not a huge estimate (a
+        // layer height of 0 is no "infinitely many samples").
+        self.params.validate()?;
         let printed = self.printed();
         let this = &printed;
         let estimate = this.estimated_samples();
@@ -470,6 +473,14 @@ mod tests {
             let est = d.estimated_samples();
             assert!(est >= real && est < 3.0 * real, "{name}: {est} vs {real}");
         }
+    }
+
+    #[test]
+    fn a_parameter_out_of_range_is_named_before_any_size_estimate() {
+        let mut d = Design::from_json(MINIMAL).unwrap();
+        d.params.layer_height = 0.0;
+        let e = d.check_size(1e6).unwrap_err().to_string();
+        assert!(e.starts_with("params.layer_height"), "{e}");
     }
 
     #[test]

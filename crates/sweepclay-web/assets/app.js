@@ -10,17 +10,20 @@ import { sample, samplePeriodic } from './bspline.js';
 const $ = (id) => document.getElementById(id);
 const STORE = 'sweepclay.design.v1';
 
+// Each parameter: its key, its label, its unit, its input step, what it
+// does (the tooltip, with the default), and the factor between the file's
+// value and the one shown (overlap is a fraction in the file, % here).
 const PARAMS = [
-  ['layer_height', 'layer height Δz₀', 'mm', 0.05],
-  ['max_layer_height', 'max layer height', 'mm', 0.05],
-  ['spacing', 'spacing along Ψ', 'mm', 0.05],
-  ['nozzle_height', 'extruder height H', 'mm', 1],
-  ['width_min', 'bead width min', 'mm', 0.1],
-  ['width_max', 'bead width max', 'mm', 0.1],
-  ['overlap', 'overlap target', '', 0.01],
-  ['max_overhang_deg', 'overhang threshold', '°', 1],
-  ['feedrate', 'feedrate', 'mm/min', 50],
-  ['floor_layers', 'floor layers (vessel)', '', 1],
+  ['layer_height', 'layer height', 'mm', 0.05, 'the thinnest layer of clay (the paper\'s Δz₀)', 1],
+  ['max_layer_height', 'max layer height', 'mm', 0.05, 'the thickest layer allowed where the two profiles differ in height', 1],
+  ['spacing', 'point spacing', 'mm', 0.05, 'distance between points along the path seen from above', 1],
+  ['nozzle_height', 'extruder body height', 'mm', 1, 'how high the extruder body reaches above the nozzle tip (the paper\'s H): no clay may rise above it', 1],
+  ['width_min', 'bead width min', 'mm', 0.1, 'the narrowest bead of clay', 1],
+  ['width_max', 'bead width max', 'mm', 0.1, 'the widest bead of clay', 1],
+  ['overlap', 'overlap with the bead below', '%', 1, 'how much of each bead rests on the bead below it', 100],
+  ['max_overhang_deg', 'steepest overhang', '°', 1, 'how far from vertical the wall may lean before it is corrected', 1],
+  ['feedrate', 'print speed', 'mm/min', 50, 'how fast the nozzle moves while printing', 1],
+  ['floor_layers', 'floor layers (vessel)', '', 1, 'flat layers of the floor of a closed vessel; 0 for bottomless', 1],
 ];
 
 const state = {
@@ -91,6 +94,8 @@ function setDesign(d, { record = true, fit = false } = {}) {
 
 function edit(mutate, final) {
   const d = clone(state.design);
+  // A parameter's own change sets it again just after this.
+  state.lastParam = null;
   mutate(d);
   state.lastEdit = state.lastEdit ?? performance.now();
   setDesign(d, { record: final });
@@ -394,20 +399,53 @@ function showNote(msg) {
   s.appendChild(div);
 }
 
+/** The label, unit and factor of parameter `key`, if it is one. */
+function param(key) {
+  const p = PARAMS.find((q) => q[0] === key);
+  return p && { label: p[1], unit: p[2], factor: p[5] };
+}
+
+/**
+ * A server message about a parameter in the page's words: `params.KEY:
+ * must be between A and B (got V)` becomes "KEY's label must be between
+ * A and B unit (it is V)".
+ */
+function plainWords(msg) {
+  return msg.replace(/params\.(\w+): must be between (\S+) and (\S+) \(got ([^)]+)\)/, (all, k, a, b, v) => {
+    const p = param(k);
+    if (!p) return all;
+    const f = (x) => (Number.isFinite(Number(x)) ? Number((Number(x) * p.factor).toFixed(4)) : x);
+    return `${p.label} must be between ${f(a)} and ${f(b)} ${p.unit} (it is ${f(v)})`;
+  }).replace(/params\.(\w+)/g, (all, k) => (param(k) ? param(k).label : all));
+}
+
 function showError(msg, key) {
   const s = $('status');
   document.querySelectorAll('#params input.bad').forEach((i) => i.classList.remove('bad'));
   if (!msg) {
     s.querySelector('.error')?.remove();
+    // A good slice: the next error is nobody's earlier change.
+    state.lastParam = null;
     return;
   }
   s.innerHTML = '';
   const div = document.createElement('div');
   div.className = 'error';
-  div.textContent = msg;
-  s.appendChild(div);
   const m = /^params\.(\w+)/.exec(key || msg);
-  if (m && $(`p-${m[1]}`)) $(`p-${m[1]}`).classList.add('bad');
+  // The field the user just changed is the one to blame, though the
+  // range it broke is another's (a layer height above the max).
+  const changed = state.lastParam;
+  let text = plainWords(msg);
+  let blamed = m && m[1];
+  if (m && changed && changed !== m[1] && param(changed)) {
+    const p = param(changed);
+    const v = Number(((state.design.params || {})[changed] ?? 0) * p.factor);
+    text = `${p.label} ${Number(v.toFixed(4))} ${p.unit}: ${text}`;
+    blamed = changed;
+  }
+  div.textContent = text;
+  s.appendChild(div);
+  if (blamed && $(`p-${blamed}`)) $(`p-${blamed}`).classList.add('bad');
 }
 
 // ---------------------------------------------------------------- parameters
@@ -431,20 +469,25 @@ function buildParams() {
   sel.addEventListener('change', () => {
     if (sel.value) edit((d) => { d.printer = sel.value; }, true);
   });
-  for (const [key, label, unit, step] of PARAMS) {
+  for (const [key, label, unit, step, help, factor] of PARAMS) {
     const l = document.createElement('label');
     l.innerHTML = `<span>${label} <small>${unit}</small></span>`;
     const inp = document.createElement('input');
     inp.type = 'number';
     inp.step = step;
     inp.id = `p-${key}`;
+    const def = state.meta.params[key] ?? (key === 'floor_layers' ? 2 : null);
+    const shown = def == null ? '' : ` (default ${Number((def * factor).toFixed(4))}${unit ? ` ${unit}` : ''})`;
+    inp.title = `${help}${shown}`;
+    l.title = inp.title;
     inp.addEventListener('change', () => {
       const v = parseFloat(inp.value);
       if (!Number.isFinite(v)) {
-        showError(`params.${key}: enter a number`, `params.${key}`);
+        showError(`${label}: enter a number`, `params.${key}`);
         return;
       }
-      edit((d) => { d.params = { ...(d.params || {}), [key]: v }; }, true);
+      edit((d) => { d.params = { ...(d.params || {}), [key]: v / factor }; }, true);
+      state.lastParam = key;
     });
     l.appendChild(inp);
     form.appendChild(l);
@@ -456,9 +499,10 @@ function fillParams() {
   const d = state.design;
   const p = { ...state.meta.params, ...(d.params || {}) };
   if (p.floor_layers === undefined || p.floor_layers === null) p.floor_layers = 2;
-  for (const [key] of PARAMS) {
+  for (const [key, , , , , factor] of PARAMS) {
     const inp = $(`p-${key}`);
-    if (document.activeElement !== inp) inp.value = Number(Number(p[key]).toFixed(4));
+    // A percentage to two decimals (2/3 is 66.67 %).
+    if (document.activeElement !== inp) inp.value = Number((Number(p[key]) * factor).toFixed(factor === 1 ? 4 : 2));
   }
   // Only a vessel has a floor.
   $('p-floor_layers').disabled = !d.trajectory.closed;

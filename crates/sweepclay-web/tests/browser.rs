@@ -439,6 +439,53 @@ async fn draw_preview_and_download_verified_gcode() {
         "the base point was deleted"
     );
 
+    // The parameters in a potter's words: overlap in %, a tooltip with
+    // the default on each, and an error that blames the field changed (a
+    // layer height above the max breaks the max's range, but it is the
+    // layer height the user typed).
+    assert_eq!(
+        js(
+            &c,
+            "return Number(document.getElementById('p-overlap').value).toFixed(2)"
+        )
+        .await,
+        json!("66.67")
+    );
+    let tip = js(&c, "return document.getElementById('p-spacing').title").await;
+    assert!(tip.as_str().unwrap().contains("(default 1.1 mm)"), "{tip}");
+    c.execute("const f = document.getElementById('p-overlap'); f.value = '70'; f.dispatchEvent(new Event('change'));", vec![])
+        .await
+        .unwrap();
+    wait_js(
+        &c,
+        "return window.sweepclay.design.params.overlap === 0.7 && !window.sweepclay.inFlight && !window.sweepclay.pending",
+        "overlap 70 % as 0.7",
+    )
+    .await;
+    c.execute("const f = document.getElementById('p-layer_height'); f.value = '3'; f.dispatchEvent(new Event('change'));", vec![])
+        .await
+        .unwrap();
+    let err = wait_js(
+        &c,
+        "const e = document.querySelector('#status .error'); return e ? e.textContent : null",
+        "the error for a layer height over the max",
+    )
+    .await;
+    let err = err.as_str().unwrap();
+    assert!(
+        err.starts_with("layer height 3 mm: ") && err.contains("max layer height"),
+        "{err}"
+    );
+    assert!(!err.contains("params."), "{err}");
+    assert_eq!(
+        js(
+            &c,
+            "return [...document.querySelectorAll('#params input.bad')].map(i => i.id)"
+        )
+        .await,
+        json!(["p-layer_height"])
+    );
+
     // A vessel: from the low wall t5, import a circle from a drawing
     // program; the page closes the trajectory; three floor layers; the
     // verdict is printable and the downloaded G-code, floor and spiral in
