@@ -101,6 +101,17 @@ async fn js(c: &Client, script: &str) -> Value {
 }
 
 /// Polls a script until it returns something other than null/false.
+/// Sets a form control's value and fires its `change`, as a user's entry
+/// does.
+async fn set_value(c: &Client, id: &str, value: &str) {
+    c.execute(
+        "const e = document.getElementById(arguments[0]); e.value = arguments[1]; e.dispatchEvent(new Event('change'));",
+        vec![json!(id), json!(value)],
+    )
+    .await
+    .unwrap();
+}
+
 async fn wait_js(c: &Client, script: &str, what: &str) -> Value {
     let deadline = Instant::now() + Duration::from_secs(30);
     loop {
@@ -324,9 +335,7 @@ async fn draw_preview_and_download_verified_gcode() {
     .await;
 
     // Colour by stage, then a screenshot for the README.
-    c.execute("const s = document.getElementById('colour-by'); s.value = 'width'; s.dispatchEvent(new Event('change'));", vec![])
-        .await
-        .unwrap();
+    set_value(&c, "colour-by", "width").await;
     wait_js(
         &c,
         "return document.getElementById('verdict').dataset.printable === 'true'",
@@ -383,9 +392,7 @@ async fn draw_preview_and_download_verified_gcode() {
         "the verdict on the imported wave",
     )
     .await;
-    c.execute("const s = document.getElementById('offset'); s.value = 'radial'; s.dispatchEvent(new Event('change'));", vec![])
-        .await
-        .unwrap();
+    set_value(&c, "offset", "radial").await;
     let err = wait_js(
         &c,
         "return document.querySelector('#status .error')?.textContent || null",
@@ -453,18 +460,14 @@ async fn draw_preview_and_download_verified_gcode() {
     );
     let tip = js(&c, "return document.getElementById('p-spacing').title").await;
     assert!(tip.as_str().unwrap().contains("(default 1.1 mm)"), "{tip}");
-    c.execute("const f = document.getElementById('p-overlap'); f.value = '70'; f.dispatchEvent(new Event('change'));", vec![])
-        .await
-        .unwrap();
+    set_value(&c, "p-overlap", "70").await;
     wait_js(
         &c,
         "return window.sweepclay.design.params.overlap === 0.7 && !window.sweepclay.inFlight && !window.sweepclay.pending",
         "overlap 70 % as 0.7",
     )
     .await;
-    c.execute("const f = document.getElementById('p-layer_height'); f.value = '3'; f.dispatchEvent(new Event('change'));", vec![])
-        .await
-        .unwrap();
+    set_value(&c, "p-layer_height", "3").await;
     let err = wait_js(
         &c,
         "const e = document.querySelector('#status .error'); return e ? e.textContent : null",
@@ -490,9 +493,7 @@ async fn draw_preview_and_download_verified_gcode() {
     // program; the page closes the trajectory; three floor layers; the
     // verdict is printable and the downloaded G-code, floor and spiral in
     // one run, checks.
-    c.execute("const s = document.getElementById('example'); s.value = 't5'; s.dispatchEvent(new Event('change'));", vec![])
-        .await
-        .unwrap();
+    set_value(&c, "example", "t5").await;
     wait_js(
         &c,
         "return window.sweepclay.design.name.startsWith('t5') && !window.sweepclay.design.trajectory.closed && document.getElementById('p-floor_layers').disabled",
@@ -517,12 +518,8 @@ async fn draw_preview_and_download_verified_gcode() {
         "the imported circle as a closed trajectory",
     )
     .await;
-    c.execute("const s = document.getElementById('offset'); s.value = 'radial'; s.dispatchEvent(new Event('change'));", vec![])
-        .await
-        .unwrap();
-    c.execute("const f = document.getElementById('p-floor_layers'); f.value = '3'; f.dispatchEvent(new Event('change'));", vec![])
-        .await
-        .unwrap();
+    set_value(&c, "offset", "radial").await;
+    set_value(&c, "p-floor_layers", "3").await;
     wait_js(
         &c,
         "return window.sweepclay.design.params.floor_layers === 3 && !window.sweepclay.inFlight && !window.sweepclay.pending && document.getElementById('verdict').dataset.printable === 'true'",
