@@ -235,6 +235,15 @@ struct Stretch {
     excess: f64,
 }
 
+/// Turnaround steps since the last bead: the first one's line, their
+/// clay (mm³) and rise (mm), and the width of the bead before them (mm).
+struct Turn {
+    line: usize,
+    clay: f64,
+    rise: f64,
+    before: f64,
+}
+
 /// The check as a state machine fed one line at a time, in one pass: what
 /// happens after a bead is held back until the next bead proves it was
 /// not after the last one.
@@ -266,11 +275,11 @@ struct Checker<'a> {
     /// [`MAX_FAILURES`]).
     failures: usize,
     deep: bool,
-    /// Turnaround steps since the last bead: their first line, their clay
-    /// (mm³), their rise (mm) and the width of the bead before them,
-    /// judged with the bead after them (docs/CHECKER.md, "Turns").
-    turn: Option<(usize, f64, f64, f64)>,
-    /// The width of the last bead that was no step (mm).
+    /// Turnaround steps since the last bead, judged with the bead after
+    /// them (docs/CHECKER.md, "Turns").
+    turn: Option<Turn>,
+    /// The width of the last bead that was no step (mm, within
+    /// [w_min, w_max]).
     last_width: f64,
     stretch: Stretch,
     /// The last judged bead was a stub, and its overlap.
@@ -785,9 +794,14 @@ impl<'a> Checker<'a> {
         let mut on_clay = false;
         if step {
             r.support.steps += 1;
-            let t = pending_turn.get_or_insert((m.line, 0.0, 0.0, *last_width));
-            t.1 += volume;
-            t.2 += rise;
+            let t = pending_turn.get_or_insert(Turn {
+                line: m.line,
+                clay: 0.0,
+                rise: 0.0,
+                before: *last_width,
+            });
+            t.clay += volume;
+            t.rise += rise;
         } else if *deep {
             let mid = [
                 0.5 * (m.from[0] + m.to[0]),
@@ -961,13 +975,13 @@ impl<'a> Checker<'a> {
             } else {
                 cfg.width_min
             };
-            if let Some((line, laid, rise, before)) = pending_turn.take() {
-                let w = w.max(before.min(cfg.width_max));
-                let need = std::f64::consts::PI / 8.0 * w * w * rise;
-                r.support.turn_clay_mm3[0] += laid;
+            if let Some(t) = pending_turn.take() {
+                let w = w.max(t.before);
+                let need = std::f64::consts::PI / 8.0 * w * w * t.rise;
+                r.support.turn_clay_mm3[0] += t.clay;
                 r.support.turn_clay_mm3[1] += need;
-                if laid > TURN_FACTOR * need {
-                    pile = Some((line, laid / need));
+                if t.clay > TURN_FACTOR * need {
+                    pile = Some((t.line, t.clay / need));
                 }
             }
             *last_width = w;

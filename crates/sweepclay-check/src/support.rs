@@ -447,45 +447,49 @@ const RIGHT_UNDER: f64 = 0.375;
 /// loop beside its own start: a nearer pass lies farther out than this.
 const NEAR_BEND: f64 = 0.1;
 
+/// Whether any bead in the bead grid's cells within `r` of the middle,
+/// between heights `zlo` and `zhi`, is one `classify` puts in a class
+/// `hit` accepts: the exact question for where a cell of the column tops
+/// is too coarse to tell. Rare, so kept out of the shortcut's code.
+#[cold]
+#[inline(never)]
+fn any_near(
+    beads: &[Bead],
+    grid: &BeadGrid,
+    q: &Query,
+    (r, zlo, zhi): (f64, f64, f64),
+    hit: impl Fn(Class) -> bool,
+) -> bool {
+    let mut found = false;
+    grid.in_box(q.mid, r, zlo, zhi, |run| {
+        found = found || (run.first..=run.last).any(|j| hit(q.classify(&beads[j as usize], j)));
+    });
+    found
+}
+
 /// Whether a bead below other than `best` covers the middle and is
 /// nearer to it ([`Candidate::nearer`]): then the full search starts from
 /// that one.
-#[cold]
-#[inline(never)]
 fn nearer_below(beads: &[Bead], grid: &BeadGrid, q: &Query, best: &Candidate) -> bool {
     let (mid, cfg) = (q.mid, q.cfg);
-    let mut found = false;
-    grid.in_box(
-        mid,
-        best.d,
-        mid[2] - cfg.max_gap_mm,
-        mid[2] - cfg.min_layer_mm,
-        |r| {
-            found = found
-                || (r.first..=r.last).any(|j| {
-                    matches!(q.classify(&beads[j as usize], j),
-                        Class::Below(c) if c.covers && c.nearer(best).is_lt())
-                })
-        },
-    );
-    found
+    let window = (best.d, mid[2] - cfg.max_gap_mm, mid[2] - cfg.min_layer_mm);
+    any_near(
+        beads,
+        grid,
+        q,
+        window,
+        |c| matches!(c, Class::Below(c) if c.covers && c.nearer(best).is_lt()),
+    )
 }
 
 /// Whether a bead lies at the new bead's own height under its middle
 /// ([`Class::Double`]): asked of the beads themselves where a cell too
 /// coarse to tell holds clay that high near it (beside the rings of a
 /// floor's layer, the next ring of the same layer).
-#[cold]
-#[inline(never)]
 fn laid_twice(beads: &[Bead], grid: &BeadGrid, q: &Query) -> bool {
     let (mid, ml) = (q.mid, q.cfg.min_layer_mm);
-    let mut found = false;
-    grid.in_box(mid, 0.5 * q.cfg.width_min, mid[2] - ml, mid[2] + ml, |r| {
-        found = found
-            || (r.first..=r.last)
-                .any(|j| matches!(q.classify(&beads[j as usize], j), Class::Double(_)));
-    });
-    found
+    let window = (0.5 * q.cfg.width_min, mid[2] - ml, mid[2] + ml);
+    any_near(beads, grid, q, window, |c| matches!(c, Class::Double(_)))
 }
 
 /// Whether the full search would find nothing under a bead near the bed

@@ -228,6 +228,18 @@ impl Params {
         }
     }
 
+    /// How much larger than designed the piece is printed, across and in
+    /// height: 1 / (1 − s) for the firing shrinkages (1 without).
+    pub fn print_scale(&self) -> [f64; 2] {
+        [self.shrinkage_xy, self.shrinkage_z].map(|s| {
+            if s > 0.0 && s < 1.0 {
+                1.0 / (1.0 - s)
+            } else {
+                1.0
+            }
+        })
+    }
+
     /// The keys `--set` accepts, in file order.
     pub const KEYS: &'static [&'static str] = &[
         "layer_height",
@@ -336,15 +348,7 @@ impl Design {
     /// process, not the piece. Without shrinkage, the design itself.
     pub fn printed(&self) -> Design {
         let mut d = self.clone();
-        let (sxy, sz) = (self.params.shrinkage_xy, self.params.shrinkage_z);
-        let scale = |s: f64| {
-            if s > 0.0 && s < 1.0 {
-                1.0 / (1.0 - s)
-            } else {
-                1.0
-            }
-        };
-        let (kxy, kz) = (scale(sxy), scale(sz));
+        let [kxy, kz] = self.params.print_scale();
         if kxy == 1.0 && kz == 1.0 {
             return d;
         }

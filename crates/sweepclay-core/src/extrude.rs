@@ -46,6 +46,21 @@ pub struct Extrusion {
     pub slow: Vec<(u32, f64)>,
 }
 
+impl Extrusion {
+    /// The fraction of the feedrate of each move, from the move into
+    /// point 1 on: 1 but for the slowed steps of [`Extrusion::slow`].
+    pub fn feed_factors(&self) -> impl Iterator<Item = f64> + '_ {
+        let mut slow = self.slow.iter().peekable();
+        (1..self.volume.len()).map(move |i| match slow.peek() {
+            Some(&&(at, k)) if at as usize == i => {
+                slow.next();
+                k
+            }
+            _ => 1.0,
+        })
+    }
+}
+
 /// The slowest a step is printed, as a fraction of the feedrate: a
 /// screw or piston cannot slow much further without stalling the clay.
 pub const MIN_TURN_FEED: f64 = 0.25;
@@ -108,14 +123,7 @@ pub fn plan_extrusion(path: &Toolpath, params: &Params, origin: [f64; 2]) -> Ext
         let l = (xy2 + (a[2] - b[2]).powi(2)).sqrt();
         let cuboid =
             l * 0.5 * (width[i] + width[i - 1]) * 0.5 * (layer_height[i] + layer_height[i - 1]);
-        // Most moves run far more than they climb: no step, as is_step
-        // would find at once.
-        let v = if xy2 > (2.0 * (b[2] - a[2]).abs() + 0.01).powi(2) {
-            if l > 1e-9 {
-                bead_rate = cuboid / l;
-            }
-            cuboid
-        } else if is_step(path, i, origin) {
+        let v = if steep(a, b, xy2, origin) {
             turn_cuboid += cuboid;
             turn_steps += 1;
             let v = step_volume(width[i], b[2] - a[2]);
@@ -162,25 +170,27 @@ pub fn is_step(path: &Toolpath, i: usize, origin: [f64; 2]) -> bool {
     let Some(prev) = i.checked_sub(1) else {
         return false;
     };
-    let at = |k: usize| {
-        let p = path.points[k].pos;
-        let r = |v: f64| (v * 1000.0).round() / 1000.0;
-        [r(p[0] + origin[0]), r(p[1] + origin[1]), r(p[2])]
-    };
+    let (q, p) = (path.points[prev].pos, path.points[i].pos);
+    steep(q, p, (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2), origin)
+}
+
+/// [`is_step`] for the move from `a` to `b`, `xy2` the square of its plan
+/// length.
+fn steep(a: [f64; 3], b: [f64; 3], xy2: f64, origin: [f64; 2]) -> bool {
     // Rounding moves each coordinate by at most 0.0005 mm: away from the
     // boundary the exact coordinates answer (in squares: no root).
-    let (p, q) = (path.points[i].pos, path.points[prev].pos);
-    let (xy2, two_rise) = (
-        (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2),
-        2.0 * (p[2] - q[2]).abs(),
-    );
+    let two_rise = 2.0 * (b[2] - a[2]).abs();
     if xy2 > (two_rise + 0.01).powi(2) {
         return false;
     }
     if two_rise > 0.01 && xy2 < (two_rise - 0.01).powi(2) {
         return true;
     }
-    let (p, q) = (at(i), at(prev));
+    let at = |p: [f64; 3]| {
+        let r = |v: f64| (v * 1000.0).round() / 1000.0;
+        [r(p[0] + origin[0]), r(p[1] + origin[1]), r(p[2])]
+    };
+    let (p, q) = (at(b), at(a));
     let rise = (p[2] - q[2]).abs();
     rise > 0.0 && (p[0] - q[0]).hypot(p[1] - q[1]) <= 2.0 * rise
 }

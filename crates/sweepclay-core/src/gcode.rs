@@ -293,7 +293,7 @@ pub fn emit_typed_moves<W: Write>(
     let mut e_total = 0.0f64;
     let mut e_printed = 0.0f64;
     let (mut last_w, mut last_h) = (i64::MIN, i64::MIN);
-    let mut slow = ex.slow.iter().peekable();
+    let mut feeds = ex.feed_factors();
     let mut was_slow = false;
     for i in 1..n {
         let w = 0.5 * (ex.width[i] + ex.width[i - 1]);
@@ -331,13 +331,7 @@ pub fn emit_typed_moves<W: Write>(
         };
         buf.extend_from_slice(b"G1 ");
         // The feedrate on the first move, and around each slowed step.
-        let slowed = match slow.peek() {
-            Some(&&(at, k)) if at as usize == i => {
-                slow.next();
-                Some(k)
-            }
-            _ => None,
-        };
+        let slowed = feeds.next().filter(|&k| k != 1.0);
         if let Some(k) = slowed {
             buf.push(b'F');
             push_fixed(&mut buf, f.feed_mm_min * k, 1);

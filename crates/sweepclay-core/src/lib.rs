@@ -342,8 +342,7 @@ fn stats(c: &Corrected, t: &Toolpath, e: &Extrusion) -> Stats {
             .collect(),
         turn_clay_ml: e.turn_volume / 1000.0,
         turn_clay_cuboid_ml: e.turn_volume_cuboid / 1000.0,
-        print_scale: [c.surface.params.shrinkage_xy, c.surface.params.shrinkage_z]
-            .map(|s| 1.0 / (1.0 - s)),
+        print_scale: c.surface.params.print_scale(),
         turn_steps: e.turn_steps,
         time_min: planned_min(c, t, e) + travel / pr.travel_feedrate,
         time_at_feedrate_min: e.path_length / c.surface.params.feedrate
@@ -363,21 +362,17 @@ fn stats(c: &Corrected, t: &Toolpath, e: &Extrusion) -> Stats {
 /// slowed steps slower), from rest at the first point.
 fn planned_min(c: &Corrected, t: &Toolpath, e: &Extrusion) -> f64 {
     let feed = c.surface.params.feedrate / 60.0;
-    let mut slow = e.slow.iter().peekable();
-    let moves = (1..t.points.len()).map(|i| {
-        let k = match slow.peek() {
-            Some(&&(at, k)) if at as usize == i => {
-                slow.next();
-                k
-            }
-            _ => 1.0,
-        };
-        motion::Move {
-            to: t.points[i].pos,
+    let moves = t
+        .points
+        .iter()
+        .skip(1)
+        .zip(e.volume.iter().skip(1))
+        .zip(e.feed_factors())
+        .map(|((p, &volume), k)| motion::Move {
+            to: p.pos,
             feed: feed * k,
-            volume: e.volume[i],
-        }
-    });
+            volume,
+        });
     let start = t.points.first().map_or([0.0; 3], |p| p.pos);
     motion::print_time(start, moves, &motion::Limits::of(&c.surface.printer)) / 60.0
 }

@@ -2,8 +2,8 @@
 //! plain serialisable answers out. Every function is a thin composition of
 //! the library's stages (`sweepclay-core`) and the checker.
 
-use crate::guard::{Cancel, CancelWriter};
-use crate::verify::{verify_into, Verified};
+use crate::guard::Cancel;
+use crate::verify::{verify_until, Verified};
 use serde::Serialize;
 use sweepclay_core::mesh;
 use sweepclay_core::toolpath::PointKind;
@@ -390,19 +390,7 @@ pub fn sliced(design: &Design, cancel: &Cancel) -> Result<Sliced, ApiError> {
 /// Slices, emits and checks a design (stopping once `cancel` is set).
 pub fn verified(design: &Design, cancel: &Cancel) -> Result<Verified, ApiError> {
     let s = sliced(design, cancel)?;
-    let mut text = Vec::with_capacity(sweepclay_core::gcode::size_hint(&s));
-    let (report, locations) = verify_into(&s, 0.5, CancelWriter(&mut text, cancel.clone()))
-        .map_err(|e| {
-            cancel
-                .check()
-                .err()
-                .unwrap_or_else(|| ApiError::new(500, format!("writing G-code: {e}")))
-        })?;
-    Ok(Verified {
-        gcode: String::from_utf8(text).expect("G-code is ASCII"),
-        report,
-        locations,
-    })
+    verify_until(&s, 0.5, cancel).map_err(|e| cancel.io_error("writing G-code", e))
 }
 
 /// The verdict of [`verified`].

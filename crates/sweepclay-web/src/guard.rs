@@ -42,6 +42,15 @@ impl Cancel {
         self.0.store(true, Ordering::Relaxed);
     }
 
+    /// The error of an I/O step that failed: the stop, if the flag is set
+    /// (a [`CancelWriter`] or [`CancelReader`] failing on purpose), else
+    /// `what` failing.
+    pub fn io_error(&self, what: &str, e: std::io::Error) -> ApiError {
+        self.check()
+            .err()
+            .unwrap_or_else(|| ApiError::new(500, format!("{what}: {e}")))
+    }
+
     /// An error to end the work with once the flag is set.
     pub fn check(&self) -> Result<(), ApiError> {
         if self.is_set() {

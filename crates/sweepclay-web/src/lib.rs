@@ -386,12 +386,7 @@ async fn check(
                 1 << 16,
                 guard::CancelReader(text.as_bytes(), cancel.clone()),
             );
-            sweepclay_check::check_reader(read, &cfg).map_err(|e| {
-                cancel
-                    .check()
-                    .err()
-                    .unwrap_or_else(|| ApiError::new(500, format!("checking: {e}")))
-            })
+            sweepclay_check::check_reader(read, &cfg).map_err(|e| cancel.io_error("checking", e))
         })
         .await
         .map(Json)

@@ -2,6 +2,7 @@
 //! and the modeler's download both run before they hand out a file, and the
 //! way back from a failing G-code line to the place in the design.
 
+use crate::guard::{Cancel, CancelWriter};
 use std::io::{self, Write};
 use sweepclay_check::{CheckConfig, CheckWriter, Report};
 use sweepclay_core::toolpath::PointKind;
@@ -94,14 +95,19 @@ pub fn verify_into<W: Write>(
 
 /// [`verify_into`] a string.
 pub fn verify(s: &Sliced, min_overlap: f64) -> Verified {
+    verify_until(s, min_overlap, &Cancel::new()).expect("writing to memory cannot fail")
+}
+
+/// [`verify`], stopping (with an error) at the next 64 KiB of G-code once
+/// `cancel` is set.
+pub fn verify_until(s: &Sliced, min_overlap: f64, cancel: &Cancel) -> io::Result<Verified> {
     let mut text = Vec::with_capacity(gcode::size_hint(s));
-    let (report, locations) =
-        verify_into(s, min_overlap, &mut text).expect("writing to memory cannot fail");
-    Verified {
+    let (report, locations) = verify_into(s, min_overlap, CancelWriter(&mut text, cancel.clone()))?;
+    Ok(Verified {
         gcode: String::from_utf8(text).expect("G-code is UTF-8"),
         report,
         locations,
-    }
+    })
 }
 
 /// The first line of each kind of failure in a report.

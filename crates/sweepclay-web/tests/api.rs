@@ -4,29 +4,8 @@ use serde_json::Value;
 use sweepclay_core::{examples, Design};
 use sweepclay_web::api::Limits;
 
-/// Starts the server on 127.0.0.1:0 in the background; returns its base URL.
-async fn server(limits: Limits) -> String {
-    let listener = tokio::net::TcpListener::bind("127.0.0.1:0").await.unwrap();
-    let addr = listener.local_addr().unwrap();
-    tokio::spawn(async move {
-        axum::serve(listener, sweepclay_web::router(limits))
-            .await
-            .unwrap()
-    });
-    format!("http://{addr}")
-}
-
-/// POSTs `body` as the page does (`application/json`; the work routes
-/// take nothing a cross-origin page could send without asking).
-async fn post(url: &str, body: impl Into<reqwest::Body>) -> reqwest::Response {
-    reqwest::Client::new()
-        .post(url)
-        .header("content-type", "application/json")
-        .body(body)
-        .send()
-        .await
-        .unwrap()
-}
+mod common;
+use common::{post, server};
 
 #[tokio::test]
 async fn page_and_assets_are_served() {
@@ -510,52 +489,4 @@ async fn connections_beyond_the_cap_wait_for_a_place() {
     .expect("served once a place is free");
     assert!(served.contains("200"), "{served}");
     drop(b);
-}
-
-/// CPU seconds this process has used (user and system, from
-/// `/proc/self/stat`, in clock ticks of 1/100 s).
-fn cpu_seconds() -> f64 {
-    let stat = std::fs::read_to_string("/proc/self/stat").unwrap();
-    // Fields after the command name in parentheses: utime is the 14th
-    // field of the line, stime the 15th.
-    let rest = &stat[stat.rfind(')').unwrap() + 2..];
-    let f: Vec<&str> = rest.split(' ').collect();
-    (f[11].parse::<f64>().unwrap() + f[12].parse::<f64>().unwrap()) / 100.0
-}
-
-#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
-async fn a_client_that_goes_away_stops_its_work() {
-    use tokio::io::AsyncWriteExt;
-    let base = server(Limits::default()).await;
-    let body = examples::scaled(1_000_000).to_json();
-    // How long the G-code of this design takes when its client waits.
-    let t = std::time::Instant::now();
-    let cpu = cpu_seconds();
-    let r = post(&format!("{base}/api/gcode"), body.clone()).await;
-    assert_eq!(r.status(), 200);
-    let _ = r.bytes().await.unwrap();
-    let (full, full_cpu) = (t.elapsed().as_secs_f64(), cpu_seconds() - cpu);
-    assert!(full_cpu > 0.5, "{full} s, {full_cpu} s of CPU");
-    // The same request, its client gone a fifth of the way in: the work
-    // stops at the next stage or G-code chunk, so over the rest of the
-    // time it would have taken the process is all but idle.
-    let addr = base.trim_start_matches("http://");
-    let mut s = tokio::net::TcpStream::connect(addr).await.unwrap();
-    let head = format!(
-        "POST /api/gcode HTTP/1.1\r\nHost: {addr}\r\nContent-Type: application/json\r\nContent-Length: {}\r\n\r\n",
-        body.len()
-    );
-    s.write_all(head.as_bytes()).await.unwrap();
-    s.write_all(body.as_bytes()).await.unwrap();
-    tokio::time::sleep(std::time::Duration::from_secs_f64(full / 5.0)).await;
-    drop(s);
-    // A stage may still run to its end (at most about a third of the job).
-    tokio::time::sleep(std::time::Duration::from_secs_f64(full / 3.0)).await;
-    let cpu = cpu_seconds();
-    tokio::time::sleep(std::time::Duration::from_secs_f64(full / 3.0)).await;
-    let after = cpu_seconds() - cpu;
-    assert!(
-        after < 0.25 * full_cpu / 3.0 + 0.05,
-        "{after} s of CPU in the last third of a {full} s job ({full_cpu} s of CPU) after its client left"
-    );
 }
