@@ -290,8 +290,14 @@ fn find_self_intersection(s: &Surface) -> Option<(u32, u32, [f64; 3])> {
             let (ca, cb) = (&s.columns[a], &s.columns[b as usize]);
             let rb = cb.samples();
             let mut start = rb.start;
+            let sb = segs[b as usize];
             for i in ca.samples() {
                 let p = s.position(a, i);
+                // All of b lies on its plan segment: a sample of a farther
+                // than a bead from it in plan is farther in 3D.
+                if point_segment2([p[0], p[1]], sb) >= w2 {
+                    continue;
+                }
                 while start < rb.end && s.samples[start].z < p[2] - w {
                     start += 1;
                 }
@@ -411,25 +417,28 @@ fn find_fold(s: &Surface) -> Option<(u32, u32, [f64; 3])> {
     None
 }
 
+/// Squared distance from a point to a segment in the plane.
+fn point_segment2(p: [f64; 2], s: [[f64; 2]; 2]) -> f64 {
+    let (dx, dy) = (s[1][0] - s[0][0], s[1][1] - s[0][1]);
+    let l2 = dx * dx + dy * dy;
+    let t = if l2 > 0.0 {
+        (((p[0] - s[0][0]) * dx + (p[1] - s[0][1]) * dy) / l2).clamp(0.0, 1.0)
+    } else {
+        0.0
+    };
+    (p[0] - s[0][0] - t * dx).powi(2) + (p[1] - s[0][1] - t * dy).powi(2)
+}
+
 /// Distance between two segments in the plane.
 fn segment_distance(a: [[f64; 2]; 2], b: [[f64; 2]; 2]) -> f64 {
-    fn point_seg(p: [f64; 2], s: [[f64; 2]; 2]) -> f64 {
-        let (dx, dy) = (s[1][0] - s[0][0], s[1][1] - s[0][1]);
-        let l2 = dx * dx + dy * dy;
-        let t = if l2 > 0.0 {
-            (((p[0] - s[0][0]) * dx + (p[1] - s[0][1]) * dy) / l2).clamp(0.0, 1.0)
-        } else {
-            0.0
-        };
-        (p[0] - s[0][0] - t * dx).hypot(p[1] - s[0][1] - t * dy)
-    }
     if crate::curves::segments_cross(a[0], a[1], b[0], b[1]) {
         return 0.0;
     }
-    point_seg(a[0], b)
-        .min(point_seg(a[1], b))
-        .min(point_seg(b[0], a))
-        .min(point_seg(b[1], a))
+    point_segment2(a[0], b)
+        .min(point_segment2(a[1], b))
+        .min(point_segment2(b[0], a))
+        .min(point_segment2(b[1], a))
+        .sqrt()
 }
 
 #[cfg(test)]

@@ -298,7 +298,7 @@ fn floor_start(
     end: &Profile,
     first_layer: f64,
 ) -> Result<(Vec<usize>, crate::vessel::FloorOf)> {
-    use crate::vessel::{floor_entries, floor_plan, FLOOR_OVERLAP};
+    use crate::vessel::{floor_entries, floor_plan, FloorRefusal, FLOOR_OVERLAP};
     // The base ring as its first layer lies (it stands straight through
     // the floor).
     let ring: Vec<[f64; 2]> = columns
@@ -313,11 +313,18 @@ fn floor_start(
     let pitch = params.width_min * (1.0 - FLOOR_OVERLAP);
     let rings = match floor_plan(&ring, pitch, spacing) {
         Ok(rings) => rings,
-        Err((depth, k)) => return Err(Error::invalid(
+        Err(FloorRefusal::Islands { depth, count: k }) => return Err(Error::invalid(
             "trajectory",
             format!(
                 "the floor's rings would split into {k} separate islands {depth:.1} mm inside the wall (a waist about {:.0} mm wide or narrower): one continuous path cannot go from one to the next without crossing clay; widen the waist, or print the vessel bottomless (params.floor_layers = 0)",
                 2.0 * depth
+            ),
+        )),
+        Err(FloorRefusal::Tail { depth, at }) => return Err(Error::invalid(
+            "trajectory",
+            format!(
+                "the floor narrows to a sliver thinner than a bead {depth:.1} mm inside the wall, near ({:.1}, {:.1}) mm: one continuous path would lay its clay twice there; round off or widen that end of the shape, or print the vessel bottomless (params.floor_layers = 0)",
+                at[0], at[1]
             ),
         )),
     };

@@ -21,6 +21,7 @@ use crate::curves::signed_area2;
 use crate::design::{Params, COLLISION_MARGIN_MM};
 use crate::error::{Error, Result};
 use crate::toolpath::{PathPoint, PointKind, Toolpath};
+use geo::Simplify;
 use i_overlay::mesh::outline::offset::OutlineOffset;
 use i_overlay::mesh::style::{LineJoin, OutlineStyle};
 
@@ -286,18 +287,47 @@ pub fn floor_rings(outer: &[[f64; 2]], pitch: f64, spacing: f64) -> Vec<FloorRin
     rings_of(outer, &inward_offsets(outer, pitch), pitch, spacing)
 }
 
-/// [`floor_rings`] and [`floor_split`] from one set of offsets: the rings,
-/// or the depth (mm) and count of the islands the floor splits into.
+/// Why a floor cannot be laid as one continuous path.
+#[derive(Clone, Copy, Debug, PartialEq)]
+pub enum FloorRefusal {
+    /// Its offsets split into `count` islands `depth` mm inside the wall.
+    Islands {
+        /// Depth (mm) of the first split.
+        depth: f64,
+        /// Islands at that depth.
+        count: usize,
+    },
+    /// A ring `depth` mm inside the wall lies on itself at `at` (plan,
+    /// design coordinates): the region ends in a tail narrower than a bead.
+    Tail {
+        /// Depth (mm) of the ring.
+        depth: f64,
+        /// Where its two sides meet.
+        at: [f64; 2],
+    },
+}
+
+/// [`floor_rings`] from one set of offsets, or why the floor is refused.
 pub fn floor_plan(
     outer: &[[f64; 2]],
     pitch: f64,
     spacing: f64,
-) -> std::result::Result<Vec<FloorRing>, (f64, usize)> {
+) -> std::result::Result<Vec<FloorRing>, FloorRefusal> {
     let offsets = inward_offsets(outer, pitch);
-    match split_of(&offsets, pitch) {
-        Some(split) => Err(split),
-        None => Ok(rings_of(outer, &offsets, pitch, spacing)),
+    if let Some((depth, count)) = split_of(&offsets, pitch) {
+        return Err(FloorRefusal::Islands { depth, count });
     }
+    let rings = rings_of(outer, &offsets, pitch, spacing);
+    for (k, r) in rings.iter().enumerate().filter(|(_, r)| !r.open) {
+        if let Some(at) = lies_on_itself(&r.pts, pitch) {
+            // One contour a depth: ring k is k + 1 pitches in.
+            return Err(FloorRefusal::Tail {
+                depth: pitch * (k + 1) as f64,
+                at,
+            });
+        }
+    }
+    Ok(rings)
 }
 
 fn rings_of(
@@ -338,14 +368,53 @@ fn rings_of(
     rings
 }
 
+/// Where a closed floor ring lies on itself, if it does: a ring round a
+/// region that ends in a tail narrower than a bead (a lobed oval's, near
+/// the ends of its long axis) runs down the tail and back, and its two
+/// sides would be one bead laid twice. One continuous path cannot lay the
+/// tail once (it would have to come back along it), so such a floor is
+/// refused (docs/ALGORITHMS.md §8). A grid of the ring's points makes it
+/// linear.
+fn lies_on_itself(ring: &[[f64; 2]], pitch: f64) -> Option<[f64; 2]> {
+    let m = ring.len();
+    let mut closed = ring.to_vec();
+    closed.push(ring[0]);
+    let cum = crate::curves::arc_lengths(&closed);
+    let perimeter = cum[m];
+    // Two points on opposite sides of a tail: nearer than half a pitch in
+    // the plane, farther along the ring than round a U-turn of two beads.
+    let (near, far) = (0.5 * pitch, 2.0 * pitch);
+    let mut grid = crate::grid::Grid2::new(near);
+    for (i, p) in ring.iter().enumerate() {
+        grid.insert_segment(*p, *p, i as u32);
+    }
+    ring.iter().enumerate().find_map(|(i, &p)| {
+        let mut hit = None;
+        grid.for_each_near_segment(p, p, near, |j| {
+            let j = j as usize;
+            let along = (cum[i] - cum[j]).abs();
+            if hit.is_none()
+                && along.min(perimeter - along) > far
+                && (p[0] - ring[j][0]).hypot(p[1] - ring[j][1]) < near
+            {
+                hit = Some(p);
+            }
+        });
+        hit
+    })
+}
+
 /// The contours (counter-clockwise, specks dropped) of the inward offsets
 /// of `outer` by `pitch`, 2 · `pitch`, … until nothing is left, one list a
 /// depth. Each depth is offset by one pitch from the one before, every
-/// contour resampled about half a millimetre a point (`i_overlay`'s cost grows
-/// with the points; the rings are resampled to the spacing anyway).
+/// contour thinned (Ramer–Douglas–Peucker) to the points that keep it within
+/// [`OFFSET_SAG_MM`] of itself: `i_overlay`'s cost grows with the points,
+/// and thinning keeps points on the contour where resampling would move
+/// them onto its chords, a little farther in at every depth. The rings are
+/// resampled to the spacing afterwards.
 fn inward_offsets(outer: &[[f64; 2]], pitch: f64) -> Vec<Vec<Vec<[f64; 2]>>> {
-    let coarse = (0.2 * pitch).max(0.5);
-    let mut first = resample_loop(outer, coarse);
+    let fine = (0.2 * pitch).max(0.5);
+    let mut first = resample_loop(outer, fine);
     if first.len() < 3 {
         first = outer.to_vec();
     }
@@ -354,7 +423,7 @@ fn inward_offsets(outer: &[[f64; 2]], pitch: f64) -> Vec<Vec<Vec<[f64; 2]>>> {
     }
     let style = OutlineStyle::new(-pitch).line_join(LineJoin::Bevel);
     let mut out = Vec::new();
-    let mut current = vec![first];
+    let mut current = vec![thinned(&first)];
     for _ in 0..MAX_FLOOR_RINGS {
         let next: Vec<Vec<[f64; 2]>> = current
             .iter()
@@ -363,16 +432,7 @@ fn inward_offsets(outer: &[[f64; 2]], pitch: f64) -> Vec<Vec<Vec<[f64; 2]>>> {
             // offset of a simple polygon has no holes.
             .filter_map(|shape| shape.into_iter().next())
             .filter(|c| !is_speck(c, pitch))
-            // Each offset adds corners: resampled, the points stay about
-            // a millimetre apart, depth after depth.
-            .map(|c| {
-                let r = resample_loop(&c, coarse);
-                if r.len() >= 3 {
-                    r
-                } else {
-                    c
-                }
-            })
+            .map(|c| thinned(&c))
             .collect();
         if next.is_empty() {
             break;
@@ -382,6 +442,33 @@ fn inward_offsets(outer: &[[f64; 2]], pitch: f64) -> Vec<Vec<Vec<[f64; 2]>>> {
     }
     out
 }
+
+/// A closed contour as a `geo` polygon.
+fn polygon(contour: &[[f64; 2]]) -> geo::Polygon<f64> {
+    let ring: geo::LineString<f64> = contour
+        .iter()
+        .chain(std::iter::once(&contour[0]))
+        .map(|p| geo::Coord { x: p[0], y: p[1] })
+        .collect();
+    geo::Polygon::new(ring, vec![])
+}
+
+/// A closed contour without the points its neighbours' chord passes within
+/// [`OFFSET_SAG_MM`] of (counter-clockwise stays counter-clockwise).
+fn thinned(contour: &[[f64; 2]]) -> Vec<[f64; 2]> {
+    let simple = polygon(contour).simplify(OFFSET_SAG_MM);
+    let pts: Vec<[f64; 2]> = simple.exterior().coords().map(|c| [c.x, c.y]).collect();
+    // A closed ring repeats its first point; fewer than three is a speck
+    // the thinning cannot be trusted with.
+    if pts.len() < 4 {
+        return contour.to_vec();
+    }
+    pts[..pts.len() - 1].to_vec()
+}
+
+/// The farthest a thinned contour's chords may stray from the curve it
+/// stands for (mm): well inside the 0.05 mm the rings are held to.
+const OFFSET_SAG_MM: f64 = 0.01;
 
 /// The first depth (mm inside `outer`) at which its inward offsets by
 /// multiples of `pitch` split into separate islands, if they do: one
@@ -640,6 +727,18 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
             visit_turn(&mut points, &mut below, &mut path_of, local, layer);
         }
     }
+    // The base ring closes on its own height: back over its first point
+    // before the spiral rises from there. Ended on the spiral's first
+    // point, barely above the ring, the closing bead would be sized for
+    // half the ring's height and leave a thin place under the seam.
+    if base > 0 {
+        let first = path_of[c0.first as usize + base as usize - 1] as usize;
+        below.push(below[first]);
+        points.push(PathPoint {
+            kind: PointKind::Pass,
+            ..points[first]
+        });
+    }
     for k in 1..=v.turns {
         let local = (base + k) as usize - 1;
         visit_turn(&mut points, &mut below, &mut path_of, local, base + k);
@@ -720,6 +819,34 @@ mod tests {
             for p in &ring.pts {
                 assert!((p[0].hypot(p[1]) - want).abs() < 0.05, "ring {k}: {p:?}");
             }
+        }
+    }
+
+    /// A long oval with five shallow lobes (a random vessel that once
+    /// failed its check): deep inside, its floor ends in a tail.
+    fn lobed_oval(depth: f64) -> Vec<[f64; 2]> {
+        (0..240)
+            .map(|i| {
+                let t = std::f64::consts::TAU * i as f64 / 240.0;
+                let r = 1.0 + depth * (5.0 * t).cos();
+                [51.86 * r * t.cos(), 19.14 * r * t.sin()]
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_floor_ring_that_would_lie_on_itself_is_refused() {
+        match floor_plan(&lobed_oval(0.1164), 2.55, 1.1) {
+            Err(FloorRefusal::Tail { depth, at }) => {
+                assert!(depth > 10.0 && at[0].abs() > 15.0, "{depth} {at:?}");
+            }
+            other => panic!("{other:?}"),
+        }
+        // Without the lobes the same oval ends in a line down its middle.
+        let rings = floor_plan(&lobed_oval(0.0), 2.55, 1.1).unwrap();
+        assert!(rings.last().unwrap().open);
+        for r in rings.iter().filter(|r| !r.open) {
+            assert_eq!(lies_on_itself(&r.pts, 2.55), None);
         }
     }
 
@@ -839,6 +966,35 @@ mod tests {
         assert!(t.points.iter().all(|p| p.kind != PointKind::Floor));
         assert_eq!(t.vessel.as_ref().unwrap().floor_rings, 0);
         assert_eq!(t.points[0].pos[2], 1.25);
+    }
+
+    #[test]
+    fn the_base_ring_closes_at_its_own_height() {
+        for floor in [0, 2] {
+            let s = cup(30.0, 20.0, floor);
+            let (t, e) = (&s.toolpath, &s.extrusion);
+            let z_base = 1.25 * f64::from(floor.max(1));
+            // The spiral's first point, barely above the base ring...
+            let i = t
+                .points
+                .iter()
+                .position(|p| p.pos[2] > z_base + 1e-9)
+                .unwrap();
+            // ... comes after the ring's first point again, at the ring's
+            // height, so the ring's closing bead is a whole ring bead.
+            let (close, ring) = (&t.points[i - 1], &t.points[i - 2]);
+            assert_eq!(close.pos[2], z_base);
+            assert_eq!(e.layer_height[i - 1], 1.25);
+            let per_mm = |k: usize| {
+                let (a, b) = (t.points[k - 1].pos, t.points[k].pos);
+                e.volume[k] / (a[0] - b[0]).hypot(a[1] - b[1])
+            };
+            assert!((per_mm(i - 1) - per_mm(i - 2)).abs() < 1e-6 * per_mm(i - 2));
+            assert_eq!(ring.pos[2], z_base);
+            // From there the spiral only rises.
+            let (a, b) = (close.pos, t.points[i].pos);
+            assert!((a[0] - b[0]).hypot(a[1] - b[1]) < 1e-9, "{a:?} {b:?}");
+        }
     }
 
     #[test]
