@@ -44,8 +44,23 @@ pub fn svg_trajectory(text: &str) -> Result<Vec<[f64; 2]>> {
     svg_path(text).map(|p| p.points)
 }
 
-/// [`svg_trajectory`] with whether the shape is closed.
+/// [`svg_trajectory`] with whether the shape is closed: the document's
+/// first shape (see [`svg_shapes`]).
 pub fn svg_path(text: &str) -> Result<ImportedPath> {
+    let mut shapes = svg_shapes(text, 1)?;
+    Ok(shapes.remove(0).1)
+}
+
+/// Most shapes [`svg_shapes`] lists for the user to pick from.
+pub const MAX_SHAPES: usize = 20;
+
+/// Every shape of an SVG document, in document order, each as trajectory
+/// points (mm, centred on `o`, y up), at most `max`: each `<polyline>`,
+/// `<polygon>`, `<line>`, `<circle>`, `<ellipse>` and `<rect>`, and each
+/// sub-path of each `<path>` (a drawing program's one path often holds a
+/// shape and its hole, or several strokes). Labelled by element, `id` and
+/// sub-path. An error when there is none.
+pub fn svg_shapes(text: &str, max: usize) -> Result<Vec<(String, ImportedPath)>> {
     let doc = roxmltree::Document::parse(text)
         .map_err(|e| Error::invalid("svg", format!("not an SVG document: {e}")))?;
     let root = doc.root_element();
@@ -59,22 +74,51 @@ pub fn svg_path(text: &str) -> Result<ImportedPath> {
         ));
     }
     let mm_per_unit = unit_scale(&root)?;
-    let node = root
+    let mut out = Vec::new();
+    let nodes = root
         .descendants()
         .filter(|n| n.is_element())
         .filter(|n| !n.ancestors().any(|a| a.tag_name().name() == "defs"))
-        .find(|n| {
+        .filter(|n| {
             matches!(
                 n.tag_name().name(),
                 "path" | "polyline" | "polygon" | "line" | "circle" | "ellipse" | "rect"
             )
-        })
-        .ok_or_else(|| {
-            Error::invalid(
-                "svg",
-                "no <path>, <polyline>, <polygon>, <line>, <circle>, <ellipse> or <rect> element to import",
-            )
-        })?;
+        });
+    for node in nodes {
+        let tag = node.tag_name().name();
+        let name = match node.attribute("id") {
+            Some(id) => format!("<{tag}> {id}"),
+            None => format!("<{tag}>"),
+        };
+        let parts = shape_of(node, mm_per_unit)?;
+        let many = parts.len() > 1;
+        for (k, (pts, closed)) in parts.into_iter().enumerate() {
+            if out.len() >= max {
+                return Ok(out);
+            }
+            let label = if many {
+                format!("{name}, sub-path {}", k + 1)
+            } else {
+                name.clone()
+            };
+            let mut path = finish_path(pts, closed, &format!("svg <{tag}>"))?;
+            centre(&mut path.points);
+            out.push((label, path));
+        }
+    }
+    if out.is_empty() {
+        return Err(Error::invalid(
+            "svg",
+            "no <path>, <polyline>, <polygon>, <line>, <circle>, <ellipse> or <rect> element to import",
+        ));
+    }
+    Ok(out)
+}
+
+/// One element's shapes in mm (y up, not yet centred): a `<path>`'s
+/// sub-paths, or the one shape of the others, each with whether it closes.
+fn shape_of(node: roxmltree::Node, mm_per_unit: f64) -> Result<Vec<(Vec<[f64; 2]>, bool)>> {
     let tag = node.tag_name().name();
     // Accumulated transform, outermost first.
     let mut ts = Transform::default();
@@ -128,23 +172,20 @@ pub fn svg_path(text: &str) -> Result<ImportedPath> {
             })
             .collect())
     };
-    let (local, closed): (Vec<[f64; 2]>, bool) = match tag {
-        "path" => {
-            let (pts, closed) = flatten_path(attr("d")?, step)?;
-            (pts, closed)
-        }
-        "line" => (
+    let parts: Vec<(Vec<[f64; 2]>, bool)> = match tag {
+        "path" => flatten_path(attr("d")?, step)?,
+        "line" => vec![(
             vec![[num("x1")?, num("y1")?], [num("x2")?, num("y2")?]],
             false,
-        ),
+        )],
         "circle" => {
             let r = num("r")?;
-            (ellipse(opt("cx")?, opt("cy")?, r, r)?, true)
+            vec![(ellipse(opt("cx")?, opt("cy")?, r, r)?, true)]
         }
-        "ellipse" => (
+        "ellipse" => vec![(
             ellipse(opt("cx")?, opt("cy")?, num("rx")?, num("ry")?)?,
             true,
-        ),
+        )],
         "rect" => {
             let (x, y, w, h) = (opt("x")?, opt("y")?, num("width")?, num("height")?);
             if !(w > 0.0 && h > 0.0) {
@@ -153,25 +194,28 @@ pub fn svg_path(text: &str) -> Result<ImportedPath> {
                     "its width and height must be positive",
                 ));
             }
-            (vec![[x, y], [x + w, y], [x + w, y + h], [x, y + h]], true)
+            vec![(vec![[x, y], [x + w, y], [x + w, y + h], [x, y + h]], true)]
         }
         _ => {
             let pts: Vec<[f64; 2]> = PointsParser::from(attr("points")?)
                 .map(|(x, y)| [x, y])
                 .collect();
-            (pts, tag == "polygon")
+            vec![(pts, tag == "polygon")]
         }
     };
-    let pts: Vec<[f64; 2]> = local
-        .iter()
-        .map(|&[x, y]| {
-            let (x, y) = (ts.a * x + ts.c * y + ts.e, ts.b * x + ts.d * y + ts.f);
-            [x * mm_per_unit, -y * mm_per_unit]
+    Ok(parts
+        .into_iter()
+        .map(|(local, closed)| {
+            let pts = local
+                .iter()
+                .map(|&[x, y]| {
+                    let (x, y) = (ts.a * x + ts.c * y + ts.e, ts.b * x + ts.d * y + ts.f);
+                    [x * mm_per_unit, -y * mm_per_unit]
+                })
+                .collect();
+            (pts, closed)
         })
-        .collect();
-    let mut pts = finish_path(pts, closed, &format!("svg <{tag}>"))?;
-    centre(&mut pts.points);
-    Ok(pts)
+        .collect())
 }
 
 /// Points of a CSV file as a trajectory (mm, centred on `o` as an SVG's).
@@ -366,22 +410,20 @@ fn unit_scale(root: &roxmltree::Node) -> Result<f64> {
     })
 }
 
-/// The first sub-path of `d` flattened, and whether it closes (a `Z`, or
-/// an end on its start).
-fn flatten_path(d: &str, step: f64) -> Result<(Vec<[f64; 2]>, bool)> {
+/// Each sub-path of `d` flattened, and whether it closes (a `Z`, or an
+/// end on its start). A sub-path of one point (a bare move) is skipped.
+fn flatten_path(d: &str, step: f64) -> Result<Vec<(Vec<[f64; 2]>, bool)>> {
+    let mut out = Vec::new();
     let mut closed = false;
     let mut pts: Vec<[f64; 2]> = Vec::new();
     let mut start = [0.0, 0.0];
     let mut cur = [0.0, 0.0];
-    let mut subpaths = 0;
     for seg in SimplifyingPathParser::from(d) {
         let seg = seg.map_err(|e| Error::invalid("svg <path> d", e.to_string()))?;
         match seg {
             SimplePathSegment::MoveTo { x, y } => {
-                subpaths += 1;
-                if subpaths > 1 {
-                    break; // the first sub-path is the trajectory
-                }
+                end_subpath(&mut out, std::mem::take(&mut pts), closed);
+                closed = false;
                 cur = [x, y];
                 start = cur;
                 pts.push(cur);
@@ -393,8 +435,9 @@ fn flatten_path(d: &str, step: f64) -> Result<(Vec<[f64; 2]>, bool)> {
             SimplePathSegment::ClosePath => {
                 cur = start;
                 pts.push(cur);
-                closed = true;
-                break;
+                end_subpath(&mut out, std::mem::take(&mut pts), true);
+                // Drawing on after a `Z` starts from the sub-path's start.
+                pts.push(cur);
             }
             SimplePathSegment::CurveTo {
                 x1,
@@ -433,10 +476,23 @@ fn flatten_path(d: &str, step: f64) -> Result<(Vec<[f64; 2]>, bool)> {
             }
         }
     }
-    if pts.is_empty() {
-        return Err(Error::invalid("svg <path> d", "is empty"));
+    end_subpath(&mut out, pts, closed);
+    if out.is_empty() {
+        return Err(Error::invalid(
+            "svg <path> d",
+            "draws nothing: a path needs at least two distinct points",
+        ));
     }
-    // A path drawn back onto its start without a `Z` is closed too.
+    Ok(out)
+}
+
+/// Adds a flattened sub-path to `out` unless it is a lone point; one drawn
+/// back onto its start without a `Z` is closed too, and a closed one drops
+/// its repeated start.
+fn end_subpath(out: &mut Vec<(Vec<[f64; 2]>, bool)>, mut pts: Vec<[f64; 2]>, closed: bool) {
+    if pts.len() < 2 {
+        return;
+    }
     let ends_on_start = pts.len() > 3 && {
         let (a, b) = (pts[0], pts[pts.len() - 1]);
         (a[0] - b[0]).hypot(a[1] - b[1]) <= 1e-6 * (1.0 + a[0].abs() + a[1].abs())
@@ -444,7 +500,7 @@ fn flatten_path(d: &str, step: f64) -> Result<(Vec<[f64; 2]>, bool)> {
     if closed || ends_on_start {
         pts.pop();
     }
-    Ok((pts, closed || ends_on_start))
+    out.push((pts, closed || ends_on_start));
 }
 
 /// Segments for a Bézier curve so each is at most `step` long (the control
@@ -549,6 +605,30 @@ mod tests {
             let e = svg_trajectory(svg).unwrap_err().to_string();
             assert!(e.contains(want), "{svg}: {e}");
         }
+    }
+
+    #[test]
+    fn every_shape_and_sub_path_is_offered() {
+        // A drawing program's export: a ring (outside and hole in one
+        // path), then a circle with an id.
+        let svg = r#"<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm" viewBox="0 0 100 100">
+            <path d="M 10 10 L 90 10 L 90 90 L 10 90 Z M 30 30 L 70 30 L 70 70 L 30 70 Z"/>
+            <circle id="foot" cx="50" cy="50" r="20"/></svg>"#;
+        let shapes = svg_shapes(svg, MAX_SHAPES).unwrap();
+        let labels: Vec<&str> = shapes.iter().map(|s| s.0.as_str()).collect();
+        assert_eq!(
+            labels,
+            ["<path>, sub-path 1", "<path>, sub-path 2", "<circle> foot"]
+        );
+        assert!(shapes.iter().all(|s| s.1.closed));
+        // Each centred on o: the hole is a 40 mm square round it.
+        let hole = &shapes[1].1.points;
+        assert!(hole
+            .iter()
+            .all(|p| (p[0].abs() - 20.0).abs() < 1e-9 || (p[1].abs() - 20.0).abs() < 1e-9));
+        // The first shape is what a plain import takes; the cap holds.
+        assert_eq!(svg_path(svg).unwrap(), shapes[0].1);
+        assert_eq!(svg_shapes(svg, 2).unwrap().len(), 2);
     }
 
     #[test]

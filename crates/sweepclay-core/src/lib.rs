@@ -34,6 +34,7 @@
 //! assert_eq!(sliced.stats.stages, 1);
 //! ```
 
+pub mod beads;
 pub mod bspline;
 pub mod correct;
 pub mod curves;
@@ -262,6 +263,14 @@ pub fn slice(design: &Design) -> Result<Sliced> {
 /// The stages after the corrections: plan the path and the extrusion,
 /// compute the statistics and check that the result fits the printer.
 pub fn finish(corrected: Corrected) -> Result<Sliced> {
+    let sliced = finish_unchecked(corrected);
+    fits(&sliced)?;
+    Ok(sliced)
+}
+
+/// [`finish`] without the check that the print fits the printer: for a
+/// preview that shows what lies outside the build volume.
+pub fn finish_unchecked(corrected: Corrected) -> Sliced {
     let toolpath = toolpath::plan_path(&corrected);
     let extrusion = extrude::plan_extrusion(
         &toolpath,
@@ -269,7 +278,18 @@ pub fn finish(corrected: Corrected) -> Result<Sliced> {
         corrected.surface.printer.origin,
     );
     let stats = stats(&corrected, &toolpath, &extrusion);
-    let pr = &corrected.surface.printer;
+    Sliced {
+        corrected,
+        toolpath,
+        extrusion,
+        stats,
+    }
+}
+
+/// Whether a sliced design fits its printer's build volume (and round bed).
+pub fn fits(s: &Sliced) -> Result<()> {
+    let (toolpath, extrusion, stats) = (&s.toolpath, &s.extrusion, &s.stats);
+    let pr = &s.corrected.surface.printer;
     if let Some(d) = pr.bed_diameter {
         let c = pr.bed_centre();
         let reach = toolpath
@@ -302,12 +322,7 @@ pub fn finish(corrected: Corrected) -> Result<Sliced> {
             });
         }
     }
-    Ok(Sliced {
-        corrected,
-        toolpath,
-        extrusion,
-        stats,
-    })
+    Ok(())
 }
 
 fn stats(c: &Corrected, t: &Toolpath, e: &Extrusion) -> Stats {

@@ -9,6 +9,12 @@ import { sample, samplePeriodic } from './bspline.js';
 
 const $ = (id) => document.getElementById(id);
 const STORE = 'sweepclay.design.v1';
+// The undo history, kept across reloads (newest 60 steps, so it stays well
+// inside the browser's few megabytes of storage).
+const HISTORY = 'sweepclay.history.v1';
+const KEPT_STEPS = 60;
+const PRINTERS = 'sweepclay.printers.v1';
+const GUIDE_SEEN = 'sweepclay.guide.v1';
 
 // Each parameter: its key, its label, its unit, its input step, what it
 // does (the tooltip, with the default), and the factor between the file's
@@ -77,8 +83,11 @@ function setDesign(d, { record = true, fit = false } = {}) {
   }
   try {
     localStorage.setItem(STORE, JSON.stringify(d));
+    const kept = state.history.slice(-KEPT_STEPS);
+    const at = state.at - (state.history.length - kept.length);
+    localStorage.setItem(HISTORY, JSON.stringify({ history: kept, at }));
   } catch (e) {
-    /* private mode: no autosave */
+    /* private mode or full: no autosave */
   }
   for (const ed of editors) {
     if (fit) ed.fitted = false;
@@ -93,6 +102,7 @@ function setDesign(d, { record = true, fit = false } = {}) {
 }
 
 function edit(mutate, final) {
+  state.restored = false;
   const d = clone(state.design);
   // A parameter's own change sets it again just after this.
   state.lastParam = null;
@@ -202,6 +212,44 @@ const editors = [
 
 state.editors = editors;
 
+// The selected point, typed in or added and deleted with buttons (touch
+// screens have no double-click).
+const EDITOR_NAMES = ['start side profile', 'end side profile', 'path seen from above', 'how one profile turns into the other'];
+const AXES = [['x', 'z'], ['x', 'z'], ['x', 'y'], ['u', 'λ']];
+function showPoint(ed) {
+  if (ed.selected >= 0) state.activeEditor = ed;
+  const a = state.activeEditor;
+  const k = editors.indexOf(a);
+  const p = a && a.selected >= 0 ? a.points[a.selected] : null;
+  $('pb-what').textContent = p ? `${EDITOR_NAMES[k]}, point ${a.selected + 1} of ${a.points.length}:` : 'Click or tap a point to select it.';
+  for (const [id, v, axis] of [['pb-x', p && p[0], k >= 0 ? AXES[k][0] : 'x'], ['pb-y', p && p[1], k >= 0 ? AXES[k][1] : 'y']]) {
+    const inp = $(id);
+    inp.disabled = !p;
+    $(`${id}l`).textContent = axis;
+    if (document.activeElement !== inp) inp.value = p ? Number(v.toFixed(3)) : '';
+  }
+  $('pb-del').disabled = !(a && a.canRemove());
+  $('pb-del').title = a && a.selected >= 0 && !a.canRemove() ? 'This point stays (the base of a profile, an end, or the fewest points allowed)' : 'Delete the selected point';
+}
+for (const ed of editors) ed.o.onSelect = showPoint;
+for (const id of ['pb-x', 'pb-y']) {
+  $(id).addEventListener('change', () => {
+    const a = state.activeEditor;
+    if (!a || a.selected < 0) return;
+    const p = [parseFloat($('pb-x').value), parseFloat($('pb-y').value)];
+    if (!p.every(Number.isFinite) || !a.moveSelected(p)) showPoint(a);
+  });
+}
+$('pb-add').addEventListener('click', () => {
+  const a = state.activeEditor || editors[2];
+  state.activeEditor = a;
+  a.addAfterSelected();
+});
+$('pb-del').addEventListener('click', () => {
+  const a = state.activeEditor;
+  if (a && a.selected >= 0) a.remove(a.selected);
+});
+
 $('snap').addEventListener('change', (e) => editors.forEach((ed) => { ed.snapOn = e.target.checked; }));
 $('closed').addEventListener('change', (e) => edit((d) => {
   // A loop (a vessel) or an open wall; the interpolation and the floor
@@ -229,11 +277,33 @@ try {
 } catch (e) {
   showError(String(e.message || e));
 }
+state.view = view;
 
 function requestSlice(fit) {
-  state.pending = { design: JSON.stringify(state.design), edit: state.lastEdit, fit: fit || state.pending?.fit };
+  // The round trip counts from the oldest edit not yet shown: one merged
+  // into a waiting request keeps that request's start.
+  const edit = state.pending?.edit ?? state.lastEdit;
+  state.pending = { design: JSON.stringify(state.design), edit, fit: fit || state.pending?.fit };
   state.lastEdit = null;
+  // A verdict belongs to one design: the last one no longer applies.
+  cancelVerify();
+  setVerdict('checking');
   if (!state.inFlight) sendSlice();
+}
+
+function cancelVerify() {
+  clearTimeout(state.verifyTimer);
+  state.verifySeq++;
+}
+
+/**
+ * Marks the preview and the statistics as out of date (the design does
+ * not slice; they still show the last one that did), or clears the mark.
+ */
+function setStale(on) {
+  state.stale = on;
+  for (const id of ['preview', 'stats']) $(id).classList.toggle('stale', on);
+  $('stale-note').hidden = !on;
 }
 
 async function sendSlice() {
@@ -247,12 +317,26 @@ async function sendSlice() {
     const r = await postDesign('/api/slice?format=binary', job.design);
     const body = r.ok ? decode(await r.arrayBuffer()) : await r.json();
     if (!r.ok) {
-      showError(body.error, body.key);
-      setVerdict(null);
+      // A newer design already waiting answers for itself.
+      if (!state.pending) {
+        showError(body.error, body.key);
+        cancelVerify();
+        setVerdict(null);
+        setStale(true);
+      }
     } else {
       showError(null);
+      setStale(false);
+      state.restored = false;
       const t1 = performance.now();
       render(body, job.fit);
+      if (body.fit_error) {
+        // Shown as it is, with what lies outside the printer in red; it
+        // cannot be printed, so there is no check to wait for.
+        showError(body.fit_error.error, body.fit_error.key);
+        cancelVerify();
+        setVerdict({ printable: false, failures: [plainWords(body.fit_error.error)], locations: [] });
+      }
       const now = performance.now();
       const since = job.edit ?? t0;
       state.roundTrips.push({
@@ -264,10 +348,14 @@ async function sendSlice() {
       });
       if (state.roundTrips.length > 100) state.roundTrips.shift();
       showTiming();
-      scheduleVerify(job.design);
+      // A newer design waiting has the verdict to come, not this one.
+      if (!state.pending && !body.fit_error) scheduleVerify(job.design);
     }
   } catch (e) {
     showError(`the server did not answer: ${e.message || e}`);
+    cancelVerify();
+    setVerdict(null);
+    setStale(true);
   } finally {
     state.inFlight = false;
     setBusy(false);
@@ -296,7 +384,13 @@ function decode(buf) {
   const width = next(Float32Array);
   const pass = next(Uint32Array);
   const top = next(Uint32Array);
-  return { ...head, surface: { positions, columns, moved, curves: head.curves }, path: { order, width, pass, top } };
+  const beads = {
+    overlap: next(Float32Array),
+    overhang_deg: next(Float32Array),
+    layer_height: next(Float32Array),
+    clearance: next(Float32Array),
+  };
+  return { ...head, surface: { positions, columns, moved, curves: head.curves }, path: { order, width, pass, top, beads } };
 }
 
 function render(data, fit) {
@@ -347,8 +441,8 @@ function list(ul, items) {
 }
 
 function scheduleVerify(design) {
-  clearTimeout(state.verifyTimer);
-  const seq = ++state.verifySeq;
+  cancelVerify();
+  const seq = state.verifySeq;
   setVerdict('checking');
   state.verifyTimer = setTimeout(async () => {
     try {
@@ -359,14 +453,20 @@ function scheduleVerify(design) {
     } catch (e) {
       if (seq === state.verifySeq) setVerdict(null);
     }
-  }, 250);
+  }, VERIFY_DELAY_MS);
 }
+
+// How long the page waits after a preview before it asks for the verdict:
+// long enough that a drag does not check every step, short enough that
+// the verdict follows the last edit within DESIGN's 250 ms
+// (docs/MODELER.md).
+const VERIFY_DELAY_MS = 60;
 
 function setVerdict(v) {
   const el = $('verdict');
   el.className = '';
   if (v === null) {
-    el.textContent = '—';
+    el.textContent = '— no verdict: the design does not slice';
   } else if (v === 'checking') {
     el.textContent = 'checking…';
   } else if (v.printable) {
@@ -411,6 +511,18 @@ function param(key) {
  * A and B unit (it is V)".
  */
 function plainWords(msg) {
+  const fit = /the design does not fit printer `([^`]+)`: (\w) spans (\S+)\.\.(\S+) mm but the build volume is (\S+)\.\.(\S+) mm/.exec(msg);
+  if (fit) {
+    const [, printer, axis, a, b, lo, hi] = fit;
+    const over = Math.max(Number(lo) - Number(a), Number(b) - Number(hi));
+    const word = { x: 'wide', y: 'deep', z: 'tall' }[axis];
+    return `${over.toFixed(1)} mm too ${word} for ${printer}: along ${axis} it spans ${Number(a).toFixed(1)} to ${Number(b).toFixed(1)} mm, the printer ${Number(lo).toFixed(1)} to ${Number(hi).toFixed(1)} mm (the part outside is red in the 3D view)`;
+  }
+  const round = /the design does not fit printer `([^`]+)`: it reaches (\S+) mm from the bed's centre but the round bed is (\S+) mm across/.exec(msg);
+  if (round) {
+    const [, printer, reach, dia] = round;
+    return `${(Number(reach) - Number(dia) / 2).toFixed(1)} mm past the edge of ${printer}'s round bed (${dia} mm across; the part outside is red in the 3D view)`;
+  }
   return msg.replace(/params\.(\w+): must be between (\S+) and (\S+) \(got ([^)]+)\)/, (all, k, a, b, v) => {
     const p = param(k);
     if (!p) return all;
@@ -444,6 +556,19 @@ function showError(msg, key) {
     blamed = changed;
   }
   div.textContent = text;
+  if (state.restored) {
+    // The design from last time does not slice: never a dead end.
+    const out = document.createElement('div');
+    out.className = 'way-out';
+    out.append('This is the design from your last visit. ');
+    const ex = document.createElement('button');
+    ex.textContent = 'Open the first example instead';
+    ex.id = 'escape-example';
+    ex.addEventListener('click', () => setDesign(clone(state.meta.examples[0].design), { fit: true }));
+    out.append(ex);
+    if (state.at > 0) out.append(' or press Undo.');
+    div.append(out);
+  }
   s.appendChild(div);
   if (blamed && $(`p-${blamed}`)) $(`p-${blamed}`).classList.add('bad');
 }
@@ -453,22 +578,25 @@ function showError(msg, key) {
 function buildParams() {
   const form = $('params');
   const printer = document.createElement('label');
-  printer.innerHTML = 'printer <select id="p-printer"></select>';
+  printer.innerHTML = 'printer <select id="p-printer" title="The printer the G-code is for: its build volume, where the design lands, its extruder"></select>';
   form.appendChild(printer);
   const sel = printer.querySelector('select');
-  for (const p of state.meta.presets) {
-    const o = document.createElement('option');
-    o.value = p.name;
-    o.textContent = `${p.name} (${p.build_volume.join('×')})`;
-    sel.appendChild(o);
-  }
-  const custom = document.createElement('option');
-  custom.value = '';
-  custom.textContent = 'custom (from the file)';
-  sel.appendChild(custom);
+  fillPrinterOptions();
   sel.addEventListener('change', () => {
-    if (sel.value) edit((d) => { d.printer = sel.value; }, true);
+    if (sel.value.startsWith('kept:')) {
+      const k = keptPrinters().find((p) => `kept:${p.printer.name}` === sel.value);
+      if (k) edit((d) => { d.printer = k.printer; d.params = { ...(d.params || {}), nozzle_height: k.nozzle_height }; }, true);
+    } else if (sel.value) {
+      edit((d) => { d.printer = sel.value; }, true);
+    }
   });
+  const editPrinter = document.createElement('button');
+  editPrinter.type = 'button';
+  editPrinter.id = 'printer-edit';
+  editPrinter.textContent = 'Edit printer…';
+  editPrinter.title = 'Set up your own printer: build volume, bed_min, origin, E per mm³, nozzle body, start and end code';
+  editPrinter.addEventListener('click', openPrinter);
+  form.appendChild(editPrinter);
   for (const [key, label, unit, step, help, factor] of PARAMS) {
     const l = document.createElement('label');
     l.innerHTML = `<span>${label} <small>${unit}</small></span>`;
@@ -506,7 +634,8 @@ function fillParams() {
   }
   // Only a vessel has a floor.
   $('p-floor_layers').disabled = !d.trajectory.closed;
-  const printer = typeof d.printer === 'string' ? d.printer : d.printer ? '' : 'generic';
+  const kept = typeof d.printer === 'object' && d.printer && keptPrinters().find((k) => JSON.stringify(k.printer) === JSON.stringify(d.printer));
+  const printer = typeof d.printer === 'string' ? d.printer : kept ? `kept:${kept.printer.name}` : d.printer ? '' : 'generic';
   $('p-printer').value = printer;
   if (document.activeElement !== $('name')) $('name').value = d.name || '';
 }
@@ -597,6 +726,127 @@ $('import-file').addEventListener('change', async () => {
     showError(`${name}: ${body.error}`);
     return;
   }
+  openImport(name, body);
+});
+
+/**
+ * Ramer–Douglas–Peucker: the fewest of `pts` that keep the polyline within
+ * `tol` of itself (a loop is split at its farthest point first).
+ */
+export function simplify(pts, tol, closed) {
+  if (pts.length < 3) return pts.slice();
+  const keep = new Uint8Array(pts.length);
+  const segDist2 = (p, a, b) => {
+    const [dx, dy] = [b[0] - a[0], b[1] - a[1]];
+    const l2 = dx * dx + dy * dy;
+    const t = l2 > 0 ? Math.max(0, Math.min(1, ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2)) : 0;
+    return (p[0] - a[0] - t * dx) ** 2 + (p[1] - a[1] - t * dy) ** 2;
+  };
+  const run = (i, j) => {
+    const stack = [[i, j]];
+    while (stack.length) {
+      const [a, b] = stack.pop();
+      let far = -1;
+      let fd = tol * tol;
+      for (let k = a + 1; k < b; k++) {
+        const d = segDist2(pts[k], pts[a], pts[b % pts.length]);
+        if (d > fd) {
+          fd = d;
+          far = k;
+        }
+      }
+      if (far >= 0) {
+        keep[far] = 1;
+        stack.push([a, far], [far, b]);
+      }
+    }
+  };
+  keep[0] = 1;
+  if (closed) {
+    // The point farthest from the first splits the loop in two.
+    let far = 1;
+    for (let k = 1; k < pts.length; k++) {
+      if ((pts[k][0] - pts[0][0]) ** 2 + (pts[k][1] - pts[0][1]) ** 2 > (pts[far][0] - pts[0][0]) ** 2 + (pts[far][1] - pts[0][1]) ** 2) far = k;
+    }
+    keep[far] = 1;
+    run(0, far);
+    run(far, pts.length);
+  } else {
+    keep[pts.length - 1] = 1;
+    run(0, pts.length - 1);
+  }
+  return pts.filter((_, k) => keep[k]);
+}
+
+/** Shows an import before it replaces the path: which shape, how dense. */
+function openImport(name, body) {
+  const shapes = body.shapes && body.shapes.length ? body.shapes : [{ label: 'the path', points: body.points, closed: body.closed }];
+  const pick = $('im-pick');
+  pick.innerHTML = '';
+  shapes.forEach((sh, i) => {
+    const o = document.createElement('option');
+    o.value = i;
+    o.textContent = `${i + 1}: ${sh.label} (${sh.points.length} points${sh.closed ? ', closed' : ''})`;
+    pick.appendChild(o);
+  });
+  $('im-pick-row').hidden = shapes.length < 2;
+  $('im-simplify').checked = shapes[0].points.length > 150;
+  const chosen = () => {
+    const sh = shapes[Number(pick.value) || 0];
+    const tol = parseFloat($('im-tol').value);
+    const pts = $('im-simplify').checked && tol > 0 ? simplify(sh.points, tol, sh.closed) : sh.points;
+    return { sh, pts, tol };
+  };
+  const draw = () => {
+    const { sh, pts, tol } = chosen();
+    $('im-count').textContent = $('im-simplify').checked ? `${sh.points.length} → ${pts.length} points (within ${tol} mm)` : `${sh.points.length} points`;
+    $('im-what').textContent = `${name}: ${shapes.length} shape${shapes.length > 1 ? 's' : ''}; the path is replaced only when you press “Use this path”.`;
+    drawImport($('im-preview'), sh.points, pts, sh.closed);
+  };
+  pick.onchange = draw;
+  $('im-simplify').onchange = draw;
+  $('im-tol').oninput = draw;
+  draw();
+  const dlg = $('import-dialog');
+  dlg.onclose = () => {
+    if (dlg.returnValue !== 'use') return;
+    const { sh, pts } = chosen();
+    useImport(name, { ...body, points: pts, closed: sh.closed, offset: sh.offset || body.offset, note: sh.note ?? body.note });
+  };
+  dlg.returnValue = '';
+  dlg.showModal();
+}
+
+/** The imported curve (grey) and the points that will be kept (blue). */
+function drawImport(canvas, all, kept, closed) {
+  const c = canvas.getContext('2d');
+  const [w, h] = [canvas.width, canvas.height];
+  c.clearRect(0, 0, w, h);
+  const xs = all.map((p) => p[0]);
+  const ys = all.map((p) => p[1]);
+  const [x0, x1, y0, y1] = [Math.min(...xs), Math.max(...xs), Math.min(...ys), Math.max(...ys)];
+  const k = Math.min((w - 20) / Math.max(1e-6, x1 - x0), (h - 20) / Math.max(1e-6, y1 - y0));
+  const at = (p) => [10 + (p[0] - x0) * k + (w - 20 - (x1 - x0) * k) / 2, h - 10 - (p[1] - y0) * k - (h - 20 - (y1 - y0) * k) / 2];
+  const line = (pts, colour, width) => {
+    c.beginPath();
+    pts.forEach((p, i) => (i ? c.lineTo(...at(p)) : c.moveTo(...at(p))));
+    if (closed) c.closePath();
+    c.strokeStyle = colour;
+    c.lineWidth = width;
+    c.stroke();
+  };
+  line(all, '#bbb', 4);
+  line(kept, '#b5653a', 1.5);
+  if (kept.length <= 400) {
+    c.fillStyle = '#1d5fbf';
+    for (const p of kept) {
+      const [x, y] = at(p);
+      c.fillRect(x - 2, y - 2, 4, 4);
+    }
+  }
+}
+
+function useImport(name, body) {
   edit((d) => {
     d.trajectory = { points: body.points };
     if (body.offset === 'normal') d.trajectory.offset = 'normal';
@@ -614,7 +864,120 @@ $('import-file').addEventListener('change', async () => {
   editors[2].fitted = false;
   editors[2].fit();
   editors[2].refresh();
+}
+
+// ---------------------------------------------------------------- guide, printer, tabs
+
+function showGuide() {
+  const g = $('guide');
+  if (!g.open) g.showModal();
+}
+$('guide-open').addEventListener('click', showGuide);
+$('guide').addEventListener('close', () => {
+  try {
+    localStorage.setItem(GUIDE_SEEN, '1');
+  } catch (e) {
+    /* no storage: the guide comes back next time */
+  }
 });
+
+/** Printers the user made, kept in this browser: [{ printer, nozzle_height }]. */
+function keptPrinters() {
+  try {
+    const v = JSON.parse(localStorage.getItem(PRINTERS));
+    return Array.isArray(v) ? v.filter((p) => p && p.printer && p.printer.name) : [];
+  } catch (e) {
+    return [];
+  }
+}
+
+const PRINTER_FIELDS = [['pr-bv', 'build_volume', 3], ['pr-bm', 'bed_min', 3], ['pr-o', 'origin', 2]];
+
+function openPrinter() {
+  const d = state.design;
+  const current = typeof d.printer === 'object' && d.printer ? d.printer : state.meta.presets.find((p) => p.name === (d.printer || 'generic'));
+  const base = { ...state.meta.presets.find((p) => p.name === 'generic'), ...current };
+  state.printerBase = base;
+  $('pr-name').value = typeof d.printer === 'object' ? base.name : `my ${base.name}`;
+  for (const [id, key, n] of PRINTER_FIELDS) {
+    for (let k = 0; k < n; k++) $(`${id}${k}`).value = (base[key] || [0, 0, 0])[k];
+  }
+  $('pr-e').value = base.e_per_mm3;
+  $('pr-r').value = base.nozzle_radius;
+  $('pr-h').value = { ...state.meta.params, ...(d.params || {}) }.nozzle_height;
+  $('pr-start').value = base.start_gcode || '';
+  $('pr-end').value = base.end_gcode || '';
+  $('pr-error').textContent = '';
+  $('printer-dialog').returnValue = '';
+  $('printer-dialog').showModal();
+}
+
+$('printer-form').addEventListener('submit', (e) => {
+  if (e.submitter && e.submitter.value !== 'save') return;
+  // Everything the dialog does not show (feedrates, relative E, a round
+  // bed) stays as the printer it started from had it.
+  const printer = { ...state.printerBase, name: $('pr-name').value.trim() };
+  for (const [id, key, n] of PRINTER_FIELDS) printer[key] = Array.from({ length: n }, (_, k) => parseFloat($(`${id}${k}`).value));
+  printer.e_per_mm3 = parseFloat($('pr-e').value);
+  printer.nozzle_radius = parseFloat($('pr-r').value);
+  printer.start_gcode = $('pr-start').value;
+  printer.end_gcode = $('pr-end').value;
+  const h = parseFloat($('pr-h').value);
+  const bad = [
+    [!printer.name, 'give the printer a name'],
+    [!printer.build_volume.every((v) => v > 0), 'the build volume must be positive on every axis'],
+    [![...printer.bed_min, ...printer.origin].every(Number.isFinite), 'bed_min and the origin must be numbers'],
+    [!(printer.e_per_mm3 > 0), 'E per mm³ must be positive'],
+    [!(printer.nozzle_radius >= 0), 'the nozzle body radius must be a number of mm'],
+    [!(h > 0), 'the nozzle body height must be positive'],
+  ].find(([b]) => b);
+  if (bad) {
+    e.preventDefault();
+    $('pr-error').textContent = bad[1];
+    return;
+  }
+  const kept = keptPrinters().filter((p) => p.printer.name !== printer.name);
+  kept.push({ printer, nozzle_height: h });
+  try {
+    localStorage.setItem(PRINTERS, JSON.stringify(kept));
+  } catch (err) {
+    /* the design still carries it */
+  }
+  fillPrinterOptions();
+  edit((d) => {
+    d.printer = printer;
+    d.params = { ...(d.params || {}), nozzle_height: h };
+  }, true);
+});
+
+function fillPrinterOptions() {
+  const sel = $('p-printer');
+  sel.innerHTML = '';
+  const add = (value, text) => {
+    const o = document.createElement('option');
+    o.value = value;
+    o.textContent = text;
+    sel.appendChild(o);
+  };
+  for (const p of state.meta.presets) add(p.name, `${p.name} (${p.build_volume.join('×')})`);
+  for (const k of keptPrinters()) add(`kept:${k.printer.name}`, `${k.printer.name} (yours, ${k.printer.build_volume.join('×')})`);
+  add('', 'custom (in the design)');
+}
+
+// Phones: one panel at a time, chosen by tabs.
+for (const b of document.querySelectorAll('#tabs button')) {
+  b.addEventListener('click', () => showTab(b.dataset.tab));
+}
+function showTab(tab) {
+  document.body.dataset.tab = tab;
+  for (const b of document.querySelectorAll('#tabs button')) b.setAttribute('aria-selected', String(b.dataset.tab === tab));
+  // Canvases sized while hidden are redrawn at their real size.
+  window.dispatchEvent(new Event('resize'));
+  if (view) view.redraw();
+  editors.forEach((ed) => ed.resize());
+}
+document.body.dataset.tab = 'editors';
+
 $('download-gcode').addEventListener('click', (e) => downloadFrom('/api/gcode', 'gcode', e.currentTarget));
 $('download-stl').addEventListener('click', (e) => downloadFrom('/api/stl', 'stl', e.currentTarget));
 $('undo').addEventListener('click', undo);
@@ -631,6 +994,7 @@ $('colour-by').addEventListener('change', (e) => {
   view.recolour();
   $('legend').innerHTML = view.legend();
 });
+$('true-width').addEventListener('change', (e) => { if (view) view.setTrueWidth(e.target.checked); });
 $('show-surface').addEventListener('change', (e) => { if (view) { view.showSurface = e.target.checked; view.redraw(); } });
 $('show-path').addEventListener('change', (e) => { if (view) { view.showPath = e.target.checked; view.redraw(); } });
 $('fit-view').addEventListener('click', () => view && view.fit());
@@ -686,11 +1050,23 @@ async function start() {
   let d = null;
   try {
     d = JSON.parse(localStorage.getItem(STORE));
+    const h = JSON.parse(localStorage.getItem(HISTORY));
+    if (h && Array.isArray(h.history) && h.history.length && h.at >= 0 && h.at < h.history.length) {
+      state.history = h.history;
+      state.at = h.at;
+      d = JSON.parse(h.history[h.at]);
+    }
   } catch (e) {
     d = null;
   }
+  // What was autosaved may not slice (a key mistyped in a file opened
+  // last time): the first answer then offers a way out, and undo works.
+  state.restored = !asked && !!(d && d.trajectory);
   if (asked) d = clone(asked.design);
-  setDesign(d && d.trajectory ? d : clone(state.meta.examples[0].design), { fit: true });
+  const shown = d && d.trajectory ? d : clone(state.meta.examples[0].design);
+  // The restored design is already the history's newest step.
+  setDesign(shown, { fit: true, record: !(state.restored && state.history.length) });
+  if (!localStorage.getItem(GUIDE_SEEN)) showGuide();
 }
 
 start().catch((e) => showError(`could not start: ${e.message || e}`));

@@ -23,6 +23,7 @@ export class CurveEditor {
    *   centre: draw and drag the centre o (the trajectory's top view)
    *   ghost(): another curve to draw faintly, e.g. the other profile
    *   label(p): text beside the selected point
+   *   onSelect(editor): the selection changed (or its point moved)
    */
   constructor(canvas, o) {
     this.canvas = canvas;
@@ -69,6 +70,55 @@ export class CurveEditor {
     this.points = this.o.get().map((p) => p.slice());
     if (this.selected >= this.points.length) this.selected = -1;
     this.draw();
+    this.told();
+  }
+
+  told() {
+    if (this.o.onSelect) this.o.onSelect(this);
+  }
+
+  /** Whether the selected point may be deleted. */
+  canRemove(i = this.selected) {
+    if (i < 0 || this.points.length <= (this.o.minPoints || 2)) return false;
+    if (this.o.pinned && this.o.pinned(i, this.points)) return false;
+    return !(this.o.kept && this.o.kept(i, this.points));
+  }
+
+  /** Moves the selected point to `p` (typed in), within the constraints. */
+  moveSelected(p) {
+    const i = this.selected;
+    if (i < 0 || (this.o.pinned && this.o.pinned(i, this.points))) return false;
+    const q = this.o.constrain ? this.o.constrain(i, p, this.points) : p;
+    if (!q) return false;
+    this.points[i] = q;
+    this.changed(true);
+    this.draw();
+    this.told();
+    return true;
+  }
+
+  /**
+   * Adds a point halfway to the next one (before the last, halfway to the
+   * one before), selected: the touch gesture for double-click.
+   */
+  addAfterSelected() {
+    const n = this.points.length;
+    let i = this.selected >= 0 ? this.selected : n - 2;
+    if (i >= n - 1) i = n - 2;
+    if (i < 0) return false;
+    const [a, b] = [this.points[i], this.points[i + 1]];
+    const m = [(a[0] + b[0]) / 2, (a[1] + b[1]) / 2];
+    const pts = this.points.slice();
+    pts.splice(i + 1, 0, m);
+    const q = this.o.constrain ? this.o.constrain(i + 1, m, pts) : m;
+    if (!q) return false;
+    pts[i + 1] = q;
+    this.points = pts;
+    this.selected = i + 1;
+    this.changed(true);
+    this.draw();
+    this.told();
+    return true;
   }
 
   /** Frames all points (and o, for the trajectory). */
@@ -137,6 +187,7 @@ export class CurveEditor {
       this.selected = -1;
     }
     this.draw();
+    this.told();
   }
 
   nearCentre(px, py) {
@@ -190,7 +241,10 @@ export class CurveEditor {
     const d = this.drag;
     this.drag = null;
     if (this.canvas.hasPointerCapture(e.pointerId)) this.canvas.releasePointerCapture(e.pointerId);
-    if (d && d.moved) this.changed(true);
+    if (d && d.moved) {
+      this.changed(true);
+      this.told();
+    }
   }
 
   dbl(e) {
@@ -220,6 +274,7 @@ export class CurveEditor {
     this.selected = best + 1;
     this.changed(true);
     this.draw();
+    this.told();
   }
 
   /** Hands a copy of the points to the model; `final` ends a gesture. */
@@ -228,13 +283,12 @@ export class CurveEditor {
   }
 
   remove(i) {
-    if (this.points.length <= (this.o.minPoints || 2)) return;
-    if (this.o.pinned && this.o.pinned(i, this.points)) return;
-    if (this.o.kept && this.o.kept(i, this.points)) return;
+    if (!this.canRemove(i)) return;
     this.points.splice(i, 1);
     this.selected = -1;
     this.changed(true);
     this.draw();
+    this.told();
   }
 
   wheel(e) {

@@ -1,7 +1,11 @@
 // The 3D preview: the corrected surface (lit, translucent, moved samples in
-// orange), the toolpath as one line coloured by bead width, pass or stage,
-// the returning turns' top-edge beads as dots, and the bed. WebGL 2, drawn
-// on demand; orbit, pan and zoom with mouse, touch or pen.
+// orange), the toolpath as one line or as beads of their true width and
+// height, coloured by stability (the least room of overlap, overhang, layer
+// height and the extruder body's clearance, docs/ALGORITHMS.md §10), one of
+// those four, bead width, pass or stage; the worst bead marked, the
+// returning turns' top-edge beads as dots, the bed and the printer's build
+// volume, with what lies outside it in red. WebGL 2, drawn on demand;
+// orbit, pan and zoom with mouse, touch or pen.
 
 const VS_LIT = `#version 300 es
 in vec3 pos; in vec3 nrm; in vec3 col;
@@ -26,6 +30,30 @@ void main() { o = vec4(v_col, 1.0); }`;
 
 const CLAY = [0.83, 0.62, 0.48];
 const MOVED = [1.0, 0.5, 0.0];
+const OUTSIDE = [0.85, 0.05, 0.05];
+const WORST = [0.55, 0.0, 0.35];
+
+/** Red → yellow → green for a margin m ∈ [0, 1] (0: at the limit). */
+export function margin(m) {
+  m = Math.min(1, Math.max(0, m));
+  return hsl(m * 120, 0.75, 0.42);
+}
+
+/**
+ * The room each bead has, 0 (at or past a limit) to 1 (plenty), by each
+ * of the four figures of the bead map, and the least of them.
+ */
+export function margins(beads, i, p) {
+  const ov = (beads.overlap[i] - 0.5) / Math.max(1e-6, p.overlap - 0.5);
+  const oh = 1 - beads.overhang_deg[i] / p.max_overhang_deg;
+  const h = beads.layer_height[i];
+  const lh = h < p.layer_height * 0.95 ? h / (p.layer_height * 0.95) : h > p.max_layer_height * 1.05 ? (p.max_layer_height * 1.05) / h : 1;
+  const cl = beads.clearance[i] / p.nozzle_height;
+  const all = { overlap: ov, overhang: oh, layer: lh, clearance: cl };
+  for (const k in all) all[k] = Math.min(1, Math.max(0, all[k]));
+  all.stability = Math.min(all.overlap, all.overhang, all.layer, all.clearance);
+  return all;
+}
 
 /** Blue → cyan → green → yellow → red for f ∈ [0, 1]. */
 export function ramp(f) {
@@ -55,7 +83,8 @@ export class View3D {
     this.target = [0, 0, 30];
     this.showSurface = true;
     this.showPath = true;
-    this.colourBy = 'width';
+    this.trueWidth = false;
+    this.colourBy = 'stability';
     this.data = null;
     this.pointers = new Map();
     canvas.addEventListener('pointerdown', (e) => this.down(e));
@@ -103,7 +132,6 @@ export class View3D {
     const PP = new Float32Array(order.length * 3);
     order.forEach((s, i) => PP.set(P.subarray(3 * s, 3 * s + 3), 3 * i));
     this.pathPositions = PP;
-    this.recolour();
     // Top-edge beads and the start/end marks.
     const marks = [];
     const mcol = [];
@@ -123,12 +151,57 @@ export class View3D {
     const g = [];
     for (let x = x0; x <= x1; x += 10) g.push(x, y0, 0, x, y1, 0);
     for (let y = y0; y <= y1; y += 10) g.push(x0, y, 0, x1, y, 0);
-    this.replace('bed', this.mesh(this.flat, { pos: new Float32Array(g), col: new Float32Array(g.length).fill(0.82) }));
+    const gc = new Array(g.length).fill(0.82);
+    // The build volume, in the design's coordinates (the bed's less the
+    // origin): a box, or a cylinder for a round bed.
+    const pr = data.printer;
+    if (pr) {
+      const b0 = [pr.bed_min[0] - o[0], pr.bed_min[1] - o[1], 0];
+      const b1 = [b0[0] + pr.build_volume[0], b0[1] + pr.build_volume[1], pr.build_volume[2]];
+      const edges = [];
+      if (pr.bed_diameter) {
+        const c = [(b0[0] + b1[0]) / 2, (b0[1] + b1[1]) / 2];
+        const r = pr.bed_diameter / 2;
+        for (let k = 0; k < 64; k++) {
+          const [a, b] = [(k / 64) * 2 * Math.PI, ((k + 1) / 64) * 2 * Math.PI];
+          for (const z of [0, b1[2]]) edges.push(c[0] + r * Math.cos(a), c[1] + r * Math.sin(a), z, c[0] + r * Math.cos(b), c[1] + r * Math.sin(b), z);
+          if (k % 16 === 0) edges.push(c[0] + r * Math.cos(a), c[1] + r * Math.sin(a), 0, c[0] + r * Math.cos(a), c[1] + r * Math.sin(a), b1[2]);
+        }
+      } else {
+        const X = [b0[0], b1[0]], Y = [b0[1], b1[1]], Z = [0, b1[2]];
+        for (const y of Y) for (const z of Z) edges.push(X[0], y, z, X[1], y, z);
+        for (const x of X) for (const z of Z) edges.push(x, Y[0], z, x, Y[1], z);
+        for (const x of X) for (const y of Y) edges.push(x, y, Z[0], x, y, Z[1]);
+      }
+      g.push(...edges);
+      for (let k = 0; k < edges.length; k += 3) gc.push(0.45, 0.55, 0.7);
+      this.volume = { b0, b1, round: pr.bed_diameter ? [(b0[0] + b1[0]) / 2, (b0[1] + b1[1]) / 2, pr.bed_diameter / 2] : null };
+    } else {
+      this.volume = null;
+    }
+    this.replace('bed', this.mesh(this.flat, { pos: new Float32Array(g), col: new Float32Array(gc) }));
     this.box = [[x0, y0, 0], [x1, y1, hi[2]]];
+    // Coloured once the build volume is known (what lies outside is red).
+    this.recolour();
     if (fit) this.fit();
     // Drawn now, not at the next frame, so the caller can time the update.
     this.draw();
     gl.finish();
+  }
+
+  /** Beads drawn as boxes of their width and height, or as a line. */
+  setTrueWidth(on) {
+    this.trueWidth = on;
+    this.recolour();
+  }
+
+  /** Whether a point (design coordinates) lies outside the build volume. */
+  outside(P, i) {
+    const v = this.volume;
+    if (!v) return false;
+    const [x, y, z] = [P[3 * i], P[3 * i + 1], P[3 * i + 2]];
+    if (v.round && Math.hypot(x - v.round[0], y - v.round[1]) > v.round[2]) return true;
+    return x < v.b0[0] || y < v.b0[1] || x > v.b1[0] || y > v.b1[1] || z > v.b1[2];
   }
 
   recolour() {
@@ -138,29 +211,118 @@ export class View3D {
     const C = new Float32Array(3 * n);
     const K = d.plan.passes;
     const lower = d.plan.lower_passes;
-    const [w0, w1] = [this.params.width_min, this.params.width_max];
+    const p = this.params;
+    const [w0, w1] = [p.width_min, p.width_max];
     const top = new Set(d.path.top);
+    const beads = d.path.beads;
+    const PP = this.pathPositions;
+    // The bead with the least room, for the mark and the legend.
+    let worst = -1;
+    let worstM = 2;
+    this.outsideCount = 0;
     for (let i = 0; i < n; i++) {
       let c;
+      const m = beads ? margins(beads, i, p) : null;
+      if (m && m.stability < worstM) {
+        worstM = m.stability;
+        worst = i;
+      }
       if (this.colourBy === 'pass') c = ramp((d.path.pass[i] - 1) / Math.max(1, K - 1));
       else if (this.colourBy === 'stage') c = top.has(i) ? [0.1, 0.1, 0.1] : d.path.pass[i] > lower ? [0.93, 0.45, 0.1] : [0.15, 0.4, 0.8];
-      else c = ramp((d.path.width[i] - w0) / Math.max(1e-6, w1 - w0));
+      else if (this.colourBy === 'width' || !m) c = ramp((d.path.width[i] - w0) / Math.max(1e-6, w1 - w0));
+      else c = margin(m[this.colourBy]);
+      if (this.outside(PP, i)) {
+        c = OUTSIDE;
+        this.outsideCount++;
+      }
       C.set(c, 3 * i);
     }
-    this.replace('path', this.mesh(this.flat, { pos: this.pathPositions, col: C }));
+    this.worst = worst >= 0 ? { i: worst, m: margins(beads, worst, p) } : null;
+    this.pathColours = C;
+    this.replace('path', this.mesh(this.flat, { pos: PP, col: C }));
+    if (this.trueWidth) this.replace('tubesMesh', this.tubes(C));
+    if (this.worst) {
+      const w = PP.subarray(3 * worst, 3 * worst + 3);
+      this.replace('worstMark', this.mesh(this.flat, { pos: new Float32Array(w), col: new Float32Array(WORST) }));
+    }
     this.redraw();
+  }
+
+  /**
+   * Each bead as a box of its width and layer height (top and both sides,
+   * flat-shaded), ending at the nozzle's height: the clay as it will lie.
+   */
+  tubes(C) {
+    const d = this.data;
+    const PP = this.pathPositions;
+    const n = d.path.order.length;
+    const pos = new Float32Array(n * 18 * 3);
+    const nrm = new Float32Array(n * 18 * 3);
+    const col = new Float32Array(n * 18 * 3);
+    let v = 0;
+    const put = (p, q, c) => {
+      pos.set(p, 3 * v);
+      nrm.set(q, 3 * v);
+      col.set(c, 3 * v);
+      v++;
+    };
+    for (let i = 1; i < n; i++) {
+      const a = PP.subarray(3 * (i - 1), 3 * i);
+      const b = PP.subarray(3 * i, 3 * i + 3);
+      let [dx, dy] = [b[0] - a[0], b[1] - a[1]];
+      const l = Math.hypot(dx, dy);
+      if (l < 1e-6) continue;
+      [dx, dy] = [dx / l, dy / l];
+      const w = d.path.width[i] / 2;
+      const h = Math.max(0.1, d.path.beads ? d.path.beads.layer_height[i] : 1);
+      const s = [-dy * w, dx * w];
+      const c = C.subarray(3 * i, 3 * i + 3);
+      const corner = (p, side, up) => [p[0] + side * s[0], p[1] + side * s[1], p[2] - (up ? 0 : h)];
+      const quad = (p0, p1, p2, p3, q) => {
+        for (const p of [p0, p1, p2, p0, p2, p3]) put(p, q, c);
+      };
+      quad(corner(a, -1, true), corner(a, 1, true), corner(b, 1, true), corner(b, -1, true), [0, 0, 1]);
+      quad(corner(a, 1, true), corner(a, 1, false), corner(b, 1, false), corner(b, 1, true), [s[0], s[1], 0]);
+      quad(corner(a, -1, false), corner(a, -1, true), corner(b, -1, true), corner(b, -1, false), [-s[0], -s[1], 0]);
+    }
+    return this.mesh(this.lit, { pos: pos.subarray(0, 3 * v), nrm: nrm.subarray(0, 3 * v), col: col.subarray(0, 3 * v) });
+  }
+
+  /** What the worst bead lacks, in words, for the legend. */
+  worstWords() {
+    const w = this.worst;
+    if (!w) return '';
+    const b = this.data.path.beads;
+    const i = w.i;
+    const z = this.pathPositions[3 * i + 2].toFixed(1);
+    const [k] = Object.entries(w.m).filter(([key]) => key !== 'stability').sort((x, y) => x[1] - y[1])[0];
+    const what = {
+      overlap: `overlap ${(100 * b.overlap[i]).toFixed(0)} %`,
+      overhang: `overhang ${b.overhang_deg[i].toFixed(0)}°`,
+      layer: `layer ${b.layer_height[i].toFixed(2)} mm`,
+      clearance: `body clearance ${b.clearance[i].toFixed(1)} mm`,
+    }[k];
+    return `least room: ${what} at z ${z} mm (◆)`;
   }
 
   legend() {
     const p = this.params;
     if (!p || !this.data) return '';
-    if (this.colourBy === 'pass') return `pass 1 <i style="background:${grad()}"></i> ${this.data.plan.passes}`;
+    const out = this.outsideCount ? ` · <b style="color:#d00">${this.outsideCount} points outside the printer</b>` : '';
+    const worst = this.data.path.beads ? ` · ${this.worstWords()}` : '';
+    const m = `<i style="background:${grad(margin)}"></i>`;
+    if (this.colourBy === 'stability') return `at a limit ${m} plenty of room${worst}${out}`;
+    if (this.colourBy === 'overlap') return `overlap 50 % ${m} ${Math.round(100 * p.overlap)} %+${worst}${out}`;
+    if (this.colourBy === 'overhang') return `overhang ${p.max_overhang_deg}° ${m} 0°${worst}${out}`;
+    if (this.colourBy === 'layer') return `layer height outside ${p.layer_height}–${p.max_layer_height} mm ${m} within${worst}${out}`;
+    if (this.colourBy === 'clearance') return `body clearance 0 ${m} ${p.nozzle_height} mm${worst}${out}`;
+    if (this.colourBy === 'pass') return `pass 1 <i style="background:${grad()}"></i> ${this.data.plan.passes}${out}`;
     if (this.colourBy === 'stage') {
       return this.data.plan.stages === 2
         ? '<b style="color:#2666cc">lower stage</b> · <b style="color:#ed731a">upper stage</b> · <b>● top-edge beads (returning turns)</b>'
         : '<b style="color:#2666cc">one stage</b>';
     }
-    return `width ${p.width_min} mm <i style="background:${grad()}"></i> ${p.width_max} mm`;
+    return `width ${p.width_min} mm <i style="background:${grad()}"></i> ${p.width_max} mm${out}`;
   }
 
   /** Swaps in a new mesh and frees the GPU buffers of the old one. */
@@ -238,8 +400,16 @@ export class View3D {
     gl.uniform1f(gl.getUniformLocation(this.flat, 'size'), 5 * dpr);
     this.drawMesh(this.bed, gl.LINES);
     if (this.showPath) {
-      this.drawMesh(this.path, gl.LINE_STRIP);
+      if (!this.trueWidth) this.drawMesh(this.path, gl.LINE_STRIP);
       this.drawMesh(this.marks, gl.POINTS);
+      gl.uniform1f(gl.getUniformLocation(this.flat, 'size'), 14 * dpr);
+      this.drawMesh(this.worstMark, gl.POINTS);
+    }
+    if (this.showPath && this.trueWidth) {
+      gl.useProgram(this.lit);
+      gl.uniformMatrix4fv(gl.getUniformLocation(this.lit, 'mvp'), false, mvp);
+      gl.uniform1f(gl.getUniformLocation(this.lit, 'alpha'), 1.0);
+      this.drawMesh(this.tubesMesh, gl.TRIANGLES);
     }
     if (this.showSurface) {
       gl.useProgram(this.lit);
@@ -347,9 +517,9 @@ export function zip(P, cols) {
   return T;
 }
 
-function grad() {
+function grad(f0 = ramp) {
   return `linear-gradient(to right, ${[0, 0.25, 0.5, 0.75, 1].map((f) => {
-    const [r, g, b] = ramp(f).map((v) => Math.round(v * 255));
+    const [r, g, b] = f0(f).map((v) => Math.round(v * 255));
     return `rgb(${r},${g},${b})`;
   }).join(',')})`;
 }

@@ -124,10 +124,14 @@ impl Default for Limits {
 }
 
 /// Parses a design and refuses one whose sample count is over the limit.
+/// One that leaves the build volume is let through: slicing refuses it all
+/// the same, and the preview shows it with the part outside marked.
 pub fn parse_design(text: &str, limits: &Limits) -> Result<Design, ApiError> {
     let d = Design::from_json(text)?;
-    d.check_size(limits.max_samples)?;
-    Ok(d)
+    match d.check_size(limits.max_samples) {
+        Ok(()) | Err(sweepclay_core::Error::DoesNotFit { .. }) => Ok(d),
+        Err(e) => Err(e.into()),
+    }
 }
 
 /// The layering the path follows.
@@ -173,6 +177,24 @@ pub struct PathView {
     pub pass: Vec<u32>,
     /// Path points that are top-edge beads of returning turns.
     pub top: Vec<u32>,
+    /// How well each bead sits (overlap, overhang, layer height, the
+    /// extruder body's clearance): the stability map.
+    pub beads: sweepclay_core::beads::BeadMap,
+}
+
+/// The printer's box and body, for the preview's build volume.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct PrinterView {
+    /// Profile name.
+    pub name: String,
+    /// Build volume `[x, y, z]` (mm).
+    pub build_volume: [f64; 3],
+    /// The box's lowest corner in the printer's coordinates (mm).
+    pub bed_min: [f64; 3],
+    /// A round bed's diameter (mm), if round.
+    pub bed_diameter: Option<f64>,
+    /// Radius of the extruder body (mm).
+    pub nozzle_radius: f64,
 }
 
 /// Everything the preview shows for one design.
@@ -195,6 +217,12 @@ pub struct SliceView {
     pub origin: [f64; 2],
     /// Time spent slicing on the server (ms).
     pub slice_ms: f64,
+    /// The printer's box and body.
+    pub printer: PrinterView,
+    /// Set when the print leaves the printer's build volume: the preview
+    /// shows it, but it cannot be printed.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub fit_error: Option<FitError>,
 }
 
 impl SliceView {
@@ -203,7 +231,8 @@ impl SliceView {
     /// field but the arrays, padded with spaces to 4 bytes), then the
     /// arrays, each a u32 count and its little-endian values, in this
     /// order: surface positions (f32), columns (u32), moved (u32), path
-    /// order (u32), width (f32), pass (u32), top (u32).
+    /// order (u32), width (f32), pass (u32), top (u32), then the bead
+    /// map's overlap, overhang, layer height and clearance (f32).
     pub fn to_binary(&self) -> Vec<u8> {
         let mut json = serde_json::to_vec(&serde_json::json!({
             "stats": self.stats,
@@ -213,6 +242,8 @@ impl SliceView {
             "warnings": self.warnings,
             "origin": self.origin,
             "slice_ms": self.slice_ms,
+            "printer": self.printer,
+            "fit_error": self.fit_error,
         }))
         .expect("plain data serialises");
         while !json.len().is_multiple_of(4) {
@@ -223,9 +254,9 @@ impl SliceView {
         let words = s.positions.len()
             + s.columns.len()
             + s.moved.len()
-            + 3 * p.order.len()
+            + 7 * p.order.len()
             + p.top.len()
-            + 7;
+            + 11;
         let mut out = Vec::with_capacity(8 + json.len() + 4 * words);
         out.extend_from_slice(b"SWCL");
         out.extend_from_slice(&(json.len() as u32).to_le_bytes());
@@ -247,6 +278,14 @@ impl SliceView {
         floats(&mut out, &p.width);
         ints(&mut out, &p.pass);
         ints(&mut out, &p.top);
+        for v in [
+            &p.beads.overlap,
+            &p.beads.overhang_deg,
+            &p.beads.layer_height,
+            &p.beads.clearance,
+        ] {
+            floats(&mut out, v);
+        }
         out
     }
 }
@@ -273,9 +312,31 @@ pub fn slice_view(design: &Design, cancel: &Cancel) -> Result<SliceView, ApiErro
         .map(|(i, _)| i as u32)
         .collect();
     drop(sampled);
-    let sliced = sweepclay_core::finish(corrected)?;
+    let sliced = sweepclay_core::finish_unchecked(corrected);
+    // A print that leaves the build volume is still shown, with what lies
+    // outside marked; the page says why it cannot be printed.
+    let fit_error = sweepclay_core::fits(&sliced).err().map(|e| {
+        let e = ApiError::from(e);
+        FitError {
+            error: e.error,
+            key: e.key,
+        }
+    });
     let slice_ms = t0.elapsed().as_secs_f64() * 1e3;
-    Ok(view(&sliced, moved, slice_ms))
+    let mut v = view(&sliced, moved, slice_ms);
+    v.fit_error = fit_error;
+    Ok(v)
+}
+
+/// Why a sliced design cannot be printed on its printer (it leaves the
+/// build volume), as an API error's message and key.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct FitError {
+    /// The message.
+    pub error: String,
+    /// The design key it concerns.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub key: Option<String>,
 }
 
 fn view(s: &Sliced, moved: Vec<u32>, slice_ms: f64) -> SliceView {
@@ -313,6 +374,12 @@ fn view(s: &Sliced, moved: Vec<u32>, slice_ms: f64) -> SliceView {
         top: (0..pts.len() as u32)
             .filter(|&i| pts[i as usize].kind == PointKind::Top)
             .collect(),
+        beads: sweepclay_core::beads::bead_map(
+            &s.toolpath,
+            &s.extrusion,
+            surf.printer.nozzle_radius,
+            surf.params.nozzle_height,
+        ),
     };
     let plan = &surf.plan;
     let mut warnings = Vec::new();
@@ -356,6 +423,14 @@ fn view(s: &Sliced, moved: Vec<u32>, slice_ms: f64) -> SliceView {
         warnings,
         origin: pr.origin,
         slice_ms,
+        printer: PrinterView {
+            name: pr.name.clone(),
+            build_volume: pr.build_volume,
+            bed_min: pr.bed_min,
+            bed_diameter: pr.bed_diameter,
+            nozzle_radius: pr.nozzle_radius,
+        },
+        fit_error: None,
     }
 }
 
@@ -447,21 +522,39 @@ pub struct Imported {
     pub note: Option<String>,
     /// A closed shape (a vessel's loop: `trajectory.closed`).
     pub closed: bool,
+    /// Every shape of the file to pick from (an SVG's elements and
+    /// sub-paths, the first being the one above), each with its own label.
+    pub shapes: Vec<ImportedShape>,
 }
 
-/// Imports a trajectory; `format` is `svg` or `csv`.
-pub fn import(format: &str, text: &str) -> Result<Imported, ApiError> {
-    let path = match format {
-        "svg" => sweepclay_core::import::svg_path(text)?,
-        "csv" => sweepclay_core::import::csv_path(text)?,
-        other => {
-            return Err(ApiError::new(
-                400,
-                format!("format: `{other}` is not an import format (svg, csv)"),
-            )
-            .with_key("format"))
-        }
-    };
+/// One shape of an imported file.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ImportedShape {
+    /// What it is in the file: `<path> id, sub-path 2`, `<circle>`, `CSV`.
+    pub label: String,
+    /// Its points, its length, its offset frame and note, closed or not,
+    /// as [`Imported`]'s.
+    #[serde(flatten)]
+    pub path: ImportedPoints,
+}
+
+/// The points of one imported shape and what follows from them.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct ImportedPoints {
+    /// The points (mm, relative to `o`).
+    pub points: Vec<[f64; 2]>,
+    /// Arc length (mm).
+    pub length_mm: f64,
+    /// The offset frame it needs.
+    pub offset: sweepclay_core::Offset,
+    /// What the page should tell the user about that choice.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub note: Option<String>,
+    /// A closed shape.
+    pub closed: bool,
+}
+
+fn imported_points(path: sweepclay_core::import::ImportedPath) -> ImportedPoints {
     let (mut points, closed) = (path.points, path.closed);
     for p in &mut points {
         *p = p.map(|x| (x * 1000.0).round() / 1000.0);
@@ -473,12 +566,45 @@ pub fn import(format: &str, text: &str) -> Result<Imported, ApiError> {
     // Near o a radial offset flips from side to side: 10 mm, about two of
     // the widest beads.
     let (offset, note) = sweepclay_core::import::offset_for(&points, 10.0);
-    Ok(Imported {
+    ImportedPoints {
         points,
         length_mm,
         offset,
         note,
         closed,
+    }
+}
+
+/// Imports a trajectory; `format` is `svg` or `csv`.
+pub fn import(format: &str, text: &str) -> Result<Imported, ApiError> {
+    let shapes: Vec<ImportedShape> = match format {
+        "svg" => sweepclay_core::import::svg_shapes(text, sweepclay_core::import::MAX_SHAPES)?
+            .into_iter()
+            .map(|(label, path)| ImportedShape {
+                label,
+                path: imported_points(path),
+            })
+            .collect(),
+        "csv" => vec![ImportedShape {
+            label: "CSV points".into(),
+            path: imported_points(sweepclay_core::import::csv_path(text)?),
+        }],
+        other => {
+            return Err(ApiError::new(
+                400,
+                format!("format: `{other}` is not an import format (svg, csv)"),
+            )
+            .with_key("format"))
+        }
+    };
+    let first = shapes[0].path.clone();
+    Ok(Imported {
+        points: first.points,
+        length_mm: first.length_mm,
+        offset: first.offset,
+        note: first.note,
+        closed: first.closed,
+        shapes,
     })
 }
 
@@ -540,7 +666,11 @@ mod tests {
                 n,
                 n,
                 n,
-                v.path.top.len()
+                v.path.top.len(),
+                n,
+                n,
+                n,
+                n
             ]
         );
         // Spot-check values: the last position and the last pass.
@@ -579,6 +709,58 @@ mod tests {
         let e = parse_design(&text, &Limits::default()).unwrap_err();
         assert_eq!(e.status, 413);
         assert!(e.error.contains("params.spacing"), "{}", e.error);
+    }
+
+    #[test]
+    fn a_print_too_big_is_previewed_with_why_it_cannot_print() {
+        let mut d = design("t1");
+        d.printer = sweepclay_core::PrinterRef::Preset("cerambot-mini".into());
+        // Let through to the preview, which says why...
+        let d = parse_design(&d.to_json(), &Limits::default()).unwrap();
+        let v = slice_view(&d, &Cancel::new()).unwrap();
+        let fit = v.fit_error.as_ref().unwrap();
+        assert!(
+            fit.error.contains("does not fit printer `cerambot-mini`"),
+            "{}",
+            fit.error
+        );
+        assert_eq!(v.printer.build_volume, [120.0, 135.0, 100.0]);
+        assert!(serde_json::to_string(&v).unwrap().contains("\"fit_error\""));
+        // ... but its G-code is refused.
+        assert_eq!(gcode(&d, &Cancel::new()).unwrap_err().status, 422);
+        assert!(slice_view(&design("t1"), &Cancel::new())
+            .unwrap()
+            .fit_error
+            .is_none());
+    }
+
+    #[test]
+    fn the_bead_map_has_a_figure_for_every_path_point() {
+        let v = slice_view(&design("t2"), &Cancel::new()).unwrap();
+        let n = v.path.order.len();
+        let b = &v.path.beads;
+        for a in [&b.overlap, &b.overhang_deg, &b.layer_height, &b.clearance] {
+            assert_eq!(a.len(), n);
+        }
+        // t2 verifies: every bead overlaps the one below by at least half.
+        assert!(b.overlap.iter().all(|&o| o >= 0.5 - 1e-6));
+        assert!(b.clearance.iter().all(|&c| c > 0.0));
+    }
+
+    #[test]
+    fn an_svg_import_lists_its_shapes() {
+        let svg = r#"<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm" viewBox="0 0 100 100"><path d="M 10 50 L 90 50 M 50 10 L 50 90"/><circle cx="50" cy="50" r="30"/></svg>"#;
+        let im = import("svg", svg).unwrap();
+        let labels: Vec<&str> = im.shapes.iter().map(|s| s.label.as_str()).collect();
+        assert_eq!(
+            labels,
+            ["<path>, sub-path 1", "<path>, sub-path 2", "<circle>"]
+        );
+        assert_eq!(im.points, im.shapes[0].path.points);
+        assert!(im.shapes[2].path.closed && !im.shapes[1].path.closed);
+        let j = serde_json::to_value(&im).unwrap();
+        assert_eq!(j["shapes"][2]["closed"], true);
+        assert!(j["shapes"][0]["points"].is_array());
     }
 
     #[test]

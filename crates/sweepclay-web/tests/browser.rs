@@ -167,6 +167,59 @@ async fn download_gcode(c: &Client, downloads: &Path, missing: &str) -> std::pat
     }
 }
 
+/// Closes the first-run guide, which a fresh browser profile shows.
+async fn close_guide(c: &Client) {
+    wait_js(
+        c,
+        "return document.getElementById('guide').open",
+        "the first-run guide",
+    )
+    .await;
+    c.find(fantoccini::Locator::Id("guide-close"))
+        .await
+        .unwrap()
+        .click()
+        .await
+        .unwrap();
+    wait_js(
+        c,
+        "return !document.getElementById('guide').open",
+        "the guide to close",
+    )
+    .await;
+}
+
+/// Picks `file` in the import button's file chooser and waits for the
+/// import's preview dialog; `shape` picks a shape (0: the first), then
+/// "Use this path" replaces the trajectory. Returns the dialog's count
+/// line.
+async fn import_file(c: &Client, file: &Path, shape: usize) -> String {
+    c.find(fantoccini::Locator::Id("import-file"))
+        .await
+        .unwrap()
+        .send_keys(file.to_str().unwrap())
+        .await
+        .unwrap();
+    wait_js(
+        c,
+        "return document.getElementById('import-dialog').open",
+        "the import preview",
+    )
+    .await;
+    set_value(c, "im-pick", &shape.to_string()).await;
+    let count = js(c, "return document.getElementById('im-count').textContent").await;
+    c.find(fantoccini::Locator::Id("im-use"))
+        .await
+        .unwrap()
+        .click()
+        .await
+        .unwrap();
+    count.as_str().unwrap().to_string()
+}
+
+/// Whether the page is idle: no slice in flight or waiting.
+const IDLE: &str = "!window.sweepclay.inFlight && !window.sweepclay.pending";
+
 async fn drag(c: &Client, from: (f64, f64), by: (f64, f64), steps: usize) {
     let mut m = MouseActions::new("mouse".into())
         .then(PointerAction::MoveTo {
@@ -218,6 +271,7 @@ async fn draw_preview_and_download_verified_gcode() {
     };
 
     c.goto(&base).await.unwrap();
+    close_guide(&c).await;
     // The first design is t1: 18,432 samples, verified printable.
     let before = wait_js(&c, SAMPLES, "the statistics").await;
     assert_eq!(before, "18,432");
@@ -325,7 +379,8 @@ async fn draw_preview_and_download_verified_gcode() {
     )
     .await;
 
-    // A reload keeps the design (autosave).
+    // A reload keeps the design (autosave) and its undo history; the
+    // guide does not come back.
     c.refresh().await.unwrap();
     wait_js(
         &c,
@@ -333,9 +388,37 @@ async fn draw_preview_and_download_verified_gcode() {
         "the autosaved design after a reload",
     )
     .await;
+    assert_eq!(
+        js(&c, "return document.getElementById('guide').open").await,
+        json!(false)
+    );
+    c.find(fantoccini::Locator::Id("undo"))
+        .await
+        .unwrap()
+        .click()
+        .await
+        .unwrap();
+    wait_js(
+        &c,
+        &format!("const s = (() => {{ {SAMPLES} }})(); return s === {before}"),
+        "undo after the reload",
+    )
+    .await;
+    c.find(fantoccini::Locator::Id("redo"))
+        .await
+        .unwrap()
+        .click()
+        .await
+        .unwrap();
+    wait_js(
+        &c,
+        &format!("const s = (() => {{ {SAMPLES} }})(); return s === {after}"),
+        "redo after the reload",
+    )
+    .await;
 
-    // Colour by stage, then a screenshot for the README.
-    set_value(&c, "colour-by", "width").await;
+    // Coloured by stability (the default), a screenshot for the README.
+    set_value(&c, "colour-by", "stability").await;
     wait_js(
         &c,
         "return document.getElementById('verdict').dataset.printable === 'true'",
@@ -367,12 +450,7 @@ async fn draw_preview_and_download_verified_gcode() {
         r#"<svg xmlns="http://www.w3.org/2000/svg" width="120mm" height="60mm" viewBox="0 0 120 60"><path d="M 0 30 C 30 0, 30 0, 60 30 S 90 60, 120 30"/></svg>"#,
     )
     .unwrap();
-    c.find(fantoccini::Locator::Id("import-file"))
-        .await
-        .unwrap()
-        .send_keys(svg.to_str().unwrap())
-        .await
-        .unwrap();
+    import_file(&c, &svg, 0).await;
     wait_js(
         &c,
         "return window.sweepclay.design.trajectory.offset === 'normal' && document.getElementById('offset').value === 'normal'",
@@ -506,12 +584,7 @@ async fn draw_preview_and_download_verified_gcode() {
         r#"<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm" viewBox="0 0 100 100"><circle cx="50" cy="50" r="30"/></svg>"#,
     )
     .unwrap();
-    c.find(fantoccini::Locator::Id("import-file"))
-        .await
-        .unwrap()
-        .send_keys(cup.to_str().unwrap())
-        .await
-        .unwrap();
+    import_file(&c, &cup, 0).await;
     wait_js(
         &c,
         "return window.sweepclay.design.trajectory.closed === true && document.getElementById('closed').checked && !document.getElementById('p-floor_layers').disabled",
@@ -540,6 +613,436 @@ async fn draw_preview_and_download_verified_gcode() {
     let report = sweepclay_check::check(&text, &sweepclay_web::verify::printer_check(&printer));
     assert!(report.printable, "{:?}", report.failures);
     assert_eq!(report.extrusion_runs, 1);
+    assert_eq!(js(&c, "return window.sweepclayErrors").await, json!([]));
+    c.close().await.unwrap();
+}
+
+/// A server for one test: `SWEEPCLAY_URL`, or one in this process.
+async fn server() -> String {
+    match std::env::var("SWEEPCLAY_URL") {
+        Ok(url) => url.trim_end_matches('/').to_string(),
+        Err(_) => {
+            let listener = tokio::net::TcpListener::bind("127.0.0.1:0").await.unwrap();
+            let base = format!("http://{}", listener.local_addr().unwrap());
+            tokio::spawn(async move {
+                axum::serve(listener, sweepclay_web::router(Default::default()))
+                    .await
+                    .unwrap()
+            });
+            base
+        }
+    }
+}
+
+/// The bounding boxes (`[left, top, right, bottom]`, viewport px) of the
+/// elements a selector finds that are shown.
+async fn boxes(c: &Client, selector: &str) -> Vec<(String, [f64; 4])> {
+    let v = c
+        .execute(
+            "return [...document.querySelectorAll(arguments[0])].filter(e => e.offsetParent !== null).map(e => { const r = e.getBoundingClientRect(); return [e.id || e.tagName, [r.left, r.top, r.right, r.bottom]]; })",
+            vec![json!(selector)],
+        )
+        .await
+        .unwrap();
+    serde_json::from_value(v).unwrap()
+}
+
+/// Fails if two of the boxes overlap (by more than a pixel of rounding).
+fn no_overlap(what: &str, b: &[(String, [f64; 4])]) {
+    for (i, (na, a)) in b.iter().enumerate() {
+        for (nb, q) in &b[i + 1..] {
+            let x = a[2].min(q[2]) - a[0].max(q[0]);
+            let y = a[3].min(q[3]) - a[1].max(q[1]);
+            assert!(
+                x <= 1.0 || y <= 1.0,
+                "{what}: {na} {a:?} overlaps {nb} {q:?}"
+            );
+        }
+    }
+}
+
+/// The page tells the truth and never gets stuck: the verdict race and
+/// the out-of-date marking, a drag released over another editor, a print
+/// too big for the printer shown with its outside in red, a custom
+/// printer, imports (a CSV with comments, a dense curve simplified, one
+/// sub-path picked), an autosave that does not slice, and the layout at
+/// phone and tablet sizes.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn truthful_state_imports_printers_and_phones() {
+    let tmp = tempfile::tempdir().unwrap();
+    let downloads = tmp.path().join("downloads");
+    std::fs::create_dir_all(&downloads).unwrap();
+    let Some((_driver, c)) = start_browser(&downloads, &tmp.path().join("profile")).await else {
+        return;
+    };
+    let base = server().await;
+    c.goto(&format!("{base}/?example=t2")).await.unwrap();
+    close_guide(&c).await;
+    let printable = "return document.getElementById('verdict').dataset.printable === 'true'";
+    wait_js(&c, printable, "the verdict on t2").await;
+
+    // The verdict race: spacing changed, then within 250 ms a layer height
+    // of 0. The error stands alone: no ✓ beside it, the preview and the
+    // statistics marked out of date.
+    set_value(&c, "p-spacing", "1.0").await;
+    tokio::time::sleep(Duration::from_millis(40)).await;
+    set_value(&c, "p-layer_height", "0").await;
+    let err = wait_js(
+        &c,
+        "return document.querySelector('#status .error')?.textContent || null",
+        "the error for layer height 0",
+    )
+    .await;
+    assert!(err.as_str().unwrap().starts_with("layer height"), "{err}");
+    tokio::time::sleep(Duration::from_millis(700)).await;
+    let state = js(
+        &c,
+        "return [document.getElementById('verdict').textContent, document.getElementById('preview').classList.contains('stale'), document.getElementById('stats').classList.contains('stale'), document.getElementById('stale-note').hidden]",
+    )
+    .await;
+    assert!(!state[0].as_str().unwrap().contains('✓'), "{state}");
+    assert_eq!(
+        state.as_array().unwrap()[1..],
+        [json!(true), json!(true), json!(false)],
+        "{state}"
+    );
+    set_value(&c, "p-layer_height", "1.25").await;
+    wait_js(&c, printable, "the verdict once the layer height is back").await;
+    assert_eq!(
+        js(&c, "return document.getElementById('preview').classList.contains('stale') || !document.getElementById('stale-note').hidden").await,
+        json!(false)
+    );
+
+    // A drag released over the next editor ends there: moving over the
+    // first editor afterwards, with no button down, changes nothing.
+    let from = point_at(&c, 0, "2").await;
+    let to = point_at(&c, 1, "2").await;
+    drag(&c, from, (to.0 - from.0, to.1 - from.1), 8).await;
+    wait_js(&c, &format!("return {IDLE}"), "the slice after the drag").await;
+    let held = js(&c, "return JSON.stringify(window.sweepclay.design)").await;
+    let wander = MouseActions::new("mouse".into())
+        .then(PointerAction::MoveTo {
+            duration: None,
+            x: from.0.round(),
+            y: (from.1 + 30.0).round(),
+        })
+        .then(PointerAction::MoveTo {
+            duration: Some(Duration::from_millis(200)),
+            x: (from.0 + 25.0).round(),
+            y: (from.1 - 30.0).round(),
+        });
+    c.perform_actions(wander).await.unwrap();
+    tokio::time::sleep(Duration::from_millis(200)).await;
+    assert_eq!(
+        js(
+            &c,
+            "return window.sweepclay.editors.every(e => e.drag === null)"
+        )
+        .await,
+        json!(true)
+    );
+    assert_eq!(
+        js(&c, "return JSON.stringify(window.sweepclay.design)").await,
+        held
+    );
+
+    // Numeric entry and the touch buttons: select the third point of the
+    // path, type a new x, add a point after it, delete that point.
+    js(
+        &c,
+        "const ed = window.sweepclay.editors[2]; ed.selected = 2; ed.told(); return 0",
+    )
+    .await;
+    let x0 = js(
+        &c,
+        "return window.sweepclay.design.trajectory.control_points[2][0]",
+    )
+    .await;
+    let x1 = x0.as_f64().unwrap() + 3.0;
+    set_value(&c, "pb-x", &x1.to_string()).await;
+    assert_eq!(
+        js(
+            &c,
+            "return window.sweepclay.design.trajectory.control_points[2][0]"
+        )
+        .await,
+        json!(x1)
+    );
+    let n = js(
+        &c,
+        "return window.sweepclay.design.trajectory.control_points.length",
+    )
+    .await;
+    c.find(fantoccini::Locator::Id("pb-add"))
+        .await
+        .unwrap()
+        .click()
+        .await
+        .unwrap();
+    assert_eq!(
+        js(
+            &c,
+            "return window.sweepclay.design.trajectory.control_points.length"
+        )
+        .await,
+        json!(n.as_u64().unwrap() + 1)
+    );
+    c.find(fantoccini::Locator::Id("pb-del"))
+        .await
+        .unwrap()
+        .click()
+        .await
+        .unwrap();
+    assert_eq!(
+        js(
+            &c,
+            "return window.sweepclay.design.trajectory.control_points.length"
+        )
+        .await,
+        n
+    );
+    // The base point of a profile cannot be deleted with the button.
+    js(
+        &c,
+        "const ed = window.sweepclay.editors[0]; ed.selected = 0; ed.told(); return 0",
+    )
+    .await;
+    assert_eq!(
+        js(&c, "return document.getElementById('pb-del').disabled").await,
+        json!(true)
+    );
+
+    // Too big for the printer: the preview shows it with the part outside
+    // in red, the message says how much too big in the user's words, and
+    // the preview is the current design, not an old one.
+    set_value(&c, "example", "t1").await;
+    wait_js(&c, printable, "the verdict on t1").await;
+    set_value(&c, "p-printer", "cerambot-mini").await;
+    let err = wait_js(
+        &c,
+        "return document.querySelector('#status .error')?.textContent || null",
+        "the error for a print too big",
+    )
+    .await;
+    assert!(
+        err.as_str().unwrap().contains("mm too") && err.as_str().unwrap().contains("cerambot-mini"),
+        "{err}"
+    );
+    assert!(!err.as_str().unwrap().contains('`'), "{err}");
+    let shown = js(
+        &c,
+        "return [window.sweepclay.view.outsideCount > 0, document.getElementById('preview').classList.contains('stale'), document.getElementById('verdict').dataset.printable]",
+    )
+    .await;
+    assert_eq!(shown, json!([true, false, "false"]));
+
+    // A custom printer, kept in the browser: big enough for t1.
+    c.find(fantoccini::Locator::Id("printer-edit"))
+        .await
+        .unwrap()
+        .click()
+        .await
+        .unwrap();
+    wait_js(
+        &c,
+        "return document.getElementById('printer-dialog').open",
+        "the printer dialog",
+    )
+    .await;
+    for (id, v) in [
+        ("pr-name", "my big printer"),
+        ("pr-bv0", "300"),
+        ("pr-bv1", "300"),
+        ("pr-bv2", "300"),
+        ("pr-o0", "150"),
+        ("pr-o1", "150"),
+    ] {
+        c.execute(
+            "document.getElementById(arguments[0]).value = arguments[1]",
+            vec![json!(id), json!(v)],
+        )
+        .await
+        .unwrap();
+    }
+    c.find(fantoccini::Locator::Id("pr-save"))
+        .await
+        .unwrap()
+        .click()
+        .await
+        .unwrap();
+    wait_js(&c, printable, "the verdict on the custom printer").await;
+    assert_eq!(
+        js(&c, "return [window.sweepclay.design.printer.name, window.sweepclay.design.printer.build_volume, document.getElementById('p-printer').value]").await,
+        json!(["my big printer", [300, 300, 300], "kept:my big printer"])
+    );
+
+    // A CSV with comments before and inside its data, and a header; it is
+    // centred on o, as an SVG is.
+    let csv = tmp.path().join("wall.csv");
+    std::fs::write(
+        &csv,
+        "# drawn by hand\n# mm\nx,y\n0,0\n# the middle\n60,20\n120,0\n",
+    )
+    .unwrap();
+    import_file(&c, &csv, 0).await;
+    let pts = wait_js(
+        &c,
+        "const p = window.sweepclay.design.trajectory.points; return p && p.length === 3 ? p : null",
+        "the CSV's three points",
+    )
+    .await;
+    assert_eq!(pts, json!([[-60, -10], [0, 10], [60, -10]]));
+
+    // A dense curve (600 points from a drawing program) is offered as a
+    // few editable points within the tolerance shown.
+    let wave: Vec<String> = (0..600)
+        .map(|i| {
+            let t = i as f64 / 599.0;
+            format!(
+                "{:.3},{:.3}",
+                20.0 + 160.0 * t,
+                60.0 + 25.0 * (std::f64::consts::TAU * t).sin()
+            )
+        })
+        .collect();
+    let dense = tmp.path().join("dense.svg");
+    std::fs::write(
+        &dense,
+        format!(r#"<svg xmlns="http://www.w3.org/2000/svg" width="200mm" height="120mm" viewBox="0 0 200 120"><polyline points="{}"/></svg>"#, wave.join(" ")),
+    )
+    .unwrap();
+    let count = import_file(&c, &dense, 0).await;
+    assert!(
+        count.starts_with("600 → ") && count.contains("within 0.2 mm"),
+        "{count}"
+    );
+    let kept: usize = count["600 → ".len()..]
+        .split(' ')
+        .next()
+        .unwrap()
+        .parse()
+        .unwrap();
+    assert!((5..100).contains(&kept), "{count}");
+    wait_js(
+        &c,
+        &format!(
+            "const p = window.sweepclay.design.trajectory.points; return p && p.length === {kept}"
+        ),
+        "the simplified wave",
+    )
+    .await;
+    // The simplified points stay within the tolerance of the drawn curve:
+    // the wave's crest is still 25 mm above its middle.
+    let crest = js(&c, "return Math.max(...window.sweepclay.design.trajectory.points.map(p => p[1])) - Math.min(...window.sweepclay.design.trajectory.points.map(p => p[1]))").await;
+    assert!((crest.as_f64().unwrap() - 50.0).abs() < 0.4, "{crest}");
+
+    // Two shapes in one path: the second is picked.
+    let two = tmp.path().join("two.svg");
+    std::fs::write(
+        &two,
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="200mm" height="200mm" viewBox="0 0 200 200"><path d="M 10 100 L 190 100 M 100 40 L 100 160 L 160 160"/></svg>"#,
+    )
+    .unwrap();
+    import_file(&c, &two, 1).await;
+    wait_js(
+        &c,
+        "const p = window.sweepclay.design.trajectory.points; return p && p.length === 3",
+        "the second sub-path",
+    )
+    .await;
+    assert_eq!(js(&c, "return window.sweepclayErrors").await, json!([]));
+
+    // An autosave that does not slice (a mistyped key) opens with a way
+    // out, and the way out works.
+    c.execute(
+        "const d = {sweepclay: 1, name: 'typo', profile_start: {control_points: [[0,0],[0,30]]}, profile_end: {control_points: [[0,0],[0,30]]}, trajectory: {control_points: [[-40,20],[0,40],[40,20]]}, params: {layer_hieght: 1}}; localStorage.setItem('sweepclay.design.v1', JSON.stringify(d)); localStorage.setItem('sweepclay.history.v1', JSON.stringify({history: [JSON.stringify(d)], at: 0}));",
+        vec![],
+    )
+    .await
+    .unwrap();
+    c.goto(&base).await.unwrap();
+    wait_js(
+        &c,
+        "return document.getElementById('escape-example') !== null",
+        "the way out of an autosave that does not slice",
+    )
+    .await;
+    c.find(fantoccini::Locator::Id("escape-example"))
+        .await
+        .unwrap()
+        .click()
+        .await
+        .unwrap();
+    wait_js(&c, printable, "the first example after the way out").await;
+
+    // A phone: tabs, one panel at a time; nothing overlaps, every editor
+    // and the 3D view have room, nothing is wider than the screen.
+    c.set_window_size(390, 844).await.unwrap();
+    tokio::time::sleep(Duration::from_millis(300)).await;
+    let vw = js(&c, "return window.innerWidth").await.as_f64().unwrap();
+    for tab in ["editors", "preview", "side"] {
+        c.execute(
+            "document.querySelector(`#tabs button[data-tab=${arguments[0]}]`).click()",
+            vec![json!(tab)],
+        )
+        .await
+        .unwrap();
+        tokio::time::sleep(Duration::from_millis(200)).await;
+        let b = boxes(&c, "header, #tabs, #editors canvas, #point-bar, #view3d, #view-controls, #stats, #verdict, #params").await;
+        no_overlap(tab, &b);
+        let wide = js(&c, "return document.documentElement.scrollWidth")
+            .await
+            .as_f64()
+            .unwrap();
+        assert!(
+            wide <= vw + 1.0,
+            "{tab}: the page is {wide} px wide on a {vw} px screen"
+        );
+        assert!(
+            b.iter().any(|(n, _)| n == "tabs"),
+            "{tab}: no tabs on a phone: {b:?}"
+        );
+        let sizes: Vec<&(String, [f64; 4])> = b
+            .iter()
+            .filter(|(n, _)| n.starts_with("ed-") || n == "view3d")
+            .collect();
+        match tab {
+            "editors" => assert_eq!(sizes.len(), 4, "{b:?}"),
+            "preview" => assert_eq!(sizes.len(), 1, "{b:?}"),
+            _ => assert!(sizes.is_empty(), "{b:?}"),
+        }
+        for (n, r) in sizes {
+            assert!(
+                r[2] - r[0] > 300.0 && r[3] - r[1] > 200.0,
+                "{tab}: {n} is {r:?}"
+            );
+        }
+        if let Ok(dir) = std::env::var("SWEEPCLAY_PHONE_SCREENSHOTS") {
+            let path = format!("{dir}/phone-{tab}.png");
+            std::fs::write(&path, c.screenshot().await.unwrap()).unwrap();
+            eprintln!("phone screenshot written to {path}");
+        }
+    }
+    // A tablet: one column, the editors above the 3D view and the side.
+    c.set_window_size(768, 1024).await.unwrap();
+    tokio::time::sleep(Duration::from_millis(300)).await;
+    let b = boxes(
+        &c,
+        "header, #editors canvas, #point-bar, #view3d, #view-controls, #stats, #verdict, #params",
+    )
+    .await;
+    no_overlap("tablet", &b);
+    assert_eq!(
+        js(&c, "return document.getElementById('tabs').offsetParent").await,
+        Value::Null
+    );
+    assert_eq!(
+        b.iter()
+            .filter(|(n, _)| n.starts_with("ed-") || n == "view3d")
+            .count(),
+        5,
+        "{b:?}"
+    );
     assert_eq!(js(&c, "return window.sweepclayErrors").await, json!([]));
     c.close().await.unwrap();
 }

@@ -1,0 +1,158 @@
+//! How well each bead sits: the stability map the modeler colours the
+//! path by (docs/ALGORITHMS.md §10). The paper's constraints (overlap with
+//! the bead below, overhang, layer height, the extruder body's height H;
+//! docs/ALGORITHMS.md §3–6) hold for the whole path; this shows, bead by
+//! bead, how much room each one has. For every path point, four figures:
+//!
+//! - **overlap** with the bead below, as a fraction of its width (at least
+//!   1/2 to be supported, `params.overlap` the target);
+//! - **overhang**, the angle from vertical of the line to the centre of the
+//!   bead below;
+//! - **layer height** above the bead below (or the bed);
+//! - **clearance** of the extruder body: how far the highest clay already
+//!   laid within the body's reach lies below the body's underside,
+//!   `z + H − top`; under zero, the body would touch clay.
+//!
+//! The clearance asks a grid of the tops laid so far, cells of the body's
+//! radius: a cell counts whole when it touches the body's square, so the
+//! figure errs low (by at most a cell's diagonal in reach). One pass, linear
+//! in the path's points.
+
+use crate::extrude::{overlap_fraction, Extrusion};
+use crate::toolpath::Toolpath;
+use rustc_hash::FxHashMap;
+
+/// The four figures of every path point, in path order.
+#[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
+pub struct BeadMap {
+    /// Overlap with the bead below (fraction of this bead's width); 1 on
+    /// the bed.
+    pub overlap: Vec<f32>,
+    /// Angle from vertical to the bead below (degrees); 0 on the bed.
+    pub overhang_deg: Vec<f32>,
+    /// Height above the bead below, or above the bed (mm).
+    pub layer_height: Vec<f32>,
+    /// The extruder body's clearance over the clay within its reach (mm).
+    pub clearance: Vec<f32>,
+}
+
+/// The stability map of a toolpath and its extrusion, for an extruder body
+/// of radius `body_radius` reaching `nozzle_height` above the tip.
+pub fn bead_map(t: &Toolpath, e: &Extrusion, body_radius: f64, nozzle_height: f64) -> BeadMap {
+    let n = t.points.len();
+    let mut map = BeadMap {
+        overlap: Vec::with_capacity(n),
+        overhang_deg: Vec::with_capacity(n),
+        layer_height: Vec::with_capacity(n),
+        clearance: Vec::with_capacity(n),
+    };
+    let cell = body_radius.max(1.0);
+    let key = |v: f64| (v / cell).floor().clamp(-1e9, 1e9) as i32;
+    let mut tops: FxHashMap<(i32, i32), f64> = FxHashMap::default();
+    for (i, p) in t.points.iter().enumerate() {
+        let [x, y, z] = p.pos;
+        let (overlap, overhang) = match t.below[i] {
+            Some(b) => {
+                let q = t.points[b as usize].pos;
+                let off = (x - q[0]).hypot(y - q[1]);
+                let dz = z - q[2];
+                (
+                    overlap_fraction(e.width[i], e.width[b as usize], off),
+                    off.atan2(dz.max(1e-9)).to_degrees(),
+                )
+            }
+            None => (1.0, 0.0),
+        };
+        map.overlap.push(overlap as f32);
+        map.overhang_deg.push(overhang as f32);
+        map.layer_height.push(e.layer_height[i] as f32);
+        // The body reaches half a bead past its radius: a bead's edge is
+        // clay too.
+        let reach = body_radius + 0.5 * e.width[i];
+        let mut top = f64::NEG_INFINITY;
+        for cx in key(x - reach)..=key(x + reach) {
+            for cy in key(y - reach)..=key(y + reach) {
+                if let Some(&h) = tops.get(&(cx, cy)) {
+                    top = top.max(h);
+                }
+            }
+        }
+        let clearance = if top.is_finite() {
+            z + nozzle_height - top
+        } else {
+            nozzle_height
+        };
+        map.clearance.push(clearance.min(nozzle_height) as f32);
+        let slot = tops.entry((key(x), key(y))).or_insert(z);
+        *slot = slot.max(z);
+    }
+    map
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::toolpath::{PathPoint, PointKind};
+
+    fn path(pts: &[[f64; 3]], below: &[Option<u32>]) -> Toolpath {
+        Toolpath {
+            points: pts
+                .iter()
+                .map(|&pos| PathPoint {
+                    pos,
+                    column: 0,
+                    pass: 1,
+                    kind: PointKind::Pass,
+                })
+                .collect(),
+            below: below.to_vec(),
+            passes: 2,
+            stages: 1,
+            returning_points: 0,
+            vessel: None,
+        }
+    }
+
+    fn extrusion(n: usize, w: f64, h: &[f64]) -> Extrusion {
+        Extrusion {
+            width: vec![w; n],
+            layer_height: h.to_vec(),
+            volume: vec![0.0; n],
+            total_volume: 0.0,
+            turn_volume: 0.0,
+            turn_volume_cuboid: 0.0,
+            turn_steps: 0,
+            path_length: 0.0,
+            slow: Vec::new(),
+        }
+    }
+
+    #[test]
+    fn a_bead_leaning_out_by_a_third_of_its_width() {
+        // A bead on the bed, one 1 mm up and 1 mm out, both 3 mm wide.
+        let t = path(&[[0.0, 0.0, 1.0], [1.0, 0.0, 2.0]], &[None, Some(0)]);
+        let e = extrusion(2, 3.0, &[1.0, 1.0]);
+        let m = bead_map(&t, &e, 5.0, 30.0);
+        assert_eq!(m.overlap[0], 1.0);
+        assert!((m.overlap[1] - 2.0 / 3.0).abs() < 1e-6);
+        assert!((m.overhang_deg[1] - 45.0).abs() < 1e-4);
+        assert_eq!(m.layer_height[1], 1.0);
+        // Nothing was laid before the first bead; the second has the first
+        // 1 mm below its tip: the body clears it by H + 1.
+        assert_eq!(m.clearance[0], 30.0);
+        assert_eq!(m.clearance[1], 30.0);
+    }
+
+    #[test]
+    fn clay_higher_than_the_tip_takes_the_body_clearance() {
+        // A tall bead at z = 25, then one at z = 2 beside it, 4 mm away:
+        // within the 5 mm body, the body clears it by 2 + 30 − 25 = 7 mm.
+        let t = path(&[[0.0, 0.0, 25.0], [4.0, 0.0, 2.0]], &[None, None]);
+        let e = extrusion(2, 3.0, &[25.0, 2.0]);
+        let m = bead_map(&t, &e, 5.0, 30.0);
+        assert!((m.clearance[1] - 7.0).abs() < 1e-6);
+        // 40 mm away it is out of reach.
+        let t = path(&[[0.0, 0.0, 25.0], [40.0, 0.0, 2.0]], &[None, None]);
+        assert_eq!(bead_map(&t, &e, 5.0, 30.0).clearance[1], 30.0);
+    }
+}
