@@ -41,6 +41,7 @@ const state = {
   pending: null,
   lastEdit: null,
   roundTrips: [],
+  verdictTimes: [],
   verifyTimer: 0,
   verifySeq: 0,
   sliced: null,
@@ -108,6 +109,7 @@ function edit(mutate, final) {
   state.lastParam = null;
   mutate(d);
   state.lastEdit = state.lastEdit ?? performance.now();
+  state.lastEditAt = performance.now();
   setDesign(d, { record: final });
 }
 
@@ -279,7 +281,46 @@ try {
 }
 state.view = view;
 
+/**
+ * The edited curves in 3D, drawn at once while the slice is in flight:
+ * the path on the bed and the two profiles standing at its ends, offset
+ * the way the design says (from o, or to the left of the path, outward
+ * round a loop; docs/FORMATS.md).
+ */
+function curveLines(d) {
+  const t = d.trajectory;
+  const given = t.points || t.control_points;
+  if (!given || given.length < 2) return [];
+  const path = t.closed ? (t.points ? given.concat([given[0]]) : samplePeriodic(given)) : t.points ? given : sample(given, 160);
+  const out = [];
+  for (let i = 0; i + 1 < path.length; i++) out.push([path[i][0], path[i][1], 0], [path[i + 1][0], path[i + 1][1], 0]);
+  let area = 0;
+  for (let i = 0; i + 1 < path.length; i++) area += path[i][0] * path[i + 1][1] - path[i + 1][0] * path[i][1];
+  const outward = t.closed && area > 0 ? -1 : 1;
+  const frame = (k) => {
+    const p = path[k];
+    const q = path[Math.min(path.length - 1, k + 1)];
+    const r = path[Math.max(0, k - 1)];
+    if (t.offset === 'normal') {
+      const [dx, dy] = [q[0] - r[0], q[1] - r[1]];
+      const l = Math.hypot(dx, dy) || 1;
+      return [p, [(-dy / l) * outward, (dx / l) * outward]];
+    }
+    const l = Math.hypot(p[0], p[1]) || 1;
+    return [p, [p[0] / l, p[1] / l]];
+  };
+  for (const [key, k] of [['profile_start', 0], ['profile_end', t.closed ? 0 : path.length - 1]]) {
+    const [p, dir] = frame(k);
+    const prof = sample(d[key].control_points, 80);
+    for (let i = 0; i + 1 < prof.length; i++) {
+      for (const [x, z] of [prof[i], prof[i + 1]]) out.push([p[0] + x * dir[0], p[1] + x * dir[1], z]);
+    }
+  }
+  return out;
+}
+
 function requestSlice(fit) {
+  if (view && state.design) view.showCurves(curveLines(state.design), state.lastEdit);
   // The round trip counts from the oldest edit not yet shown: one merged
   // into a waiting request keeps that request's start.
   const edit = state.pending?.edit ?? state.lastEdit;
@@ -315,6 +356,7 @@ async function sendSlice() {
   setBusy(true);
   try {
     const r = await postDesign('/api/slice?format=binary', job.design);
+    const th = performance.now();
     const body = r.ok ? decode(await r.arrayBuffer()) : await r.json();
     if (!r.ok) {
       // A newer design already waiting answers for itself.
@@ -342,6 +384,7 @@ async function sendSlice() {
       state.roundTrips.push({
         ms: now - since,
         request_ms: t1 - t0,
+        headers_ms: th - t0,
         render_ms: now - t1,
         server_ms: body.slice_ms,
         samples: body.stats.sample_points,
@@ -450,6 +493,9 @@ function scheduleVerify(design) {
       const body = await r.json();
       if (seq !== state.verifySeq) return;
       setVerdict(r.ok ? body : { printable: false, failures: [body.error], locations: [] });
+      // For the speed budget (docs/MODELER.md): last edit → its verdict.
+      if (state.lastEditAt != null) state.verdictTimes.push(performance.now() - state.lastEditAt);
+      if (state.verdictTimes.length > 100) state.verdictTimes.shift();
     } catch (e) {
       if (seq === state.verifySeq) setVerdict(null);
     }

@@ -104,6 +104,7 @@ export class View3D {
   update(data, params, fit) {
     const gl = this.gl;
     this.data = data;
+    this.replace('curves', null);
     this.params = params;
     const P = new Float32Array(data.surface.positions);
     const n = P.length / 3;
@@ -187,6 +188,19 @@ export class View3D {
     // Drawn now, not at the next frame, so the caller can time the update.
     this.draw();
     gl.finish();
+  }
+
+  /**
+   * The edited curves (pairs of points), drawn over the last slice until
+   * the next one arrives; `since` is the edit's time, for the speed
+   * budget's immediate preview (docs/MODELER.md).
+   */
+  showCurves(lines, since) {
+    const P = new Float32Array(lines.length * 3);
+    lines.forEach((p, i) => P.set(p, 3 * i));
+    this.replace('curves', this.mesh(this.flat, { pos: P, col: new Float32Array(P.length).fill(0).map((_, i) => [0.1, 0.2, 0.75][i % 3]) }));
+    this.curvesSince = since ?? null;
+    this.redraw();
   }
 
   /** Beads drawn as boxes of their width and height, or as a line. */
@@ -399,6 +413,7 @@ export class View3D {
     gl.uniformMatrix4fv(gl.getUniformLocation(this.flat, 'mvp'), false, mvp);
     gl.uniform1f(gl.getUniformLocation(this.flat, 'size'), 5 * dpr);
     this.drawMesh(this.bed, gl.LINES);
+    this.drawMesh(this.curves, gl.LINES);
     if (this.showPath) {
       if (!this.trueWidth) this.drawMesh(this.path, gl.LINE_STRIP);
       this.drawMesh(this.marks, gl.POINTS);
@@ -422,7 +437,15 @@ export class View3D {
       gl.depthMask(true);
       gl.disable(gl.BLEND);
     }
+    if (this.curves && this.curvesSince != null) {
+      this.curveTimes.push(performance.now() - this.curvesSince);
+      if (this.curveTimes.length > 200) this.curveTimes.shift();
+      this.curvesSince = null;
+    }
   }
+
+  /** Times from edits to their curves on screen (ms), newest last. */
+  curveTimes = [];
 
   drawMesh(m, mode) {
     if (!m) return;

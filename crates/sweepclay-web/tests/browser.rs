@@ -1046,3 +1046,103 @@ async fn truthful_state_imports_printers_and_phones() {
     assert_eq!(js(&c, "return window.sweepclayErrors").await, json!([]));
     c.close().await.unwrap();
 }
+
+/// The speed budget of docs/MODELER.md, measured (not a pass/fail timing:
+/// run by `scripts/bench-modeler`, which prints the figures): t1, a drag
+/// of the end profile's top point at 60 pointer moves a second, then the
+/// round trips from the oldest edit each preview shows, and the time from
+/// the last edit to its verdict.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+#[ignore = "a measurement: scripts/bench-modeler runs it"]
+async fn modeler_speed_budget() {
+    let tmp = tempfile::tempdir().unwrap();
+    let downloads = tmp.path().join("downloads");
+    std::fs::create_dir_all(&downloads).unwrap();
+    let Some((_driver, c)) = start_browser(&downloads, &tmp.path().join("profile")).await else {
+        return;
+    };
+    let base = server().await;
+    c.goto(&format!("{base}/?example=t1")).await.unwrap();
+    close_guide(&c).await;
+    let printable = "return document.getElementById('verdict').dataset.printable === 'true'";
+    wait_js(&c, printable, "the verdict on t1").await;
+    let rounds: usize = std::env::var("SWEEPCLAY_BENCH_DRAGS")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(5);
+    let (mut preview, mut verdict) = (Vec::new(), Vec::new());
+    let mut parts: [Vec<f64>; 4] = Default::default();
+    let mut curves = Vec::new();
+    for r in 0..rounds {
+        js(&c, "window.sweepclay.roundTrips = []; window.sweepclay.verdictTimes = []; window.sweepclay.view.curveTimes = []; return 0").await;
+        let top = point_at(&c, 1, "ed.points.length - 1").await;
+        let dy = if r % 2 == 0 { -30.0 } else { 30.0 };
+        let mut m = MouseActions::new("mouse".into())
+            .then(PointerAction::MoveTo {
+                duration: None,
+                x: top.0.round(),
+                y: top.1.round(),
+            })
+            .then(PointerAction::Down {
+                button: MOUSE_BUTTON_LEFT,
+            });
+        for k in 1..=60 {
+            m = m.then(PointerAction::MoveTo {
+                duration: Some(Duration::from_millis(16)),
+                x: top.0.round(),
+                y: (top.1 + dy * k as f64 / 60.0).round(),
+            });
+        }
+        m = m.then(PointerAction::Up {
+            button: MOUSE_BUTTON_LEFT,
+        });
+        c.perform_actions(m).await.unwrap();
+        wait_js(
+            &c,
+            &format!("return {IDLE} && window.sweepclay.verdictTimes.length > 0"),
+            "the verdict after the drag",
+        )
+        .await;
+        let v = js(
+            &c,
+            "return [window.sweepclay.roundTrips.map(r => r.ms), window.sweepclay.verdictTimes.at(-1), window.sweepclay.roundTrips.map(r => [r.server_ms, r.request_ms, r.render_ms, r.headers_ms]), window.sweepclay.view.curveTimes]",
+        )
+        .await;
+        preview.extend(v[0].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()));
+        for p in v[2].as_array().unwrap() {
+            for k in 0..4 {
+                parts[k].push(p[k].as_f64().unwrap());
+            }
+        }
+        verdict.push(v[1].as_f64().unwrap());
+        curves.extend(v[3].as_array().unwrap().iter().map(|x| x.as_f64().unwrap()));
+    }
+    preview.sort_by(f64::total_cmp);
+    verdict.sort_by(f64::total_cmp);
+    curves.sort_by(f64::total_cmp);
+    assert!(!curves.is_empty(), "the edited curves were never drawn");
+    let q = |v: &[f64], f: f64| v[((v.len() as f64 - 1.0) * f).round() as usize];
+    eprintln!(
+        "modeler speed (t1, {rounds} drags of 60 moves at 60 Hz): the edited curves in 3D, {} frames, from the edit median {:.0} ms, 95th percentile {:.0} ms; {} sliced previews, from the oldest unshown edit median {:.0} ms, 95th percentile {:.0} ms, max {:.0} ms; last edit to verdict median {:.0} ms, max {:.0} ms",
+        curves.len(),
+        q(&curves, 0.5),
+        q(&curves, 0.95),
+        preview.len(),
+        q(&preview, 0.5),
+        q(&preview, 0.95),
+        preview[preview.len() - 1],
+        q(&verdict, 0.5),
+        verdict[verdict.len() - 1],
+    );
+    for p in &mut parts {
+        p.sort_by(f64::total_cmp);
+    }
+    eprintln!(
+        "modeler speed, medians of a preview's parts: slicing on the server {:.0} ms, the request with transfer and decoding {:.0} ms (its headers after {:.0} ms), drawing {:.0} ms",
+        q(&parts[0], 0.5),
+        q(&parts[1], 0.5),
+        q(&parts[3], 0.5),
+        q(&parts[2], 0.5),
+    );
+    c.close().await.unwrap();
+}
