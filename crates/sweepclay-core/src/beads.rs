@@ -7,7 +7,8 @@
 //! - **overlap** with the bead below, as a fraction of its width (at least
 //!   1/2 to be supported, `params.overlap` the target);
 //! - **overhang**, the angle from vertical of the line to the centre of the
-//!   bead below;
+//!   bead below, over the taller of the two beads (as the checker, so a
+//!   thin bead pressed onto a thick one is no steep overhang);
 //! - **layer height** above the bead below (or the bed);
 //! - **clearance** of the extruder body: how far the highest clay already
 //!   laid within the body's reach lies below the body's underside,
@@ -56,9 +57,14 @@ pub fn bead_map(t: &Toolpath, e: &Extrusion, body_radius: f64, nozzle_height: f6
                 let q = t.points[b as usize].pos;
                 let off = (x - q[0]).hypot(y - q[1]);
                 let dz = z - q[2];
+                // Against the taller of this bead and the one below, as
+                // the checker measures it: a thin bead pressed onto a
+                // thick one (a spiral's first turn rising from the floor)
+                // leans over that bead's height, not its own.
+                let h = dz.max(e.layer_height[b as usize]).max(1e-9);
                 (
                     overlap_fraction(e.width[i], e.width[b as usize], off),
-                    off.atan2(dz.max(1e-9)).to_degrees(),
+                    off.atan2(h).to_degrees(),
                 )
             }
             None => (1.0, 0.0),
@@ -141,6 +147,19 @@ mod tests {
         // 1 mm below its tip: the body clears it by H + 1.
         assert_eq!(m.clearance[0], 30.0);
         assert_eq!(m.clearance[1], 30.0);
+    }
+
+    #[test]
+    fn a_thin_bead_pressed_on_a_thick_one_leans_over_the_thick_one() {
+        // 0.3 mm up and 0.3 mm out from a 1.25 mm bead: 13.5°, not 45°.
+        let t = path(&[[0.0, 0.0, 1.25], [0.3, 0.0, 1.55]], &[None, Some(0)]);
+        let e = extrusion(2, 3.0, &[1.25, 0.3]);
+        let m = bead_map(&t, &e, 5.0, 30.0);
+        assert!(
+            (m.overhang_deg[1] - 0.24f32.atan().to_degrees()).abs() < 1e-3,
+            "{}",
+            m.overhang_deg[1]
+        );
     }
 
     #[test]

@@ -47,7 +47,10 @@ export function margins(beads, i, p) {
   const ov = (beads.overlap[i] - 0.5) / Math.max(1e-6, p.overlap - 0.5);
   const oh = 1 - beads.overhang_deg[i] / p.max_overhang_deg;
   const h = beads.layer_height[i];
-  const lh = h < p.layer_height * 0.95 ? h / (p.layer_height * 0.95) : h > p.max_layer_height * 1.05 ? (p.max_layer_height * 1.05) / h : 1;
+  // A layer thinner than the minimum is a bead pressed onto the one below
+  // (a spiral's first turn, a rim's taper): supported, but worth seeing,
+  // so it goes no lower than half; one thicker than the maximum falls off.
+  const lh = h < p.layer_height * 0.95 ? 0.5 + 0.5 * (h / (p.layer_height * 0.95)) : h > p.max_layer_height * 1.05 ? (p.max_layer_height * 1.05) / h : 1;
   const cl = beads.clearance[i] / p.nozzle_height;
   const all = { overlap: ov, overhang: oh, layer: lh, clearance: cl };
   for (const k in all) all[k] = Math.min(1, Math.max(0, all[k]));
