@@ -435,6 +435,29 @@ async fn draw_preview_and_download_verified_gcode() {
     let file = download_gcode(&c, &downloads, "no G-code was downloaded").await;
     // The design's own name, spaces kept.
     assert_eq!(file.file_name().unwrap(), "t1 wave ring.gcode");
+    // A name in any script keeps its letters in the file name; only what
+    // no file system takes is replaced.
+    set_value(&c, "name", "my sail édition #2: «vase»").await;
+    c.find(fantoccini::Locator::Id("save"))
+        .await
+        .unwrap()
+        .click()
+        .await
+        .unwrap();
+    let want = downloads.join("my sail édition #2_ «vase».json");
+    let deadline = Instant::now() + Duration::from_secs(20);
+    while !want.exists() {
+        assert!(
+            Instant::now() < deadline,
+            "no {}: {:?}",
+            want.display(),
+            std::fs::read_dir(&downloads).unwrap().collect::<Vec<_>>()
+        );
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    }
+    let saved: Value = serde_json::from_str(&std::fs::read_to_string(&want).unwrap()).unwrap();
+    assert_eq!(saved["name"], "my sail édition #2: «vase»");
+    set_value(&c, "name", "t1 wave ring").await;
     let text = std::fs::read_to_string(&file).unwrap();
     let printer = sweepclay_core::Printer::preset("cerambot-plus").unwrap();
     let report = sweepclay_check::check(&text, &sweepclay_web::verify::printer_check(&printer));
