@@ -14,14 +14,14 @@
 //!   laid within the body's reach lies below the body's underside,
 //!   `z + H − top`; under zero, the body would touch clay.
 //!
-//! The clearance asks a grid of the tops laid so far, cells of the body's
-//! radius: a cell counts whole when it touches the body's square, so the
-//! figure errs low (by at most a cell's diagonal in reach). One pass, linear
-//! in the path's points.
+//! The clearance asks a grid of the tops laid so far (dense, over the
+//! path's plan box, cells of the body's radius, larger only where the box
+//! is over 1024 of them along a side): a cell counts whole when it touches the
+//! body's square, so the figure errs low (by at most a cell's diagonal in
+//! reach). One pass, linear in the path's points.
 
 use crate::extrude::{overlap_fraction, Extrusion};
 use crate::toolpath::Toolpath;
-use rustc_hash::FxHashMap;
 
 /// The four figures of every path point, in path order.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]
@@ -47,9 +47,21 @@ pub fn bead_map(t: &Toolpath, e: &Extrusion, body_radius: f64, nozzle_height: f6
         layer_height: Vec::with_capacity(n),
         clearance: Vec::with_capacity(n),
     };
-    let cell = body_radius.max(1.0);
-    let key = |v: f64| (v / cell).floor().clamp(-1e9, 1e9) as i32;
-    let mut tops: FxHashMap<(i32, i32), f64> = FxHashMap::default();
+    // A dense grid over the path's plan box: cells of the body's radius,
+    // larger where the box is over 1024 of them along a side (a million
+    // cells at most).
+    let (mut lo, mut hi) = ([f64::INFINITY; 2], [f64::NEG_INFINITY; 2]);
+    for p in &t.points {
+        for a in 0..2 {
+            lo[a] = lo[a].min(p.pos[a]);
+            hi[a] = hi[a].max(p.pos[a]);
+        }
+    }
+    let span = [(hi[0] - lo[0]).max(0.0), (hi[1] - lo[1]).max(0.0)];
+    let cell = body_radius.max(1.0).max(span[0].max(span[1]) / 1024.0);
+    let (nx, ny) = ((span[0] / cell) as usize + 1, (span[1] / cell) as usize + 1);
+    let at = |v: f64, a: usize, n: usize| (((v - lo[a]) / cell).max(0.0) as usize).min(n - 1);
+    let mut tops = vec![f64::NEG_INFINITY; if n == 0 { 0 } else { nx * ny }];
     for (i, p) in t.points.iter().enumerate() {
         let [x, y, z] = p.pos;
         let (overlap, overhang) = match t.below[i] {
@@ -76,11 +88,10 @@ pub fn bead_map(t: &Toolpath, e: &Extrusion, body_radius: f64, nozzle_height: f6
         // clay too.
         let reach = body_radius + 0.5 * e.width[i];
         let mut top = f64::NEG_INFINITY;
-        for cx in key(x - reach)..=key(x + reach) {
-            for cy in key(y - reach)..=key(y + reach) {
-                if let Some(&h) = tops.get(&(cx, cy)) {
-                    top = top.max(h);
-                }
+        for cy in at(y - reach, 1, ny)..=at(y + reach, 1, ny) {
+            let row = &tops[cy * nx..(cy + 1) * nx];
+            for &h in &row[at(x - reach, 0, nx)..=at(x + reach, 0, nx)] {
+                top = top.max(h);
             }
         }
         let clearance = if top.is_finite() {
@@ -89,7 +100,7 @@ pub fn bead_map(t: &Toolpath, e: &Extrusion, body_radius: f64, nozzle_height: f6
             nozzle_height
         };
         map.clearance.push(clearance.min(nozzle_height) as f32);
-        let slot = tops.entry((key(x), key(y))).or_insert(z);
+        let slot = &mut tops[at(y, 1, ny) * nx + at(x, 0, nx)];
         *slot = slot.max(z);
     }
     map
@@ -160,6 +171,15 @@ mod tests {
             "{}",
             m.overhang_deg[1]
         );
+    }
+
+    #[test]
+    fn a_path_kilometres_across_keeps_its_grid_small() {
+        // 1000 km apart: cells of a kilometre, a million of them at most;
+        // the far bead is out of the first one's reach.
+        let t = path(&[[0.0, 0.0, 25.0], [1e9, 1e9, 2.0]], &[None, None]);
+        let e = extrusion(2, 3.0, &[25.0, 2.0]);
+        assert_eq!(bead_map(&t, &e, 5.0, 30.0).clearance[1], 30.0);
     }
 
     #[test]

@@ -43,7 +43,7 @@ export function margin(m) {
  * The room each bead has, 0 (at or past a limit) to 1 (plenty), by each
  * of the four figures of the bead map, and the least of them.
  */
-export function margins(beads, i, p) {
+export function margins(beads, i, p, all = {}) {
   const ov = (beads.overlap[i] - 0.5) / Math.max(1e-6, p.overlap - 0.5);
   const oh = 1 - beads.overhang_deg[i] / p.max_overhang_deg;
   const h = beads.layer_height[i];
@@ -52,8 +52,11 @@ export function margins(beads, i, p) {
   // so it goes no lower than half; one thicker than the maximum falls off.
   const lh = h < p.layer_height * 0.95 ? 0.5 + 0.5 * (h / (p.layer_height * 0.95)) : h > p.max_layer_height * 1.05 ? (p.max_layer_height * 1.05) / h : 1;
   const cl = beads.clearance[i] / p.nozzle_height;
-  const all = { overlap: ov, overhang: oh, layer: lh, clearance: cl };
-  for (const k in all) all[k] = Math.min(1, Math.max(0, all[k]));
+  // Filled in place: the page asks for every bead of the path at once.
+  all.overlap = Math.min(1, Math.max(0, ov));
+  all.overhang = Math.min(1, Math.max(0, oh));
+  all.layer = Math.min(1, Math.max(0, lh));
+  all.clearance = Math.min(1, Math.max(0, cl));
   all.stability = Math.min(all.overlap, all.overhang, all.layer, all.clearance);
   return all;
 }
@@ -237,9 +240,10 @@ export class View3D {
     let worst = -1;
     let worstM = 2;
     this.outsideCount = 0;
+    const scratch = {};
     for (let i = 0; i < n; i++) {
       let c;
-      const m = beads ? margins(beads, i, p) : null;
+      const m = beads ? margins(beads, i, p, scratch) : null;
       if (m && m.stability < worstM) {
         worstM = m.stability;
         worst = i;
