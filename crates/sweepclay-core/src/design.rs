@@ -374,6 +374,25 @@ impl Design {
         serde_json::to_string_pretty(self).expect("a design always serialises")
     }
 
+    /// Refuses, before anything is sampled, a design with a parameter out
+    /// of its range or whose estimated sample count
+    /// ([`Design::estimated_samples`]) is over `max_samples`
+    /// ([`Error::TooLarge`]): the cap on work, without [`Design::check_size`]'s
+    /// early fit check (for a preview that shows what leaves the printer).
+    pub fn check_samples(&self, max_samples: f64) -> crate::Result<()> {
+        // A parameter out of its range is that, not a huge estimate (a
+        // layer height of 0 is no "infinitely many samples").
+        self.params.validate()?;
+        let estimate = self.printed().estimated_samples();
+        if estimate > max_samples {
+            return Err(Error::TooLarge {
+                estimate,
+                limit: max_samples,
+            });
+        }
+        Ok(())
+    }
+
     /// Refuses, before anything is sampled, a design whose estimated sample
     /// count ([`Design::estimated_samples`]) is over `max_samples`
     /// ([`Error::TooLarge`]), or that cannot fit its printer: the surface
@@ -383,18 +402,9 @@ impl Design {
     /// B-spline Ψ does not pass through its control points, so for a
     /// closed Ψ only the height is checked here (slicing checks the rest).
     pub fn check_size(&self, max_samples: f64) -> crate::Result<()> {
-        // A parameter out of its range is that, not a huge estimate (a
-        // layer height of 0 is no "infinitely many samples").
-        self.params.validate()?;
+        self.check_samples(max_samples)?;
         let printed = self.printed();
         let this = &printed;
-        let estimate = this.estimated_samples();
-        if estimate > max_samples {
-            return Err(Error::TooLarge {
-                estimate,
-                limit: max_samples,
-            });
-        }
         let pr = self.printer.resolve()?;
         let t = &this.trajectory;
         let pts = t.given_points();

@@ -347,9 +347,7 @@ fn rings_of(
             if !ccw {
                 ring.reverse();
             }
-            let mut closed = ring.clone();
-            closed.push(ring[0]);
-            let perimeter = crate::curves::arc_lengths(&closed)[ring.len()];
+            let perimeter = closed_loop(&ring).1[ring.len()];
             if 2.0 * ring_area(&ring) / perimeter < 0.75 * pitch {
                 if let Some(line) = midline(&ring, spacing) {
                     rings.push(FloorRing {
@@ -377,9 +375,7 @@ fn rings_of(
 /// linear.
 fn lies_on_itself(ring: &[[f64; 2]], pitch: f64) -> Option<[f64; 2]> {
     let m = ring.len();
-    let mut closed = ring.to_vec();
-    closed.push(ring[0]);
-    let cum = crate::curves::arc_lengths(&closed);
+    let cum = closed_loop(ring).1;
     let perimeter = cum[m];
     // Two points on opposite sides of a tail: nearer than half a pitch in
     // the plane, farther along the ring than round a U-turn of two beads.
@@ -475,10 +471,6 @@ const OFFSET_SAG_MM: f64 = 0.01;
 /// continuous path cannot go from one island to the next without crossing
 /// the clay between them, so such a floor is refused (docs/ALGORITHMS.md
 /// §8).
-pub fn floor_split(outer: &[[f64; 2]], pitch: f64) -> Option<(f64, usize)> {
-    split_of(&inward_offsets(outer, pitch), pitch)
-}
-
 fn split_of(offsets: &[Vec<Vec<[f64; 2]>>], pitch: f64) -> Option<(f64, usize)> {
     offsets
         .iter()
@@ -557,12 +549,19 @@ fn midline(ring: &[[f64; 2]], spacing: f64) -> Option<Vec<[f64; 2]>> {
     )
 }
 
+/// A loop of points with its first point again at the end, and the arc
+/// lengths along it (the last is the perimeter).
+fn closed_loop(ring: &[[f64; 2]]) -> (Vec<[f64; 2]>, Vec<f64>) {
+    let mut closed = ring.to_vec();
+    closed.push(ring[0]);
+    let cum = crate::curves::arc_lengths(&closed);
+    (closed, cum)
+}
+
 /// A closed polygon resampled into points about `spacing` apart (at least
 /// three when it is longer than a few spacings, none when it is a speck).
 fn resample_loop(poly: &[[f64; 2]], spacing: f64) -> Vec<[f64; 2]> {
-    let mut closed = poly.to_vec();
-    closed.push(poly[0]);
-    let cum = crate::curves::arc_lengths(&closed);
+    let (closed, cum) = closed_loop(poly);
     let length = cum[cum.len() - 1];
     if length < 3.0 * spacing {
         return Vec::new();

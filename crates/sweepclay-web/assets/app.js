@@ -3,7 +3,7 @@
 // the browser, and re-sliced by the server; the preview, the statistics and
 // the checker's verdict follow.
 
-import { CurveEditor, fmt } from './editor.js';
+import { CurveEditor, fmt, segDist } from './editor.js';
 import { View3D } from './view3d.js';
 import { sample, samplePeriodic } from './bspline.js';
 
@@ -253,11 +253,14 @@ $('pb-del').addEventListener('click', () => {
 });
 
 $('snap').addEventListener('change', (e) => editors.forEach((ed) => { ed.snapOn = e.target.checked; }));
-$('closed').addEventListener('change', (e) => edit((d) => {
-  // A loop (a vessel) or an open wall; the interpolation and the floor
-  // follow (docs/FORMATS.md).
+/**
+ * Makes `d`'s trajectory a loop (a vessel) or an open wall; the
+ * interpolation (a loop's ends at 0, a wall's at 0 and 1) and the floor
+ * follow (docs/FORMATS.md).
+ */
+function setClosed(d, closed) {
   const ip = d.interpolation?.control_points;
-  if (e.target.checked) {
+  if (closed) {
     d.trajectory.closed = true;
     if (ip && ip[ip.length - 1][1] !== 0) delete d.interpolation;
   } else {
@@ -265,7 +268,8 @@ $('closed').addEventListener('change', (e) => edit((d) => {
     if (ip && ip[ip.length - 1][1] !== 1) delete d.interpolation;
     if (d.params) delete d.params.floor_layers;
   }
-}, true));
+}
+$('closed').addEventListener('change', (e) => edit((d) => setClosed(d, e.target.checked), true));
 $('offset').addEventListener('change', (e) => edit((d) => {
   if (e.target.value === 'normal') d.trajectory.offset = 'normal';
   else delete d.trajectory.offset;
@@ -332,6 +336,14 @@ function requestSlice(fit) {
   if (!state.inFlight) sendSlice();
 }
 
+/** The design did not slice: the error, no verdict, the old preview greyed. */
+function sliceFailed(msg, key) {
+  showError(msg, key);
+  cancelVerify();
+  setVerdict(null);
+  setStale(true);
+}
+
 function cancelVerify() {
   clearTimeout(state.verifyTimer);
   state.verifySeq++;
@@ -342,7 +354,6 @@ function cancelVerify() {
  * not slice; they still show the last one that did), or clears the mark.
  */
 function setStale(on) {
-  state.stale = on;
   for (const id of ['preview', 'stats']) $(id).classList.toggle('stale', on);
   $('stale-note').hidden = !on;
 }
@@ -360,12 +371,7 @@ async function sendSlice() {
     const body = r.ok ? decode(await r.arrayBuffer()) : await r.json();
     if (!r.ok) {
       // A newer design already waiting answers for itself.
-      if (!state.pending) {
-        showError(body.error, body.key);
-        cancelVerify();
-        setVerdict(null);
-        setStale(true);
-      }
+      if (!state.pending) sliceFailed(body.error, body.key);
     } else {
       showError(null);
       setStale(false);
@@ -395,10 +401,7 @@ async function sendSlice() {
       if (!state.pending && !body.fit_error) scheduleVerify(job.design);
     }
   } catch (e) {
-    showError(`the server did not answer: ${e.message || e}`);
-    cancelVerify();
-    setVerdict(null);
-    setStale(true);
+    sliceFailed(`the server did not answer: ${e.message || e}`);
   } finally {
     state.inFlight = false;
     setBusy(false);
@@ -779,23 +782,17 @@ $('import-file').addEventListener('change', async () => {
  * Ramer–Douglas–Peucker: the fewest of `pts` that keep the polyline within
  * `tol` of itself (a loop is split at its farthest point first).
  */
-export function simplify(pts, tol, closed) {
+function simplify(pts, tol, closed) {
   if (pts.length < 3) return pts.slice();
   const keep = new Uint8Array(pts.length);
-  const segDist2 = (p, a, b) => {
-    const [dx, dy] = [b[0] - a[0], b[1] - a[1]];
-    const l2 = dx * dx + dy * dy;
-    const t = l2 > 0 ? Math.max(0, Math.min(1, ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2)) : 0;
-    return (p[0] - a[0] - t * dx) ** 2 + (p[1] - a[1] - t * dy) ** 2;
-  };
   const run = (i, j) => {
     const stack = [[i, j]];
     while (stack.length) {
       const [a, b] = stack.pop();
       let far = -1;
-      let fd = tol * tol;
+      let fd = tol;
       for (let k = a + 1; k < b; k++) {
-        const d = segDist2(pts[k], pts[a], pts[b % pts.length]);
+        const d = segDist(pts[a], pts[b % pts.length], pts[k]);
         if (d > fd) {
           fd = d;
           far = k;
@@ -826,7 +823,7 @@ export function simplify(pts, tol, closed) {
 
 /** Shows an import before it replaces the path: which shape, how dense. */
 function openImport(name, body) {
-  const shapes = body.shapes && body.shapes.length ? body.shapes : [{ label: 'the path', points: body.points, closed: body.closed }];
+  const shapes = body.shapes;
   const pick = $('im-pick');
   pick.innerHTML = '';
   shapes.forEach((sh, i) => {
@@ -857,7 +854,7 @@ function openImport(name, body) {
   dlg.onclose = () => {
     if (dlg.returnValue !== 'use') return;
     const { sh, pts } = chosen();
-    useImport(name, { ...body, points: pts, closed: sh.closed, offset: sh.offset || body.offset, note: sh.note ?? body.note });
+    useImport(name, { ...sh, points: pts });
   };
   dlg.returnValue = '';
   dlg.showModal();
@@ -896,15 +893,7 @@ function useImport(name, body) {
   edit((d) => {
     d.trajectory = { points: body.points };
     if (body.offset === 'normal') d.trajectory.offset = 'normal';
-    if (body.closed) {
-      d.trajectory.closed = true;
-      const ip = d.interpolation?.control_points;
-      if (ip && ip[ip.length - 1][1] !== 0) delete d.interpolation;
-    } else {
-      const ip = d.interpolation?.control_points;
-      if (ip && ip[ip.length - 1][1] !== 1) delete d.interpolation;
-      if (d.params) delete d.params.floor_layers;
-    }
+    setClosed(d, body.closed);
   }, true);
   if (body.note) showNote(`${name}: ${body.note}`);
   editors[2].fitted = false;

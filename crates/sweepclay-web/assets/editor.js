@@ -107,14 +107,21 @@ export class CurveEditor {
     if (i >= n - 1) i = n - 2;
     if (i < 0) return false;
     const [a, b] = [this.points[i], this.points[i + 1]];
-    const m = [(a[0] + b[0]) / 2, (a[1] + b[1]) / 2];
+    return this.insertAt(i + 1, [(a[0] + b[0]) / 2, (a[1] + b[1]) / 2]);
+  }
+
+  /**
+   * Inserts a point near `m` as point `k` (where the constraints allow),
+   * selected; false when they allow none.
+   */
+  insertAt(k, m) {
     const pts = this.points.slice();
-    pts.splice(i + 1, 0, m);
-    const q = this.o.constrain ? this.o.constrain(i + 1, m, pts) : m;
+    pts.splice(k, 0, m);
+    const q = this.o.constrain ? this.o.constrain(k, m, pts) : m;
     if (!q) return false;
-    pts[i + 1] = q;
+    pts[k] = q;
     this.points = pts;
-    this.selected = i + 1;
+    this.selected = k;
     this.changed(true);
     this.draw();
     this.told();
@@ -265,16 +272,7 @@ export class CurveEditor {
         best = k;
       }
     }
-    const pts = this.points.slice();
-    pts.splice(best + 1, 0, m);
-    const p = this.o.constrain ? this.o.constrain(best + 1, m, pts) : m;
-    if (!p) return;
-    pts[best + 1] = p;
-    this.points = pts;
-    this.selected = best + 1;
-    this.changed(true);
-    this.draw();
-    this.told();
+    this.insertAt(best + 1, m);
   }
 
   /** Hands a copy of the points to the model; `final` ends a gesture. */
@@ -424,7 +422,8 @@ function bounds(pts, withOrigin) {
   return [x0 - pad, y0 - pad, x1 + pad, y1 + pad];
 }
 
-function segDist(a, b, p) {
+/** Distance from `p` to the segment from `a` to `b` (any units). */
+export function segDist(a, b, p) {
   const dx = b[0] - a[0];
   const dy = b[1] - a[1];
   const l2 = dx * dx + dy * dy;

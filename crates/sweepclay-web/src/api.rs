@@ -128,10 +128,8 @@ impl Default for Limits {
 /// the same, and the preview shows it with the part outside marked.
 pub fn parse_design(text: &str, limits: &Limits) -> Result<Design, ApiError> {
     let d = Design::from_json(text)?;
-    match d.check_size(limits.max_samples) {
-        Ok(()) | Err(sweepclay_core::Error::DoesNotFit { .. }) => Ok(d),
-        Err(e) => Err(e.into()),
-    }
+    d.check_samples(limits.max_samples)?;
+    Ok(d)
 }
 
 /// The layering the path follows.
@@ -323,9 +321,7 @@ pub fn slice_view(design: &Design, cancel: &Cancel) -> Result<SliceView, ApiErro
         }
     });
     let slice_ms = t0.elapsed().as_secs_f64() * 1e3;
-    let mut v = view(&sliced, moved, slice_ms);
-    v.fit_error = fit_error;
-    Ok(v)
+    Ok(view(&sliced, moved, slice_ms, fit_error))
 }
 
 /// Why a sliced design cannot be printed on its printer (it leaves the
@@ -339,7 +335,7 @@ pub struct FitError {
     pub key: Option<String>,
 }
 
-fn view(s: &Sliced, moved: Vec<u32>, slice_ms: f64) -> SliceView {
+fn view(s: &Sliced, moved: Vec<u32>, slice_ms: f64, fit_error: Option<FitError>) -> SliceView {
     let surf = &s.corrected.surface;
     let mut positions = Vec::with_capacity(3 * surf.samples.len());
     for (c, col) in surf.columns.iter().enumerate() {
@@ -430,7 +426,7 @@ fn view(s: &Sliced, moved: Vec<u32>, slice_ms: f64) -> SliceView {
             bed_diameter: pr.bed_diameter,
             nozzle_radius: pr.nozzle_radius,
         },
-        fit_error: None,
+        fit_error,
     }
 }
 
@@ -510,18 +506,10 @@ pub fn stl(design: &Design, cancel: &Cancel) -> Result<Vec<u8>, ApiError> {
 /// Trajectory points imported from an SVG or CSV file.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Imported {
-    /// The points (mm, relative to `o`).
-    pub points: Vec<[f64; 2]>,
-    /// Arc length (mm).
-    pub length_mm: f64,
-    /// The offset frame the path needs (`normal` when it passes near the
-    /// centre `o`).
-    pub offset: sweepclay_core::Offset,
-    /// What the page should tell the user about that choice.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub note: Option<String>,
-    /// A closed shape (a vessel's loop: `trajectory.closed`).
-    pub closed: bool,
+    /// The file's first shape, the one a plain import takes (its fields
+    /// at the top level of the answer).
+    #[serde(flatten)]
+    pub first: ImportedPoints,
     /// Every shape of the file to pick from (an SVG's elements and
     /// sub-paths, the first being the one above), each with its own label.
     pub shapes: Vec<ImportedShape>,
@@ -532,13 +520,13 @@ pub struct Imported {
 pub struct ImportedShape {
     /// What it is in the file: `<path> id, sub-path 2`, `<circle>`, `CSV`.
     pub label: String,
-    /// Its points, its length, its offset frame and note, closed or not,
-    /// as [`Imported`]'s.
+    /// Its points, its length, its offset frame and note, closed or not.
     #[serde(flatten)]
     pub path: ImportedPoints,
 }
 
-/// The points of one imported shape and what follows from them.
+/// The points of one imported shape and what follows from them: its
+/// length and the offset frame it needs.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct ImportedPoints {
     /// The points (mm, relative to `o`).
@@ -597,13 +585,8 @@ pub fn import(format: &str, text: &str) -> Result<Imported, ApiError> {
             .with_key("format"))
         }
     };
-    let first = shapes[0].path.clone();
     Ok(Imported {
-        points: first.points,
-        length_mm: first.length_mm,
-        offset: first.offset,
-        note: first.note,
-        closed: first.closed,
+        first: shapes[0].path.clone(),
         shapes,
     })
 }
@@ -756,7 +739,7 @@ mod tests {
             labels,
             ["<path>, sub-path 1", "<path>, sub-path 2", "<circle>"]
         );
-        assert_eq!(im.points, im.shapes[0].path.points);
+        assert_eq!(im.first.points, im.shapes[0].path.points);
         assert!(im.shapes[2].path.closed && !im.shapes[1].path.closed);
         let j = serde_json::to_value(&im).unwrap();
         assert_eq!(j["shapes"][2]["closed"], true);

@@ -147,12 +147,7 @@ async fn point_at(c: &Client, e: usize, i: &str) -> (f64, f64) {
 /// Clicks "Download G-code" and waits (30 s at most, else fails with
 /// `missing`) for a `.gcode` file in `downloads`.
 async fn download_gcode(c: &Client, downloads: &Path, missing: &str) -> std::path::PathBuf {
-    c.find(fantoccini::Locator::Id("download-gcode"))
-        .await
-        .unwrap()
-        .click()
-        .await
-        .unwrap();
+    click(&c, "download-gcode").await;
     let deadline = Instant::now() + Duration::from_secs(30);
     loop {
         let done = std::fs::read_dir(downloads)
@@ -167,6 +162,29 @@ async fn download_gcode(c: &Client, downloads: &Path, missing: &str) -> std::pat
     }
 }
 
+/// Clicks the element with id `id`.
+async fn click(c: &Client, id: &str) {
+    c.find(fantoccini::Locator::Id(id))
+        .await
+        .unwrap()
+        .click()
+        .await
+        .unwrap();
+}
+
+/// Waits for the error above the 3D view and returns its text.
+async fn error_text(c: &Client, what: &str) -> Value {
+    wait_js(
+        c,
+        "return document.querySelector('#status .error')?.textContent || null",
+        what,
+    )
+    .await
+}
+
+/// Whether the verdict says printable.
+const PRINTABLE: &str = "return document.getElementById('verdict').dataset.printable === 'true'";
+
 /// Closes the first-run guide, which a fresh browser profile shows.
 async fn close_guide(c: &Client) {
     wait_js(
@@ -175,12 +193,7 @@ async fn close_guide(c: &Client) {
         "the first-run guide",
     )
     .await;
-    c.find(fantoccini::Locator::Id("guide-close"))
-        .await
-        .unwrap()
-        .click()
-        .await
-        .unwrap();
+    click(c, "guide-close").await;
     wait_js(
         c,
         "return !document.getElementById('guide').open",
@@ -208,12 +221,7 @@ async fn import_file(c: &Client, file: &Path, shape: usize) -> String {
     .await;
     set_value(c, "im-pick", &shape.to_string()).await;
     let count = js(c, "return document.getElementById('im-count').textContent").await;
-    c.find(fantoccini::Locator::Id("im-use"))
-        .await
-        .unwrap()
-        .click()
-        .await
-        .unwrap();
+    click(c, "im-use").await;
     count.as_str().unwrap().to_string()
 }
 
@@ -275,12 +283,7 @@ async fn draw_preview_and_download_verified_gcode() {
     // The first design is t1: 18,432 samples, verified printable.
     let before = wait_js(&c, SAMPLES, "the statistics").await;
     assert_eq!(before, "18,432");
-    wait_js(
-        &c,
-        "return document.getElementById('verdict').dataset.printable === 'true'",
-        "the verdict on t1",
-    )
-    .await;
+    wait_js(&c, PRINTABLE, "the verdict on t1").await;
     assert_eq!(js(&c, "return window.sweepclayErrors").await, json!([]));
     // The clay in ml and g, and the planner's time.
     let clay = js(
@@ -392,24 +395,14 @@ async fn draw_preview_and_download_verified_gcode() {
         js(&c, "return document.getElementById('guide').open").await,
         json!(false)
     );
-    c.find(fantoccini::Locator::Id("undo"))
-        .await
-        .unwrap()
-        .click()
-        .await
-        .unwrap();
+    click(&c, "undo").await;
     wait_js(
         &c,
         &format!("const s = (() => {{ {SAMPLES} }})(); return s === {before}"),
         "undo after the reload",
     )
     .await;
-    c.find(fantoccini::Locator::Id("redo"))
-        .await
-        .unwrap()
-        .click()
-        .await
-        .unwrap();
+    click(&c, "redo").await;
     wait_js(
         &c,
         &format!("const s = (() => {{ {SAMPLES} }})(); return s === {after}"),
@@ -419,12 +412,7 @@ async fn draw_preview_and_download_verified_gcode() {
 
     // Coloured by stability (the default), a screenshot for the README.
     set_value(&c, "colour-by", "stability").await;
-    wait_js(
-        &c,
-        "return document.getElementById('verdict').dataset.printable === 'true'",
-        "the verdict on the edited design",
-    )
-    .await;
+    wait_js(&c, PRINTABLE, "the verdict on the edited design").await;
     if let Ok(path) = std::env::var("SWEEPCLAY_SCREENSHOT") {
         let png = c.screenshot().await.unwrap();
         std::fs::write(&path, png).unwrap();
@@ -438,12 +426,7 @@ async fn draw_preview_and_download_verified_gcode() {
     // A name in any script keeps its letters in the file name; only what
     // no file system takes is replaced.
     set_value(&c, "name", "my sail édition #2: «vase»").await;
-    c.find(fantoccini::Locator::Id("save"))
-        .await
-        .unwrap()
-        .click()
-        .await
-        .unwrap();
+    click(&c, "save").await;
     let want = downloads.join("my sail édition #2_ «vase».json");
     let deadline = Instant::now() + Duration::from_secs(20);
     while !want.exists() {
@@ -494,12 +477,7 @@ async fn draw_preview_and_download_verified_gcode() {
     )
     .await;
     set_value(&c, "offset", "radial").await;
-    let err = wait_js(
-        &c,
-        "return document.querySelector('#status .error')?.textContent || null",
-        "the error for a radial wave through o",
-    )
-    .await;
+    let err = error_text(&c, "the error for a radial wave through o").await;
     assert!(
         err.as_str().unwrap().contains("\"offset\": \"normal\""),
         "{err}"
@@ -569,12 +547,7 @@ async fn draw_preview_and_download_verified_gcode() {
     )
     .await;
     set_value(&c, "p-layer_height", "3").await;
-    let err = wait_js(
-        &c,
-        "const e = document.querySelector('#status .error'); return e ? e.textContent : null",
-        "the error for a layer height over the max",
-    )
-    .await;
+    let err = error_text(&c, "the error for a layer height over the max").await;
     let err = err.as_str().unwrap();
     assert!(
         err.starts_with("layer height 3 mm: ") && err.contains("max layer height"),
@@ -701,8 +674,7 @@ async fn truthful_state_imports_printers_and_phones() {
     let base = server().await;
     c.goto(&format!("{base}/?example=t2")).await.unwrap();
     close_guide(&c).await;
-    let printable = "return document.getElementById('verdict').dataset.printable === 'true'";
-    wait_js(&c, printable, "the verdict on t2").await;
+    wait_js(&c, PRINTABLE, "the verdict on t2").await;
 
     // The verdict race: spacing changed, then within 250 ms a layer height
     // of 0. The error stands alone: no ✓ beside it, the preview and the
@@ -710,12 +682,7 @@ async fn truthful_state_imports_printers_and_phones() {
     set_value(&c, "p-spacing", "1.0").await;
     tokio::time::sleep(Duration::from_millis(40)).await;
     set_value(&c, "p-layer_height", "0").await;
-    let err = wait_js(
-        &c,
-        "return document.querySelector('#status .error')?.textContent || null",
-        "the error for layer height 0",
-    )
-    .await;
+    let err = error_text(&c, "the error for layer height 0").await;
     assert!(err.as_str().unwrap().starts_with("layer height"), "{err}");
     tokio::time::sleep(Duration::from_millis(700)).await;
     let state = js(
@@ -730,7 +697,7 @@ async fn truthful_state_imports_printers_and_phones() {
         "{state}"
     );
     set_value(&c, "p-layer_height", "1.25").await;
-    wait_js(&c, printable, "the verdict once the layer height is back").await;
+    wait_js(&c, PRINTABLE, "the verdict once the layer height is back").await;
     assert_eq!(
         js(&c, "return document.getElementById('preview').classList.contains('stale') || !document.getElementById('stale-note').hidden").await,
         json!(false)
@@ -796,12 +763,7 @@ async fn truthful_state_imports_printers_and_phones() {
         "return window.sweepclay.design.trajectory.control_points.length",
     )
     .await;
-    c.find(fantoccini::Locator::Id("pb-add"))
-        .await
-        .unwrap()
-        .click()
-        .await
-        .unwrap();
+    click(&c, "pb-add").await;
     assert_eq!(
         js(
             &c,
@@ -810,12 +772,7 @@ async fn truthful_state_imports_printers_and_phones() {
         .await,
         json!(n.as_u64().unwrap() + 1)
     );
-    c.find(fantoccini::Locator::Id("pb-del"))
-        .await
-        .unwrap()
-        .click()
-        .await
-        .unwrap();
+    click(&c, "pb-del").await;
     assert_eq!(
         js(
             &c,
@@ -839,14 +796,9 @@ async fn truthful_state_imports_printers_and_phones() {
     // in red, the message says how much too big in the user's words, and
     // the preview is the current design, not an old one.
     set_value(&c, "example", "t1").await;
-    wait_js(&c, printable, "the verdict on t1").await;
+    wait_js(&c, PRINTABLE, "the verdict on t1").await;
     set_value(&c, "p-printer", "cerambot-mini").await;
-    let err = wait_js(
-        &c,
-        "return document.querySelector('#status .error')?.textContent || null",
-        "the error for a print too big",
-    )
-    .await;
+    let err = error_text(&c, "the error for a print too big").await;
     assert!(
         err.as_str().unwrap().contains("mm too") && err.as_str().unwrap().contains("cerambot-mini"),
         "{err}"
@@ -860,12 +812,7 @@ async fn truthful_state_imports_printers_and_phones() {
     assert_eq!(shown, json!([true, false, "false"]));
 
     // A custom printer, kept in the browser: big enough for t1.
-    c.find(fantoccini::Locator::Id("printer-edit"))
-        .await
-        .unwrap()
-        .click()
-        .await
-        .unwrap();
+    click(&c, "printer-edit").await;
     wait_js(
         &c,
         "return document.getElementById('printer-dialog').open",
@@ -887,13 +834,8 @@ async fn truthful_state_imports_printers_and_phones() {
         .await
         .unwrap();
     }
-    c.find(fantoccini::Locator::Id("pr-save"))
-        .await
-        .unwrap()
-        .click()
-        .await
-        .unwrap();
-    wait_js(&c, printable, "the verdict on the custom printer").await;
+    click(&c, "pr-save").await;
+    wait_js(&c, PRINTABLE, "the verdict on the custom printer").await;
     assert_eq!(
         js(&c, "return [window.sweepclay.design.printer.name, window.sweepclay.design.printer.build_volume, document.getElementById('p-printer').value]").await,
         json!(["my big printer", [300, 300, 300], "kept:my big printer"])
@@ -990,13 +932,8 @@ async fn truthful_state_imports_printers_and_phones() {
         "the way out of an autosave that does not slice",
     )
     .await;
-    c.find(fantoccini::Locator::Id("escape-example"))
-        .await
-        .unwrap()
-        .click()
-        .await
-        .unwrap();
-    wait_js(&c, printable, "the first example after the way out").await;
+    click(&c, "escape-example").await;
+    wait_js(&c, PRINTABLE, "the first example after the way out").await;
 
     // A phone: tabs, one panel at a time; nothing overlaps, every editor
     // and the 3D view have room, nothing is wider than the screen.
@@ -1087,8 +1024,7 @@ async fn modeler_speed_budget() {
     let base = server().await;
     c.goto(&format!("{base}/?example=t1")).await.unwrap();
     close_guide(&c).await;
-    let printable = "return document.getElementById('verdict').dataset.printable === 'true'";
-    wait_js(&c, printable, "the verdict on t1").await;
+    wait_js(&c, PRINTABLE, "the verdict on t1").await;
     let rounds: usize = std::env::var("SWEEPCLAY_BENCH_DRAGS")
         .ok()
         .and_then(|v| v.parse().ok())
