@@ -147,7 +147,7 @@ async fn point_at(c: &Client, e: usize, i: &str) -> (f64, f64) {
 /// Clicks "Download G-code" and waits (30 s at most, else fails with
 /// `missing`) for a `.gcode` file in `downloads`.
 async fn download_gcode(c: &Client, downloads: &Path, missing: &str) -> std::path::PathBuf {
-    click(&c, "download-gcode").await;
+    click(c, "download-gcode").await;
     let deadline = Instant::now() + Duration::from_secs(30);
     loop {
         let done = std::fs::read_dir(downloads)
