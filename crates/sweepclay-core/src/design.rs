@@ -22,8 +22,10 @@ pub struct Design {
     pub name: String,
     /// C_s: profile at the start of the trajectory, points `[x, z]`.
     pub profile_start: CurveSpec,
-    /// C_t: profile at the end of the trajectory, points `[x, z]`.
-    pub profile_end: CurveSpec,
+    /// C_t: profile at the end of the trajectory, points `[x, z]`; left
+    /// out, the start profile (a pot with one profile: [`Design::end_profile`]).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub profile_end: Option<CurveSpec>,
     /// Ψ: the trajectory in the xy plane, relative to the centre `o`.
     pub trajectory: TrajectorySpec,
     /// Control curve of f(u), points `[u, f]`; omitted means linear.
@@ -352,7 +354,7 @@ impl Design {
         if kxy == 1.0 && kz == 1.0 {
             return d;
         }
-        for c in [&mut d.profile_start, &mut d.profile_end] {
+        for c in std::iter::once(&mut d.profile_start).chain(d.profile_end.as_mut()) {
             for p in &mut c.control_points {
                 *p = [p[0] * kxy, p[1] * kz];
             }
@@ -367,6 +369,12 @@ impl Design {
             }
         }
         d
+    }
+
+    /// C_t: `profile_end`, or `profile_start` where the design gives one
+    /// profile (the same section all round the loop or along the wall).
+    pub fn end_profile(&self) -> &CurveSpec {
+        self.profile_end.as_ref().unwrap_or(&self.profile_start)
     }
 
     /// The design as pretty JSON (the format [`Design::from_json`] reads).
@@ -423,7 +431,7 @@ impl Design {
             }
         }
         lo[2] = 0.0;
-        hi[2] = top(&this.profile_start).max(top(&this.profile_end));
+        hi[2] = top(&this.profile_start).max(top(this.end_profile()));
         for a in 0..3 {
             let (min, max) = (pr.bed_min[a], pr.bed_min[a] + pr.build_volume[a]);
             if lo[a] < min - 1e-9 || hi[a] > max + 1e-9 {
@@ -462,7 +470,7 @@ impl Design {
             floor = 1.5 * area / (pitch * p.spacing) * f64::from(layers);
         }
         let top = |c: &CurveSpec| c.control_points.iter().map(|p| p[1]).fold(0.0, f64::max);
-        let height = top(&self.profile_start).max(top(&self.profile_end));
+        let height = top(&self.profile_start).max(top(self.end_profile()));
         (length / p.spacing + 1.0) * (height / p.layer_height + 1.0) + floor
     }
 }
@@ -527,6 +535,23 @@ mod tests {
         assert_eq!(d.printer, PrinterRef::default());
         assert!(d.interpolation.is_none());
         d.params.validate().unwrap();
+    }
+
+    #[test]
+    fn a_pot_with_one_profile_is_the_same_pot_with_two() {
+        let one = r#"{"sweepclay": 1,
+            "profile_start": { "control_points": [[0, 0], [8, 20], [2, 40]] },
+            "trajectory": { "control_points": [[40, 0], [0, 40], [-40, 0], [0, -40]], "closed": true }}"#;
+        let d = Design::from_json(one).unwrap();
+        assert_eq!(d.end_profile(), &d.profile_start);
+        // Saved as it was given: one profile stays one profile.
+        assert!(!d.to_json().contains("profile_end"));
+        assert_eq!(Design::from_json(&d.to_json()).unwrap(), d);
+        let mut two = d.clone();
+        two.profile_end = Some(d.profile_start.clone());
+        let (a, b) = (crate::slice(&d).unwrap(), crate::slice(&two).unwrap());
+        assert_eq!(a.toolpath, b.toolpath);
+        assert_eq!(a.extrusion, b.extrusion);
     }
 
     #[test]

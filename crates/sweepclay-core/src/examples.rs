@@ -44,7 +44,7 @@ pub fn scaled(samples: usize) -> crate::Design {
     }
     // Both ends 240 mm tall: one stage at every resolution, so the sample
     // count follows spacing and layer height smoothly.
-    for c in [&mut d.profile_start, &mut d.profile_end] {
+    for c in std::iter::once(&mut d.profile_start).chain(d.profile_end.as_mut()) {
         let top = c.control_points.last().expect("a profile has points")[1];
         c.control_points
             .iter_mut()

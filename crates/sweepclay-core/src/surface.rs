@@ -156,7 +156,7 @@ pub fn sample_surface(design: &Design) -> Result<Surface> {
     let params = design.params.clone();
     let printer = design.printer.resolve()?;
     let start = Profile::new("profile_start", &design.profile_start)?;
-    let end = Profile::new("profile_end", &design.profile_end)?;
+    let end = Profile::new("profile_end", design.end_profile())?;
     for (key, prof) in [("profile_start", &start), ("profile_end", &end)] {
         if prof.height < params.layer_height {
             return Err(Error::invalid(
@@ -526,7 +526,9 @@ mod tests {
     fn leaning_profiles_offset_radially() {
         let mut d = cylinder(40.0, 40.0);
         d.profile_start.control_points = vec![[0.0, 0.0], [10.0, 40.0]];
-        d.profile_end.control_points = vec![[5.0, 0.0], [5.0, 40.0]];
+        d.profile_end = Some(crate::design::CurveSpec {
+            control_points: vec![[5.0, 0.0], [5.0, 40.0]],
+        });
         let s = sample_surface(&d).unwrap();
         let first = &s.columns[0];
         let top = s.samples[first.samples().end - 1];
@@ -587,7 +589,9 @@ mod tests {
         d.trajectory.points = Some(vec![[-30.0, 0.0], [30.0, 0.0]]);
         d.trajectory.offset = Offset::Normal;
         d.profile_start.control_points = vec![[0.0, 0.0], [5.0, 20.0]];
-        d.profile_end.control_points = vec![[0.0, 0.0], [5.0, 20.0]];
+        d.profile_end = Some(crate::design::CurveSpec {
+            control_points: vec![[0.0, 0.0], [5.0, 20.0]],
+        });
         d.params.max_overhang_deg = 60.0;
         let s = sample_surface(&d).unwrap();
         let col = &s.columns[s.columns.len() / 2];

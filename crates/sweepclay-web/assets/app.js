@@ -75,6 +75,8 @@ function interpolationPoints(d) {
 
 /** Replaces the design; `record` adds an undo step. */
 function setDesign(d, { record = true, fit = false } = {}) {
+  // A pot with one profile (docs/FORMATS.md): the editors show both.
+  if (!d.profile_end) d.profile_end = JSON.parse(JSON.stringify(d.profile_start));
   state.design = d;
   if (record) {
     state.history = state.history.slice(0, state.at + 1);
@@ -253,6 +255,19 @@ $('pb-del').addEventListener('click', () => {
 });
 
 $('snap').addEventListener('change', (e) => editors.forEach((ed) => { ed.snapOn = e.target.checked; }));
+/** Control points of a circle a quarter as wide as `d`'s printer bed (8 points, periodic). */
+function defaultLoop(d) {
+  const pr = typeof d.printer === 'object' && d.printer ? d.printer : state.meta?.presets.find((p) => p.name === (d.printer || 'generic'));
+  const bed = pr?.build_volume || [200, 200, 200];
+  const r = Math.max(15, Math.round(Math.min(bed[0], bed[1]) / 8));
+  // A periodic cubic B-spline through a regular octagon's points runs
+  // about 0.93 of the way out: the control polygon is drawn wider.
+  return Array.from({ length: 8 }, (_, i) => {
+    const a = (2 * Math.PI * i) / 8;
+    return [+(1.08 * r * Math.cos(a)).toFixed(2), +(1.08 * r * Math.sin(a)).toFixed(2)];
+  });
+}
+
 /**
  * Makes `d`'s trajectory a loop (a vessel) or an open wall; the
  * interpolation (a loop's ends at 0, a wall's at 0 and 1) and the floor
@@ -261,6 +276,9 @@ $('snap').addEventListener('change', (e) => editors.forEach((ed) => { ed.snapOn 
 function setClosed(d, closed) {
   const ip = d.interpolation?.control_points;
   if (closed) {
+    // An open wall's points wrapped round make a sliver: a new vessel
+    // starts as a round pot a quarter of the printer's bed across.
+    if (!d.trajectory.closed) d.trajectory = { control_points: defaultLoop(d), closed: true };
     d.trajectory.closed = true;
     if (ip && ip[ip.length - 1][1] !== 0) delete d.interpolation;
   } else {
@@ -757,8 +775,8 @@ $('open-file').addEventListener('change', async () => {
     showError(`${name}: not JSON: ${e.message}`);
     return;
   }
-  if (typeof d !== 'object' || !d || !d.profile_start || !d.profile_end || !d.trajectory) {
-    showError(`${name}: not a sweepclay design (it needs profile_start, profile_end and trajectory)`);
+  if (typeof d !== 'object' || !d || !d.profile_start || !d.trajectory) {
+    showError(`${name}: not a sweepclay design (it needs profile_start and trajectory)`);
     return;
   }
   setDesign(d, { fit: true });
@@ -891,7 +909,7 @@ function drawImport(canvas, all, kept, closed) {
 
 function useImport(name, body) {
   edit((d) => {
-    d.trajectory = { points: body.points };
+    d.trajectory = body.closed ? { points: body.points, closed: true } : { points: body.points };
     if (body.offset === 'normal') d.trajectory.offset = 'normal';
     setClosed(d, body.closed);
   }, true);

@@ -675,7 +675,9 @@ mod tests {
         // An end profile leaning 45 mm over 20 mm of height overhangs far
         // beyond 57°: the support correction moves its upper samples.
         let mut d = design("t4");
-        d.profile_end.control_points = vec![[0.0, 0.0], [45.0, 20.0], [45.0, 40.0]];
+        d.profile_end = Some(sweepclay_core::design::CurveSpec {
+            control_points: vec![[0.0, 0.0], [45.0, 20.0], [45.0, 40.0]],
+        });
         let v = slice_view(&d, &Cancel::new()).unwrap();
         assert!(!v.corrections.is_empty());
         assert!(!v.surface.moved.is_empty());
