@@ -866,7 +866,10 @@ impl<'a> Checker<'a> {
                         r.support.wide.add(m.line, width);
                     }
                 } else {
-                    width = cfg.width_max;
+                    // No gap to measure it by: as wide as its clay would
+                    // be on the thinnest layer, at most the widest bead (a
+                    // join carrying next to no clay is a smear, not a bead).
+                    width = (volume / (len * cfg.min_layer_mm)).min(cfg.width_max);
                 }
             }
             rest = Some(match support {
@@ -914,52 +917,57 @@ impl<'a> Checker<'a> {
                 } else if width < cfg.width_min * (1.0 - WIDTH_TOLERANCE) {
                     r.support.thin.add(m.line, cfg.width_min - width);
                 }
-                let bin = if overlap < 0.5 {
-                    0
-                } else if overlap < 0.6 {
-                    1
-                } else if overlap < cfg.overlap_target - 1e-9 {
-                    2
-                } else if overlap < 0.9 {
-                    3
-                } else {
-                    4
-                };
-                r.support.overlap_histogram[bin] += 1;
-                if r.support.min_overlap.is_none_or(|(v, _)| overlap < v) {
-                    r.support.min_overlap = Some((overlap, m.line));
-                }
-                // A bead much shorter than it is wide (a slicer's stub at a
-                // layer change) is a blob joined to the bead before: it is
-                // as well supported as that bead, if that one is no stub.
-                let stub = xy < 0.25 * cfg.width_min;
-                let overlap = if stub && !*prev_stub {
-                    overlap.max(*prev_overlap)
-                } else {
-                    overlap
-                };
-                *prev_stub = stub;
-                *prev_overlap = overlap;
-                if overlap < cfg.overlap_min - 1e-9 {
-                    hold(Finding::UnderMinOverlap, cfg.overlap_min - overlap);
-                }
-                if overlap < cfg.overlap_target - 1e-6 {
-                    r.support.under_target += 1;
-                }
-                // The angle against the bead's real geometry: a bead
-                // thinner than the one it rests on leans over that bead's
-                // height, not over its own (a finishing turn 0.3 mm up is
-                // no 80° overhang). An arc tangent only when it can
-                // matter: a new steepest or one near the limit.
-                let ratio = offset / dz.max(below_h);
-                if !(ratio <= *steepest && ratio < *overhang_near) {
-                    *steepest = steepest.max(ratio);
-                    let angle = ratio.atan().to_degrees();
-                    if r.support.max_overhang_deg.is_none_or(|(v, _)| angle > v) {
-                        r.support.max_overhang_deg = Some((angle, m.line));
+                // A smear (a join across clay) carries no clay to hold up:
+                // what it overlaps or leans over is not judged
+                // (docs/CHECKER.md, "Clay on clay").
+                if width >= crate::support::SMEAR * cfg.width_min {
+                    let bin = if overlap < 0.5 {
+                        0
+                    } else if overlap < 0.6 {
+                        1
+                    } else if overlap < cfg.overlap_target - 1e-9 {
+                        2
+                    } else if overlap < 0.9 {
+                        3
+                    } else {
+                        4
+                    };
+                    r.support.overlap_histogram[bin] += 1;
+                    if r.support.min_overlap.is_none_or(|(v, _)| overlap < v) {
+                        r.support.min_overlap = Some((overlap, m.line));
                     }
-                    if angle > cfg.max_overhang_deg + cfg.overhang_tolerance_deg {
-                        hold(Finding::Overhang, angle);
+                    // A bead much shorter than it is wide (a slicer's stub at a
+                    // layer change) is a blob joined to the bead before: it is
+                    // as well supported as that bead, if that one is no stub.
+                    let stub = xy < 0.25 * cfg.width_min;
+                    let overlap = if stub && !*prev_stub {
+                        overlap.max(*prev_overlap)
+                    } else {
+                        overlap
+                    };
+                    *prev_stub = stub;
+                    *prev_overlap = overlap;
+                    if overlap < cfg.overlap_min - 1e-9 {
+                        hold(Finding::UnderMinOverlap, cfg.overlap_min - overlap);
+                    }
+                    if overlap < cfg.overlap_target - 1e-6 {
+                        r.support.under_target += 1;
+                    }
+                    // The angle against the bead's real geometry: a bead
+                    // thinner than the one it rests on leans over that bead's
+                    // height, not over its own (a finishing turn 0.3 mm up is
+                    // no 80° overhang). An arc tangent only when it can
+                    // matter: a new steepest or one near the limit.
+                    let ratio = offset / dz.max(below_h);
+                    if !(ratio <= *steepest && ratio < *overhang_near) {
+                        *steepest = steepest.max(ratio);
+                        let angle = ratio.atan().to_degrees();
+                        if r.support.max_overhang_deg.is_none_or(|(v, _)| angle > v) {
+                            r.support.max_overhang_deg = Some((angle, m.line));
+                        }
+                        if angle > cfg.max_overhang_deg + cfg.overhang_tolerance_deg {
+                            hold(Finding::Overhang, angle);
+                        }
                     }
                 }
             }

@@ -121,7 +121,12 @@ impl Query<'_> {
             return Class::Neither;
         }
         if z <= mid[2] - cfg.min_layer_mm {
-            if mid[2] - z <= cfg.max_gap_mm && d <= cfg.width_max.max(b.width() / 2.0) {
+            // A smear a quarter of the thinnest bead wide (a join across
+            // clay, a ramp's start) holds nothing up: what it lies on does.
+            if mid[2] - z <= cfg.max_gap_mm
+                && d <= cfg.width_max.max(b.width() / 2.0)
+                && b.width() >= SMEAR * cfg.width_min
+            {
                 return Class::Below(Candidate {
                     id: j,
                     z,
@@ -134,6 +139,8 @@ impl Query<'_> {
             }
         } else if (z - mid[2]).abs() < cfg.min_layer_mm
             && d < 0.5 * b.width().min(cfg.width_min)
+            // Nor is a smear clay to be laid on.
+            && b.width() >= SMEAR * cfg.width_min
             // Clay laid in the last 2 w_max of path is the run's own fresh
             // clay (a corner piles up, it is not laid twice).
             && s_start - b.s_end > 2.0 * cfg.width_max
@@ -432,6 +439,10 @@ pub(crate) fn follow_support(
     }
     Some(best)
 }
+
+/// Below this many `w_min` wide, a bead is a smear of clay, no support
+/// (docs/CHECKER.md, "Support").
+pub(crate) const SMEAR: f64 = 0.25;
 
 /// Within this many `w_min` of the middle, the shortcut's answer is taken
 /// as the nearest bead below without asking the beads around: passes of

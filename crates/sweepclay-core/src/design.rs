@@ -465,7 +465,7 @@ impl Design {
             // fill at most the control polygon's area (docs/ALGORITHMS.md §8).
             length += crate::bspline::dist(pts[pts.len() - 1], pts[0]);
             let area = 0.5 * crate::curves::signed_area2(pts).abs();
-            let pitch = p.width_min * (1.0 - crate::vessel::FLOOR_OVERLAP);
+            let pitch = p.width_min * (1.0 - crate::floor::FLOOR_OVERLAP);
             let layers = p.floor_layers.unwrap_or(DEFAULT_FLOOR_LAYERS);
             floor = 1.5 * area / (pitch * p.spacing) * f64::from(layers);
         }

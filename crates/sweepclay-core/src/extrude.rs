@@ -61,6 +61,12 @@ impl Extrusion {
     }
 }
 
+/// The clay of a join ([`crate::vessel::VesselPath::joins`]), as a
+/// fraction of a bead's cuboid: the step from one floor element to the next
+/// runs across clay both already cover (docs/ALGORITHMS.md §8), so it gets
+/// next to none — but some, so E keeps rising and the clay never stops.
+pub const JOIN_CLAY: f64 = 0.05;
+
 /// The slowest a step is printed, as a fraction of the feedrate: a
 /// screw or piston cannot slow much further without stalling the clay.
 pub const MIN_TURN_FEED: f64 = 0.25;
@@ -80,6 +86,8 @@ pub fn plan_extrusion(path: &Toolpath, params: &Params, origin: [f64; 2]) -> Ext
     let n = path.points.len();
     let (wmin, wmax, ov) = (params.width_min, params.width_max, params.overlap);
     let mut width = vec![wmin; n];
+    let joins = path.vessel.as_ref().map_or(&[][..], |v| &v.joins[..]);
+    let mut joins = joins.iter().peekable();
     let mut layer_height = Vec::with_capacity(n);
     let mut offset = Vec::with_capacity(n);
     for (i, p) in path.points.iter().enumerate() {
@@ -123,6 +131,7 @@ pub fn plan_extrusion(path: &Toolpath, params: &Params, origin: [f64; 2]) -> Ext
         let l = (xy2 + (a[2] - b[2]).powi(2)).sqrt();
         let cuboid =
             l * 0.5 * (width[i] + width[i - 1]) * 0.5 * (layer_height[i] + layer_height[i - 1]);
+        while joins.next_if(|&&j| (j as usize) < i).is_some() {}
         let v = if steep(a, b, xy2, origin) {
             turn_cuboid += cuboid;
             turn_steps += 1;
@@ -135,7 +144,12 @@ pub fn plan_extrusion(path: &Toolpath, params: &Params, origin: [f64; 2]) -> Ext
                 slow.push((i as u32, (bead_rate / rate).max(MIN_TURN_FEED)));
             }
             v
+        } else if joins.peek().is_some_and(|&&j| j as usize == i) {
+            JOIN_CLAY * cuboid
         } else {
+            // The first turn of a vase rises from nothing: its first beads
+            // still get the least clay that keeps the flow going.
+            let cuboid = cuboid.max(JOIN_CLAY * wmin * params.layer_height * l);
             if l > 1e-9 {
                 bead_rate = cuboid / l;
             }

@@ -42,6 +42,7 @@ pub mod design;
 pub mod error;
 pub mod examples;
 pub mod extrude;
+pub mod floor;
 pub mod gcode;
 pub mod grid;
 pub mod import;

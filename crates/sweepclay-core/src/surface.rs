@@ -298,7 +298,7 @@ fn floor_start(
     end: &Profile,
     first_layer: f64,
 ) -> Result<(Vec<usize>, crate::vessel::FloorOf)> {
-    use crate::vessel::{floor_entries, floor_plan, FloorRefusal, FLOOR_OVERLAP};
+    use crate::floor::{floor_entries, floor_plan, FloorRefusal};
     // The base ring as its first layer lies (it stands straight through
     // the floor).
     let ring: Vec<[f64; 2]> = columns
@@ -310,8 +310,9 @@ fn floor_start(
             [q[0], q[1]]
         })
         .collect();
-    let pitch = params.width_min * (1.0 - FLOOR_OVERLAP);
-    let rings = match floor_plan(&ring, pitch, spacing) {
+    let beads = crate::vessel::floor_beads(params, spacing);
+    let pitch = beads.pitch();
+    let rings = match floor_plan(&ring, beads) {
         Ok(rings) => rings,
         Err(FloorRefusal::Islands { depth, count: k }) => return Err(Error::invalid(
             "trajectory",
@@ -331,22 +332,30 @@ fn floor_start(
     let Some(inner) = rings.last() else {
         return Ok((vec![0], Some((ring, rings))));
     };
-    let m = inner.pts.len() as f64;
-    let c = inner
-        .pts
-        .iter()
-        .fold([0.0, 0.0], |a, p| [a[0] + p[0] / m, a[1] + p[1] / m]);
-    let d2 = |p: [f64; 2]| (p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2);
-    let centre = (0..ring.len())
-        .min_by(|&a, &b| d2(ring[a]).total_cmp(&d2(ring[b])))
-        .unwrap_or(0);
+    let nearest_to = |c: [f64; 2]| {
+        let d2 = |p: [f64; 2]| (p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2);
+        (0..ring.len())
+            .min_by(|&a, &b| d2(ring[a]).total_cmp(&d2(ring[b])))
+            .unwrap_or(0)
+    };
+    let centre = nearest_to(crate::floor::centroid(&inner.pts));
+    // A line down an elongated core is entered at an end: from the column
+    // beyond that end, the rings' nearest points lead to it.
+    let ends = inner
+        .open
+        .then(|| [inner.pts[0], inner.pts[inner.pts.len() - 1]].map(nearest_to));
     // The start of Ψ first (where the default interpolation keeps the rim
     // flat across the seam), then the column nearest the floor's centre.
     let mut worst = 0.0f64;
+    // Each moved off any corner where the base ring's seam would lay its
+    // last beads alongside its first.
     let ok: Vec<usize> = [0, centre]
         .into_iter()
+        .chain(ends.into_iter().flatten())
+        .map(|st| crate::floor::seam_at(&ring, st, params.width_min))
         .filter(|&st| {
-            let (_, step) = floor_entries(&rings, [ring[st][0], ring[st][1], 0.0]);
+            let (_, step) =
+                floor_entries(&rings, [ring[st][0], ring[st][1], 0.0], params.width_min);
             worst = worst.max(step);
             step <= 2.0 * pitch
         })

@@ -11,29 +11,17 @@
 //! ```
 //!
 //! so z rises along every turn with no seam, and a last, partial turn lays
-//! the rim level at h_i. The floor inside the base ring is filled by
-//! concentric inward offsets ([`floor_rings`], computed with `i_overlay`)
-//! whose beads touch with [`FLOOR_OVERLAP`]; [`plan_vessel_path`] joins
-//! them, layer by layer, into the path with no travel.
+//! the rim level at h_i. The floor inside the base ring is filled by the
+//! elements of [`crate::floor`]; [`plan_vessel_path`] joins them, layer by
+//! layer, into the path with no travel.
 
 use crate::correct::Corrected;
-use crate::curves::signed_area2;
 use crate::design::{Params, COLLISION_MARGIN_MM};
 use crate::error::{Error, Result};
+#[cfg(test)]
+use crate::floor::FLOOR_OVERLAP;
+use crate::floor::{floor_entries, floor_rings, ring_area, seam_at, FloorBeads, FloorRing};
 use crate::toolpath::{PathPoint, PointKind, Toolpath};
-use geo::Simplify;
-use i_overlay::mesh::outline::offset::OutlineOffset;
-use i_overlay::mesh::style::{LineJoin, OutlineStyle};
-
-/// Overlap of a floor bead with its neighbour in the same layer, as a
-/// fraction of its width: enough to close the floor, little enough that the
-/// clay has room (docs/ALGORITHMS.md §8).
-pub const FLOOR_OVERLAP: f64 = 0.15;
-
-/// Most floor rings a layer may have (a floor 5 m across at 3 mm beads,
-/// far beyond any printer; the sample cap refuses such designs first):
-/// bounds the offsetting work.
-pub const MAX_FLOOR_RINGS: usize = 1000;
 
 /// The layering of a vessel.
 #[derive(Clone, Debug, PartialEq)]
@@ -273,359 +261,22 @@ impl<'a> Neighbours<'a> {
 /// body, is a graze on a bead's rounded edge (as the checker allows).
 pub const BODY_GRAZE_MM: f64 = 0.2;
 
-/// The concentric rings that fill a closed polygon `outer` (the base ring,
-/// counter-clockwise or not) inside it: offsets inward by `pitch`, 2 ·
-/// `pitch`, … until nothing is left, each resampled about `spacing` apart
-/// and turned the way `outer` turns. An offset that splits (a waist
-/// narrower than two beads) gives several rings at one depth; they follow
-/// each other outermost first.
-///
-/// A ring whose two sides come closer than 3/4 of `pitch` (its mean width
-/// 2A/P, area over half the perimeter: the last ring of a long ellipse) would lay its beads on each other; it becomes the line
-/// down its middle instead, an open [`FloorRing`].
-pub fn floor_rings(outer: &[[f64; 2]], pitch: f64, spacing: f64) -> Vec<FloorRing> {
-    rings_of(outer, &inward_offsets(outer, pitch), pitch, spacing)
-}
-
-/// Why a floor cannot be laid as one continuous path.
-#[derive(Clone, Copy, Debug, PartialEq)]
-pub enum FloorRefusal {
-    /// Its offsets split into `count` islands `depth` mm inside the wall.
-    Islands {
-        /// Depth (mm) of the first split.
-        depth: f64,
-        /// Islands at that depth.
-        count: usize,
-    },
-    /// A ring `depth` mm inside the wall lies on itself at `at` (plan,
-    /// design coordinates): the region ends in a tail narrower than a bead.
-    Tail {
-        /// Depth (mm) of the ring.
-        depth: f64,
-        /// Where its two sides meet.
-        at: [f64; 2],
-    },
-}
-
-/// [`floor_rings`] from one set of offsets, or why the floor is refused.
-pub fn floor_plan(
-    outer: &[[f64; 2]],
-    pitch: f64,
-    spacing: f64,
-) -> std::result::Result<Vec<FloorRing>, FloorRefusal> {
-    let offsets = inward_offsets(outer, pitch);
-    if let Some((depth, count)) = split_of(&offsets, pitch) {
-        return Err(FloorRefusal::Islands { depth, count });
+/// The bead sizes of a vessel's floor from its parameters and the loop's
+/// sample spacing.
+pub fn floor_beads(params: &Params, spacing: f64) -> FloorBeads {
+    FloorBeads {
+        width: params.width_min,
+        spacing,
     }
-    let rings = rings_of(outer, &offsets, pitch, spacing);
-    for (k, r) in rings.iter().enumerate().filter(|(_, r)| !r.open) {
-        if let Some(at) = lies_on_itself(&r.pts, pitch) {
-            // One contour a depth: ring k is k + 1 pitches in.
-            return Err(FloorRefusal::Tail {
-                depth: pitch * (k + 1) as f64,
-                at,
-            });
-        }
-    }
-    Ok(rings)
 }
 
-fn rings_of(
-    outer: &[[f64; 2]],
-    offsets: &[Vec<Vec<[f64; 2]>>],
-    pitch: f64,
-    spacing: f64,
-) -> Vec<FloorRing> {
-    let ccw = signed_area2(outer) > 0.0;
-    let mut rings = Vec::new();
-    for contours in offsets {
-        for contour in contours {
-            let mut ring = resample_loop(contour, spacing);
-            if ring.len() < 3 {
-                continue;
-            }
-            if !ccw {
-                ring.reverse();
-            }
-            let perimeter = closed_loop(&ring).1[ring.len()];
-            if 2.0 * ring_area(&ring) / perimeter < 0.75 * pitch {
-                if let Some(line) = midline(&ring, spacing) {
-                    rings.push(FloorRing {
-                        pts: line,
-                        open: true,
-                    });
-                }
-            } else {
-                rings.push(FloorRing {
-                    pts: ring,
-                    open: false,
-                });
-            }
-        }
-    }
-    rings
-}
-
-/// Where a closed floor ring lies on itself, if it does: a ring round a
-/// region that ends in a tail narrower than a bead (a lobed oval's, near
-/// the ends of its long axis) runs down the tail and back, and its two
-/// sides would be one bead laid twice. One continuous path cannot lay the
-/// tail once (it would have to come back along it), so such a floor is
-/// refused (docs/ALGORITHMS.md §8). A grid of the ring's points makes it
-/// linear.
-fn lies_on_itself(ring: &[[f64; 2]], pitch: f64) -> Option<[f64; 2]> {
-    let m = ring.len();
-    let cum = closed_loop(ring).1;
-    let perimeter = cum[m];
-    // Two points on opposite sides of a tail: nearer than half a pitch in
-    // the plane, farther along the ring than round a U-turn of two beads.
-    let (near, far) = (0.5 * pitch, 2.0 * pitch);
-    let mut grid = crate::grid::Grid2::new(near);
-    for (i, p) in ring.iter().enumerate() {
-        grid.insert_segment(*p, *p, i as u32);
-    }
-    ring.iter().enumerate().find_map(|(i, &p)| {
-        let mut hit = None;
-        grid.for_each_near_segment(p, p, near, |j| {
-            let j = j as usize;
-            let along = (cum[i] - cum[j]).abs();
-            if hit.is_none()
-                && along.min(perimeter - along) > far
-                && (p[0] - ring[j][0]).hypot(p[1] - ring[j][1]) < near
-            {
-                hit = Some(p);
-            }
-        });
-        hit
-    })
-}
-
-/// The contours (counter-clockwise, specks dropped) of the inward offsets
-/// of `outer` by `pitch`, 2 · `pitch`, … until nothing is left, one list a
-/// depth. Each depth is offset by one pitch from the one before, every
-/// contour thinned (Ramer–Douglas–Peucker) to the points that keep it within
-/// [`OFFSET_SAG_MM`] of itself: `i_overlay`'s cost grows with the points,
-/// and thinning keeps points on the contour where resampling would move
-/// them onto its chords, a little farther in at every depth. The rings are
-/// resampled to the spacing afterwards.
-fn inward_offsets(outer: &[[f64; 2]], pitch: f64) -> Vec<Vec<Vec<[f64; 2]>>> {
-    let fine = (0.2 * pitch).max(0.5);
-    let mut first = resample_loop(outer, fine);
-    if first.len() < 3 {
-        first = outer.to_vec();
-    }
-    if signed_area2(&first) < 0.0 {
-        first.reverse();
-    }
-    let style = OutlineStyle::new(-pitch).line_join(LineJoin::Bevel);
-    let mut out = Vec::new();
-    let mut current = vec![thinned(&first)];
-    for _ in 0..MAX_FLOOR_RINGS {
-        let next: Vec<Vec<[f64; 2]>> = current
-            .iter()
-            .flat_map(|c| c.outline(&style))
-            // The first contour of a shape is its outside; an inward
-            // offset of a simple polygon has no holes.
-            .filter_map(|shape| shape.into_iter().next())
-            .filter(|c| !is_speck(c, pitch))
-            .map(|c| thinned(&c))
-            .collect();
-        if next.is_empty() {
-            break;
-        }
-        out.push(next.clone());
-        current = next;
-    }
-    out
-}
-
-/// A closed contour as a `geo` polygon.
-fn polygon(contour: &[[f64; 2]]) -> geo::Polygon<f64> {
-    let ring: geo::LineString<f64> = contour
-        .iter()
-        .chain(std::iter::once(&contour[0]))
-        .map(|p| geo::Coord { x: p[0], y: p[1] })
-        .collect();
-    geo::Polygon::new(ring, vec![])
-}
-
-/// A closed contour without the points its neighbours' chord passes within
-/// [`OFFSET_SAG_MM`] of (counter-clockwise stays counter-clockwise).
-fn thinned(contour: &[[f64; 2]]) -> Vec<[f64; 2]> {
-    let simple = polygon(contour).simplify(OFFSET_SAG_MM);
-    let pts: Vec<[f64; 2]> = simple.exterior().coords().map(|c| [c.x, c.y]).collect();
-    // A closed ring repeats its first point; fewer than three is a speck
-    // the thinning cannot be trusted with.
-    if pts.len() < 4 {
-        return contour.to_vec();
-    }
-    pts[..pts.len() - 1].to_vec()
-}
-
-/// The farthest a thinned contour's chords may stray from the curve it
-/// stands for (mm): well inside the 0.05 mm the rings are held to.
-const OFFSET_SAG_MM: f64 = 0.01;
-
-/// The first depth (mm inside `outer`) at which its inward offsets by
-/// multiples of `pitch` split into separate islands, if they do: one
-/// continuous path cannot go from one island to the next without crossing
-/// the clay between them, so such a floor is refused (docs/ALGORITHMS.md
-/// §8).
-fn split_of(offsets: &[Vec<Vec<[f64; 2]>>], pitch: f64) -> Option<(f64, usize)> {
-    offsets
-        .iter()
-        .enumerate()
-        .find(|(_, c)| c.len() > 1)
-        .map(|(d, c)| (pitch * (d + 1) as f64, c.len()))
-}
-
-/// Whether an offset contour encloses less than a pitch squared: a speck
-/// the squeeze of the beads round it fills (docs/ALGORITHMS.md §8).
-fn is_speck(contour: &[[f64; 2]], pitch: f64) -> bool {
-    ring_area(contour) < pitch * pitch
-}
-
-/// One element of a floor layer: a closed ring, or the open line down the
-/// middle of a ring too thin to lay as one.
-#[derive(Clone, Debug, PartialEq)]
-pub struct FloorRing {
-    /// Points about `spacing` apart.
-    pub pts: Vec<[f64; 2]>,
-    /// An open line (laid end to end), not a ring.
-    pub open: bool,
-}
-
-/// The line down the middle of a thin closed ring: between the point
-/// farthest from its centroid and the point farthest from that, the mean
-/// of its two sides, points about `spacing` apart (`None` for a speck).
-fn midline(ring: &[[f64; 2]], spacing: f64) -> Option<Vec<[f64; 2]>> {
-    let m = ring.len();
-    let c = ring.iter().fold([0.0, 0.0], |a, p| {
-        [a[0] + p[0] / m as f64, a[1] + p[1] / m as f64]
-    });
-    let far = |from: [f64; 2]| {
-        (0..m)
-            .max_by(|&x, &y| {
-                let dx = (ring[x][0] - from[0]).hypot(ring[x][1] - from[1]);
-                let dy = (ring[y][0] - from[0]).hypot(ring[y][1] - from[1]);
-                dx.total_cmp(&dy)
-            })
-            .unwrap_or(0)
-    };
-    let a = far(c);
-    let b = far(ring[a]);
-    let side = |forward: bool| -> Vec<[f64; 2]> {
-        let mut v = vec![ring[a]];
-        let mut i = a;
-        while i != b {
-            i = if forward {
-                (i + 1) % m
-            } else {
-                (i + m - 1) % m
-            };
-            v.push(ring[i]);
-        }
-        v
-    };
-    let (s1, s2) = (side(true), side(false));
-    let (c1, c2) = (
-        crate::curves::arc_lengths(&s1),
-        crate::curves::arc_lengths(&s2),
-    );
-    let length = 0.5 * (c1[c1.len() - 1] + c2[c2.len() - 1]);
-    if length < spacing || s1.len() < 2 || s2.len() < 2 {
-        return None;
-    }
-    let k = ((length / spacing).round() as usize).max(2);
-    let (r1, r2) = (
-        crate::curves::resample_polyline(&s1, &c1, k),
-        crate::curves::resample_polyline(&s2, &c2, k),
-    );
-    Some(
-        r1.iter()
-            .zip(&r2)
-            .map(|(p, q)| [0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1])])
-            .collect(),
-    )
-}
-
-/// A loop of points with its first point again at the end, and the arc
-/// lengths along it (the last is the perimeter).
-fn closed_loop(ring: &[[f64; 2]]) -> (Vec<[f64; 2]>, Vec<f64>) {
-    let mut closed = ring.to_vec();
-    closed.push(ring[0]);
-    let cum = crate::curves::arc_lengths(&closed);
-    (closed, cum)
-}
-
-/// A closed polygon resampled into points about `spacing` apart (at least
-/// three when it is longer than a few spacings, none when it is a speck).
-fn resample_loop(poly: &[[f64; 2]], spacing: f64) -> Vec<[f64; 2]> {
-    let (closed, cum) = closed_loop(poly);
-    let length = cum[cum.len() - 1];
-    if length < 3.0 * spacing {
-        return Vec::new();
-    }
-    let n = ((length / spacing).round() as usize).max(3);
-    let mut pts = crate::curves::resample_polyline(&closed, &cum, n + 1);
-    pts.pop();
-    pts
-}
-
-/// Area of the region a ring of points encloses (mm²).
-pub fn ring_area(ring: &[[f64; 2]]) -> f64 {
-    0.5 * signed_area2(ring).abs()
-}
-
-fn d2(a: [f64; 3], b: [f64; 2]) -> f64 {
-    (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)
-}
-
-/// The index of the point of `ring` nearest to `p` in plan.
-fn nearest(ring: &[[f64; 2]], p: [f64; 3]) -> usize {
-    (0..ring.len())
-        .min_by(|&a, &b| d2(p, ring[a]).total_cmp(&d2(p, ring[b])))
-        .unwrap_or(0)
-}
-
-/// Where each floor element is entered, and the longest step from one to
-/// the next (mm; a step into a ring counted at 2/3, as a ring is entered
-/// at its nearest point and a line only at an end, and refused above two
-/// pitches): each ring nearest the previous one's entry,
-/// the first nearest `start` (where the base ring begins); an open line at
-/// its nearer end.
-pub fn floor_entries(rings: &[FloorRing], start: [f64; 3]) -> (Vec<usize>, f64) {
-    let mut entry = Vec::with_capacity(rings.len());
-    let mut at = start;
-    let mut longest = 0.0f64;
-    for r in rings {
-        let pts = &r.pts;
-        // An open line is entered at an end; inward layers leave it at
-        // the other end, where the next (outward) layer comes back.
-        let e = if r.open {
-            if d2(at, pts[0]) <= d2(at, pts[pts.len() - 1]) {
-                0
-            } else {
-                pts.len() - 1
-            }
-        } else {
-            nearest(pts, at)
-        };
-        // A step into a line counts whole; into a ring, beyond the one
-        // pitch the rings lie apart (a ring far from the last entry is
-        // reached across the clay of the ring before).
-        let step = d2(at, pts[e]).sqrt();
-        longest = longest.max(if r.open { step } else { step * 2.0 / 3.0 });
-        entry.push(e);
-        at = [pts[e][0], pts[e][1], 0.0];
-    }
-    (entry, longest)
-}
-
-/// The toolpath of a vessel: the base layers (floor rings inward on one
+/// The toolpath of a vessel: the base layers (floor elements inward on one
 /// layer, outward on the next, so the last ends on the base ring), the
-/// spiral turns, and the rim. Every sample of the surface is visited once;
-/// the floor's inner rings add their own points.
+/// spiral turns, and the rim. Every sample of the surface is visited once,
+/// the base ring's first point of each base layer twice (the ring closes
+/// over it); the floor's elements add their own points, each ring closing
+/// on its entry. The move into each element, and from the floor to the
+/// base ring, is a join ([`VesselPath::joins`]).
 pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
     let s = &c.surface;
     let n = s.columns.len();
@@ -635,20 +286,40 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
             [p[0], p[1]]
         })
         .collect();
-    let pitch = s.params.width_min * (1.0 - FLOOR_OVERLAP);
     let rings = match &v.floor {
         _ if v.floor_layers == 0 => Vec::new(),
         Some((ring, rings)) if *ring == base_ring => rings.clone(),
-        _ => floor_rings(&base_ring, pitch, s.spacing),
+        _ => floor_rings(&base_ring, floor_beads(&s.params, s.spacing)),
     };
     // Where each ring is entered: nearest the previous ring's entry,
     // the first nearest column 0 (where the base ring starts).
     let c0 = &s.columns[v.start];
-    let entry = floor_entries(&rings, s.position(v.start, c0.first as usize)).0;
-    let floor_points: usize = rings.iter().map(|r| r.pts.len()).sum();
-    let total = s.samples.len() + floor_points * v.floor_layers as usize;
+    let entry = floor_entries(
+        &rings,
+        s.position(v.start, c0.first as usize),
+        s.params.width_min,
+    )
+    .0;
+    // An outward layer enters its rings about a bead farther along: its
+    // joins then lie on the rings of the layer below, not on its joins.
+    let shift = (s.params.width_min / s.spacing).ceil() as usize;
+    let outward_entry: Vec<usize> = rings
+        .iter()
+        .zip(&entry)
+        .map(|(r, &e)| match r.open {
+            true => e,
+            false => seam_at(&r.pts, (e + shift) % r.pts.len(), s.params.width_min),
+        })
+        .collect();
+    // A ring's points and its closing point again; a line's points.
+    let floor_points: usize = rings
+        .iter()
+        .map(|r| r.pts.len() + usize::from(!r.open))
+        .sum();
+    let total = s.samples.len() + (floor_points + 1) * v.base_layers as usize;
     let mut points = Vec::with_capacity(total);
     let mut below = Vec::with_capacity(total);
+    let mut joins = Vec::new();
     // Path index of each column's samples, and of each floor ring's points
     // on the layer below.
     let mut path_of = vec![u32::MAX; s.samples.len()];
@@ -682,6 +353,18 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
             visit_column(points, below, path_of, i, local, pass, PointKind::Pass);
         }
     };
+    // The base ring closes on its own height: back over its first point
+    // before the floor or the spiral goes on from there. Ended on the
+    // spiral's first point, barely above the ring, the closing bead would
+    // be sized for half the ring's height and leave a thin place under the
+    // seam; ended on a join, it would leave a gap.
+    let close_ring = |points: &mut Vec<PathPoint>, below: &mut Vec<Option<u32>>, first: usize| {
+        below.push(below[first]);
+        points.push(PathPoint {
+            kind: PointKind::Pass,
+            ..points[first]
+        });
+    };
     let base = v.base_layers;
     for layer in 1..=base {
         let z = f64::from(layer) * v.base_layer_mm;
@@ -689,18 +372,34 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
         // The last base layer runs outward, the one before inward, …
         let outward = (base - layer).is_multiple_of(2);
         let mut floor = |points: &mut Vec<PathPoint>, below: &mut Vec<Option<u32>>, r: usize| {
-            let ring = &rings[r].pts;
+            let FloorRing { pts: ring, open } = &rings[r];
             let m = ring.len();
-            for step in 0..m {
-                let j = match (rings[r].open, outward == (entry[r] == 0)) {
+            // A ring closes on its entry; a line runs inward from its
+            // entry end, outward back to it.
+            let steps = if *open { m } else { m + 1 };
+            if !points.is_empty() {
+                joins.push(points.len() as u32);
+            }
+            let mut entered_on = u32::MAX;
+            for step in 0..steps {
+                let j = match (*open, outward == (entry[r] == 0)) {
+                    // The innermost, where the layer below turned, is
+                    // entered where that layer left it.
+                    (false, _) if outward && r + 1 < rings.len() => (outward_entry[r] + step) % m,
                     (false, _) => (entry[r] + step) % m,
-                    // Open: inward from the entry end, outward back to it.
                     (true, true) => m - 1 - step,
                     (true, false) => step,
                 };
-                let under = ring_below[r][j];
+                // The closing point lies on what the entry lay on.
+                let under = if step < m {
+                    std::mem::replace(&mut ring_below[r][j], points.len() as u32)
+                } else {
+                    entered_on
+                };
+                if step == 0 {
+                    entered_on = under;
+                }
                 below.push((under != u32::MAX).then_some(under));
-                ring_below[r][j] = points.len() as u32;
                 points.push(PathPoint {
                     pos: [ring[j][0], ring[j][1], z],
                     column: 0,
@@ -716,27 +415,21 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
             true if outward => (0..rings.len()).rev().collect(),
             true => (0..rings.len()).collect(),
         };
+        let ring_at = |path_of: &[u32]| path_of[c0.first as usize + local] as usize;
         if !outward {
             visit_turn(&mut points, &mut below, &mut path_of, local, layer);
+            close_ring(&mut points, &mut below, ring_at(&path_of));
         }
         for r in floor_order {
             floor(&mut points, &mut below, r);
         }
         if outward {
+            if !points.is_empty() {
+                joins.push(points.len() as u32);
+            }
             visit_turn(&mut points, &mut below, &mut path_of, local, layer);
+            close_ring(&mut points, &mut below, ring_at(&path_of));
         }
-    }
-    // The base ring closes on its own height: back over its first point
-    // before the spiral rises from there. Ended on the spiral's first
-    // point, barely above the ring, the closing bead would be sized for
-    // half the ring's height and leave a thin place under the seam.
-    if base > 0 {
-        let first = path_of[c0.first as usize + base as usize - 1] as usize;
-        below.push(below[first]);
-        points.push(PathPoint {
-            kind: PointKind::Pass,
-            ..points[first]
-        });
     }
     for k in 1..=v.turns {
         let local = (base + k) as usize - 1;
@@ -777,6 +470,7 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
             floor_rings: rings.len() as u32,
             floor_area_mm2: floor_area,
             turns: v.turns,
+            joins,
         }),
     }
 }
@@ -792,6 +486,11 @@ pub struct VesselPath {
     pub floor_area_mm2: f64,
     /// Spiral turns of the wall.
     pub turns: u32,
+    /// The points (in order) the move into which is a join: from one floor
+    /// element to the next, or between the floor and the base ring. It
+    /// runs across clay both already cover, so it carries almost no clay
+    /// ([`crate::extrude::JOIN_CLAY`]).
+    pub joins: Vec<u32>,
 }
 
 #[cfg(test)]
@@ -805,57 +504,6 @@ mod tests {
                 [r * a.cos(), r * a.sin()]
             })
             .collect()
-    }
-
-    #[test]
-    fn a_circle_fills_with_concentric_rings() {
-        let rings = floor_rings(&circle(30.0, 200), 2.55, 1.1);
-        // Radii 30 − 2.55 k; the last (1.95 mm) is a line across the middle.
-        assert_eq!(rings.len(), 11, "{}", rings.len());
-        assert!(rings[..10].iter().all(|r| !r.open));
-        for (k, ring) in rings.iter().enumerate().take(10) {
-            let want = 30.0 - 2.55 * (k + 1) as f64;
-            for p in &ring.pts {
-                assert!((p[0].hypot(p[1]) - want).abs() < 0.05, "ring {k}: {p:?}");
-            }
-        }
-    }
-
-    /// A long oval with five shallow lobes (a random vessel that once
-    /// failed its check): deep inside, its floor ends in a tail.
-    fn lobed_oval(depth: f64) -> Vec<[f64; 2]> {
-        (0..240)
-            .map(|i| {
-                let t = std::f64::consts::TAU * i as f64 / 240.0;
-                let r = 1.0 + depth * (5.0 * t).cos();
-                [51.86 * r * t.cos(), 19.14 * r * t.sin()]
-            })
-            .collect()
-    }
-
-    #[test]
-    fn a_floor_ring_that_would_lie_on_itself_is_refused() {
-        match floor_plan(&lobed_oval(0.1164), 2.55, 1.1) {
-            Err(FloorRefusal::Tail { depth, at }) => {
-                assert!(depth > 10.0 && at[0].abs() > 15.0, "{depth} {at:?}");
-            }
-            other => panic!("{other:?}"),
-        }
-        // Without the lobes the same oval ends in a line down its middle.
-        let rings = floor_plan(&lobed_oval(0.0), 2.55, 1.1).unwrap();
-        assert!(rings.last().unwrap().open);
-        for r in rings.iter().filter(|r| !r.open) {
-            assert_eq!(lies_on_itself(&r.pts, 2.55), None);
-        }
-    }
-
-    #[test]
-    fn rings_turn_the_way_the_outline_turns() {
-        let mut cw = circle(20.0, 100);
-        cw.reverse();
-        for ring in floor_rings(&cw, 2.55, 1.1).iter().filter(|r| !r.open) {
-            assert!(signed_area2(&ring.pts) < 0.0);
-        }
     }
 
     fn cup(r: f64, h: f64, floor: u32) -> crate::Sliced {
@@ -946,7 +594,10 @@ mod tests {
                     }
                     inside += 1;
                     let reach = 1.5f64.hypot(0.55);
-                    if beads.iter().any(|b| d2(*b, q) <= reach * reach) {
+                    if beads
+                        .iter()
+                        .any(|b| (b[0] - q[0]).hypot(b[1] - q[1]) <= reach)
+                    {
                         under += 1;
                     }
                 }
