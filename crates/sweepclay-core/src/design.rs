@@ -169,6 +169,12 @@ impl Default for Params {
 /// of the carriage, on top of one layer (see `docs/ALGORITHMS.md`).
 pub const COLLISION_MARGIN_MM: f64 = 1.0;
 
+/// Overlap of a floor bead with its neighbour in the same layer, as a
+/// fraction of its width: enough to close the floor, little enough that the
+/// clay has room (docs/ALGORITHMS.md §8). The floor is laid with it; the
+/// sample estimate counts its rings with it.
+pub const FLOOR_OVERLAP: f64 = 0.15;
+
 impl Params {
     /// Checks every parameter against its allowed range.
     pub fn validate(&self) -> Result<()> {
@@ -464,8 +470,15 @@ impl Design {
             // The closing side; a vessel's floor rings, a pitch apart,
             // fill at most the control polygon's area (docs/ALGORITHMS.md §8).
             length += crate::bspline::dist(pts[pts.len() - 1], pts[0]);
-            let area = 0.5 * crate::curves::signed_area2(pts).abs();
-            let pitch = p.width_min * (1.0 - crate::floor::FLOOR_OVERLAP);
+            // The shoelace formula over the control polygon.
+            let twice: f64 = (0..pts.len())
+                .map(|i| {
+                    let (a, b) = (pts[i], pts[(i + 1) % pts.len()]);
+                    a[0] * b[1] - b[0] * a[1]
+                })
+                .sum();
+            let area = 0.5 * twice.abs();
+            let pitch = p.width_min * (1.0 - FLOOR_OVERLAP);
             let layers = p.floor_layers.unwrap_or(DEFAULT_FLOOR_LAYERS);
             floor = 1.5 * area / (pitch * p.spacing) * f64::from(layers);
         }

@@ -19,10 +19,7 @@ use geo::Simplify;
 use i_overlay::mesh::outline::offset::OutlineOffset;
 use i_overlay::mesh::style::{LineJoin, OutlineStyle};
 
-/// Overlap of a floor bead with its neighbour in the same layer, as a
-/// fraction of its width: enough to close the floor, little enough that the
-/// clay has room (docs/ALGORITHMS.md §8).
-pub const FLOOR_OVERLAP: f64 = 0.15;
+pub use crate::design::FLOOR_OVERLAP;
 
 /// Most floor rings a layer may have (a floor 5 m across at 3 mm beads,
 /// far beyond any printer; the sample cap refuses such designs first):

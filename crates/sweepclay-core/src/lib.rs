@@ -21,6 +21,12 @@
 //! Table 1. The layering that decides single or two stages is in
 //! [`layers`]; `docs/ALGORITHMS.md` gives the formulation and its proofs.
 //!
+//! A closed Ψ (a vessel, not in the paper) goes through the same stages:
+//! sampling samples its wall and [`vessel`] chooses its layering (flat base
+//! layers, then spiral turns); the path stage lays the floor, whose
+//! geometry is [`floor`]'s (a region in, the bead elements that fill it
+//! out), and the spiral ([`toolpath::plan_vessel_path`]).
+//!
 //! ```
 //! let design = sweepclay_core::Design::from_json(r#"{
 //!   "sweepclay": 1,

@@ -75,8 +75,9 @@ pub fn sample_of_point(s: &Surface, p: &crate::toolpath::PathPoint) -> Option<us
 /// The closed solid of the surface thickened to the bead width: each sample
 /// is pushed ±w/2 across Ψ (horizontally, perpendicular to the trajectory),
 /// where w is the width of the bead printed there, from the bed (z = 0) to
-/// the top of the last bead. Triangles are
-/// consistently oriented with their normals pointing out.
+/// the top of the last bead. A vessel with a floor is one solid, the wall
+/// standing on the floor (one watertight shell, as slicers read a piece).
+/// Triangles are consistently oriented with their normals pointing out.
 pub fn solid(s: &Sliced) -> Vec<[[f64; 3]; 3]> {
     let surface = &s.corrected.surface;
     let cols = &surface.columns;
@@ -107,6 +108,48 @@ pub fn solid(s: &Sliced) -> Vec<[[f64; 3]; 3]> {
         }
     }
     let (o, inner) = (|i: usize| i, |i: usize| n + i);
+    // A vessel with a floor is one solid: its wall's inside stands on the
+    // floor's top, and the bottom is one face across the outside ring. The
+    // wall's inside below the floor's top, and its bottom strip, go.
+    let floor = surface
+        .vessel
+        .as_ref()
+        .filter(|v| v.floor_layers > 0)
+        .map(|v| v.base_layers as usize);
+    let ring_at = |side: &dyn Fn(usize) -> usize, local: usize| -> Vec<usize> {
+        cols.iter()
+            .map(|c| side(c.first as usize + local))
+            .collect()
+    };
+    let area = |ring: &[usize]| {
+        let pts: Vec<[f64; 2]> = ring.iter().map(|&i| [v[i][0], v[i][1]]).collect();
+        crate::curves::signed_area2(&pts).abs()
+    };
+    // Which of the two sides is the vessel's inside.
+    let inside_is_inner = floor.is_some() && area(&ring_at(&inner, 0)) < area(&ring_at(&o, 0));
+    let inside = |i: usize| (i >= n) == inside_is_inner;
+    if let Some(base) = floor {
+        if base == 1 {
+            // The inside starts at the floor's top, the first layer's.
+            for c in cols {
+                let si = c.first as usize;
+                let at = if inside_is_inner { inner(si) } else { o(si) };
+                v[at][2] = surface.samples[si].z;
+            }
+        }
+    }
+    // Each sample's place up its column (0 at the bed).
+    let mut local_of = vec![0usize; n];
+    for c in cols {
+        for (k, si) in c.samples().enumerate() {
+            local_of[si] = k;
+        }
+    }
+    let local = |i: usize| local_of[i % n];
+    let below_floor = |t: &[usize; 3]| match floor {
+        Some(base) => t.iter().all(|&i| inside(i) && local(i) < base),
+        None => false,
+    };
     let mut idx: Vec<[usize; 3]> = Vec::with_capacity(4 * n + 4 * cols.len());
     let quad = |idx: &mut Vec<[usize; 3]>, a: usize, b: usize, c: usize, d: usize| {
         idx.push([a, b, c]);
@@ -114,19 +157,24 @@ pub fn solid(s: &Sliced) -> Vec<[[f64; 3]; 3]> {
     };
     for t in surface_triangles(surface) {
         let [a, b, c] = t.map(|i| i as usize);
-        idx.push([o(a), o(b), o(c)]);
-        idx.push([inner(c), inner(b), inner(a)]);
+        for tri in [[o(a), o(b), o(c)], [inner(c), inner(b), inner(a)]] {
+            if !below_floor(&tri) {
+                idx.push(tri);
+            }
+        }
     }
     for (ca, cb) in column_pairs(surface) {
         let (a, b) = (cols[ca].samples(), cols[cb].samples());
         // Bottom and top edges.
-        quad(
-            &mut idx,
-            o(b.start),
-            o(a.start),
-            inner(a.start),
-            inner(b.start),
-        );
+        if floor.is_none() {
+            quad(
+                &mut idx,
+                o(b.start),
+                o(a.start),
+                inner(a.start),
+                inner(b.start),
+            );
+        }
         let (ta, tb) = (a.end - 1, b.end - 1);
         quad(&mut idx, o(ta), o(tb), inner(tb), inner(ta));
     }
@@ -141,25 +189,82 @@ pub fn solid(s: &Sliced) -> Vec<[[f64; 3]; 3]> {
             quad(&mut idx, o(s + 1), o(s), inner(s), inner(s + 1));
         }
     }
+    if let Some(base) = floor {
+        // The bottom across the outside ring, the floor's top across the
+        // inside ring where the wall's inside stands on it.
+        let (outside, inside): (&dyn Fn(usize) -> usize, &dyn Fn(usize) -> usize) =
+            if inside_is_inner {
+                (&o, &inner)
+            } else {
+                (&inner, &o)
+            };
+        idx.extend(cap(&v, &ring_at(outside, 0)));
+        idx.extend(cap(&v, &ring_at(inside, base - 1)));
+    }
+    orient(&mut idx);
     let mut tris: Vec<[[f64; 3]; 3]> = idx.iter().map(|t| t.map(|i| v[i])).collect();
     outward(&mut tris);
-    if let Some(v) = &surface.vessel {
-        if v.floor_layers > 0 {
-            // The floor: a slab inside the base ring, from the bed to the
-            // top of its layers (a second shell, overlapping the wall's).
-            let ring: Vec<[f64; 2]> = cols
-                .iter()
-                .map(|c| {
-                    let p = surface.position_of(c);
-                    [p[0], p[1]]
-                })
-                .collect();
-            let mut floor = slab(&ring, v.base_mm());
-            outward(&mut floor);
-            tris.extend(floor);
+    tris
+}
+
+/// The triangles (vertex indices) of the flat face across a ring of
+/// vertices, by `earcut` (non-convex rings of lobed and cornered pots).
+fn cap(v: &[[f64; 3]], ring: &[usize]) -> Vec<[usize; 3]> {
+    let mut idx: Vec<u32> = Vec::new();
+    earcut::Earcut::new().earcut(
+        ring.iter().map(|&i| [v[i][0], v[i][1]]),
+        &[] as &[u32],
+        &mut idx,
+    );
+    idx.chunks_exact(3)
+        .map(|t| {
+            [
+                ring[t[0] as usize],
+                ring[t[1] as usize],
+                ring[t[2] as usize],
+            ]
+        })
+        .collect()
+}
+
+/// Turns the triangles of a closed mesh so that each shares its edges
+/// with its neighbours the opposite way round (a consistent orientation),
+/// walking from the first triangle across shared edges.
+fn orient(tris: &mut [[usize; 3]]) {
+    let mut by_edge: rustc_hash::FxHashMap<(usize, usize), Vec<usize>> = Default::default();
+    for (k, t) in tris.iter().enumerate() {
+        for e in 0..3 {
+            let (a, b) = (t[e], t[(e + 1) % 3]);
+            by_edge.entry((a.min(b), a.max(b))).or_default().push(k);
         }
     }
-    tris
+    let mut done = vec![false; tris.len()];
+    for start in 0..tris.len() {
+        if done[start] {
+            continue;
+        }
+        done[start] = true;
+        let mut stack = vec![start];
+        while let Some(k) = stack.pop() {
+            let t = tris[k];
+            for e in 0..3 {
+                let (a, b) = (t[e], t[(e + 1) % 3]);
+                for &j in &by_edge[&(a.min(b), a.max(b))] {
+                    if done[j] {
+                        continue;
+                    }
+                    // The neighbour must run the shared edge b → a.
+                    let u = tris[j];
+                    let same = (0..3).any(|f| u[f] == a && u[(f + 1) % 3] == b);
+                    if same {
+                        tris[j].swap(1, 2);
+                    }
+                    done[j] = true;
+                    stack.push(j);
+                }
+            }
+        }
+    }
 }
 
 /// Turns a closed shell's triangles so that their normals point out.
@@ -169,33 +274,6 @@ fn outward(tris: &mut [[[f64; 3]; 3]]) {
             t.swap(1, 2);
         }
     }
-}
-
-/// The closed prism over a simple polygon from z = 0 to `top`: its two
-/// faces triangulated by `earcut`, its sides as quads.
-fn slab(ring: &[[f64; 2]], top: f64) -> Vec<[[f64; 3]; 3]> {
-    let mut idx: Vec<u32> = Vec::new();
-    earcut::Earcut::new().earcut(ring.iter().copied(), &[] as &[u32], &mut idx);
-    let at = |i: u32, z: f64| {
-        let p = ring[i as usize];
-        [p[0], p[1], z]
-    };
-    let mut tris = Vec::with_capacity(2 * idx.len() / 3 + 2 * ring.len());
-    for t in idx.chunks_exact(3) {
-        tris.push([at(t[0], top), at(t[1], top), at(t[2], top)]);
-        tris.push([at(t[0], 0.0), at(t[2], 0.0), at(t[1], 0.0)]);
-    }
-    // Sides turn with the faces: earcut keeps the ring's order, so a side
-    // goes round the way the top's triangles do.
-    let ccw = crate::curves::signed_area2(ring) > 0.0;
-    let n = ring.len() as u32;
-    for i in 0..n {
-        let j = (i + 1) % n;
-        let (a, b) = if ccw { (i, j) } else { (j, i) };
-        tris.push([at(a, 0.0), at(b, 0.0), at(b, top)]);
-        tris.push([at(a, 0.0), at(b, top), at(a, top)]);
-    }
-    tris
 }
 
 /// The volume enclosed by a closed, consistently oriented triangle mesh
@@ -314,6 +392,41 @@ mod tests {
                 (vol / clay - 1.0).abs() < 0.25,
                 "{name}: solid {vol:.1} ml vs clay {clay:.1} ml"
             );
+        }
+    }
+
+    #[test]
+    fn a_vessel_is_one_solid_standing_on_its_floor() {
+        // Slicers read overlapping shells as holes: a vessel's wall and
+        // floor are one shell (every triangle reached from every other
+        // across shared edges; closed and outward as tested above).
+        for name in ["cup", "flower", "vase"] {
+            let s = sliced(name);
+            let tris = solid(&s);
+            let key = |p: [f64; 3]| p.map(|x| (x * 1e6).round() as i64);
+            let mut by_edge: FxHashMap<([i64; 3], [i64; 3]), Vec<usize>> = FxHashMap::default();
+            for (k, t) in tris.iter().enumerate() {
+                for e in 0..3 {
+                    let (a, b) = (key(t[e]), key(t[(e + 1) % 3]));
+                    by_edge.entry((a.min(b), a.max(b))).or_default().push(k);
+                }
+            }
+            let mut seen = vec![false; tris.len()];
+            let mut stack = vec![0];
+            seen[0] = true;
+            while let Some(k) = stack.pop() {
+                for e in 0..3 {
+                    let (a, b) = (key(tris[k][e]), key(tris[k][(e + 1) % 3]));
+                    for &j in &by_edge[&(a.min(b), a.max(b))] {
+                        if !seen[j] {
+                            seen[j] = true;
+                            stack.push(j);
+                        }
+                    }
+                }
+            }
+            let reached = seen.iter().filter(|&&x| x).count();
+            assert_eq!(reached, tris.len(), "{name}: more than one shell");
         }
     }
 

@@ -12,16 +12,15 @@
 //!
 //! so z rises along every turn with no seam, and a last, partial turn lays
 //! the rim level at h_i. The floor inside the base ring is filled by the
-//! elements of [`crate::floor`]; [`plan_vessel_path`] joins them, layer by
-//! layer, into the path with no travel.
+//! elements of [`crate::floor`]; the path stage (`plan_vessel_path` in
+//! the toolpath module) joins them, layer by layer, into the path with no
+//! travel.
 
-use crate::correct::Corrected;
 use crate::design::{Params, COLLISION_MARGIN_MM};
 use crate::error::{Error, Result};
 #[cfg(test)]
 use crate::floor::FLOOR_OVERLAP;
-use crate::floor::{floor_entries, floor_rings, ring_area, seam_at, FloorBeads, FloorRing};
-use crate::toolpath::{PathPoint, PointKind, Toolpath};
+use crate::floor::{FloorBeads, FloorRing};
 
 /// The layering of a vessel.
 #[derive(Clone, Debug, PartialEq)]
@@ -270,232 +269,10 @@ pub fn floor_beads(params: &Params, spacing: f64) -> FloorBeads {
     }
 }
 
-/// The toolpath of a vessel: the base layers (floor elements inward on one
-/// layer, outward on the next, so the last ends on the base ring), the
-/// spiral turns, and the rim. Every sample of the surface is visited once,
-/// the base ring's first point of each base layer twice (the ring closes
-/// over it); the floor's elements add their own points, each ring closing
-/// on its entry. The move into each element, and from the floor to the
-/// base ring, is a join ([`VesselPath::joins`]).
-pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
-    let s = &c.surface;
-    let n = s.columns.len();
-    let base_ring: Vec<[f64; 2]> = (0..n)
-        .map(|i| {
-            let p = s.position(i, s.columns[i].first as usize);
-            [p[0], p[1]]
-        })
-        .collect();
-    let rings = match &v.floor {
-        _ if v.floor_layers == 0 => Vec::new(),
-        Some((ring, rings)) if *ring == base_ring => rings.clone(),
-        _ => floor_rings(&base_ring, floor_beads(&s.params, s.spacing)),
-    };
-    // Where each ring is entered: nearest the previous ring's entry,
-    // the first nearest column 0 (where the base ring starts).
-    let c0 = &s.columns[v.start];
-    let entry = floor_entries(
-        &rings,
-        s.position(v.start, c0.first as usize),
-        s.params.width_min,
-    )
-    .0;
-    // An outward layer enters its rings about a bead farther along: its
-    // joins then lie on the rings of the layer below, not on its joins.
-    let shift = (s.params.width_min / s.spacing).ceil() as usize;
-    let outward_entry: Vec<usize> = rings
-        .iter()
-        .zip(&entry)
-        .map(|(r, &e)| match r.open {
-            true => e,
-            false => seam_at(&r.pts, (e + shift) % r.pts.len(), s.params.width_min),
-        })
-        .collect();
-    // A ring's points and its closing point again; a line's points.
-    let floor_points: usize = rings
-        .iter()
-        .map(|r| r.pts.len() + usize::from(!r.open))
-        .sum();
-    let total = s.samples.len() + (floor_points + 1) * v.base_layers as usize;
-    let mut points = Vec::with_capacity(total);
-    let mut below = Vec::with_capacity(total);
-    let mut joins = Vec::new();
-    // Path index of each column's samples, and of each floor ring's points
-    // on the layer below.
-    let mut path_of = vec![u32::MAX; s.samples.len()];
-    let mut ring_below: Vec<Vec<u32>> = rings.iter().map(|r| vec![u32::MAX; r.pts.len()]).collect();
-    let visit_column = |points: &mut Vec<PathPoint>,
-                        below: &mut Vec<Option<u32>>,
-                        path_of: &mut Vec<u32>,
-                        i: usize,
-                        local: usize,
-                        pass: u32,
-                        kind: PointKind| {
-        let col = &s.columns[i];
-        let si = col.first as usize + local;
-        path_of[si] = points.len() as u32;
-        below.push((local > 0).then(|| path_of[si - 1]));
-        points.push(PathPoint {
-            pos: s.position(i, si),
-            column: i as u32,
-            pass,
-            kind,
-        });
-    };
-    // Sample `local` of every column, round the loop from the start.
-    let visit_turn = |points: &mut Vec<PathPoint>,
-                      below: &mut Vec<Option<u32>>,
-                      path_of: &mut Vec<u32>,
-                      local: usize,
-                      pass: u32| {
-        for m in 0..n {
-            let i = (v.start + m) % n;
-            visit_column(points, below, path_of, i, local, pass, PointKind::Pass);
-        }
-    };
-    // The base ring closes on its own height: back over its first point
-    // before the floor or the spiral goes on from there. Ended on the
-    // spiral's first point, barely above the ring, the closing bead would
-    // be sized for half the ring's height and leave a thin place under the
-    // seam; ended on a join, it would leave a gap.
-    let close_ring = |points: &mut Vec<PathPoint>, below: &mut Vec<Option<u32>>, first: usize| {
-        below.push(below[first]);
-        points.push(PathPoint {
-            kind: PointKind::Pass,
-            ..points[first]
-        });
-    };
-    let base = v.base_layers;
-    for layer in 1..=base {
-        let z = f64::from(layer) * v.base_layer_mm;
-        let local = layer as usize - 1;
-        // The last base layer runs outward, the one before inward, …
-        let outward = (base - layer).is_multiple_of(2);
-        let mut floor = |points: &mut Vec<PathPoint>, below: &mut Vec<Option<u32>>, r: usize| {
-            let FloorRing { pts: ring, open } = &rings[r];
-            let m = ring.len();
-            // A ring closes on its entry; a line runs inward from its
-            // entry end, outward back to it.
-            let steps = if *open { m } else { m + 1 };
-            if !points.is_empty() {
-                joins.push(points.len() as u32);
-            }
-            let mut entered_on = u32::MAX;
-            for step in 0..steps {
-                let j = match (*open, outward == (entry[r] == 0)) {
-                    // The innermost, where the layer below turned, is
-                    // entered where that layer left it.
-                    (false, _) if outward && r + 1 < rings.len() => (outward_entry[r] + step) % m,
-                    (false, _) => (entry[r] + step) % m,
-                    (true, true) => m - 1 - step,
-                    (true, false) => step,
-                };
-                // The closing point lies on what the entry lay on.
-                let under = if step < m {
-                    std::mem::replace(&mut ring_below[r][j], points.len() as u32)
-                } else {
-                    entered_on
-                };
-                if step == 0 {
-                    entered_on = under;
-                }
-                below.push((under != u32::MAX).then_some(under));
-                points.push(PathPoint {
-                    pos: [ring[j][0], ring[j][1], z],
-                    column: 0,
-                    pass: layer,
-                    kind: PointKind::Floor,
-                });
-            }
-        };
-        // A floor layer that runs inward starts on the base ring; one that
-        // runs outward ends on it.
-        let floor_order: Vec<usize> = match layer <= v.floor_layers {
-            false => Vec::new(),
-            true if outward => (0..rings.len()).rev().collect(),
-            true => (0..rings.len()).collect(),
-        };
-        let ring_at = |path_of: &[u32]| path_of[c0.first as usize + local] as usize;
-        if !outward {
-            visit_turn(&mut points, &mut below, &mut path_of, local, layer);
-            close_ring(&mut points, &mut below, ring_at(&path_of));
-        }
-        for r in floor_order {
-            floor(&mut points, &mut below, r);
-        }
-        if outward {
-            if !points.is_empty() {
-                joins.push(points.len() as u32);
-            }
-            visit_turn(&mut points, &mut below, &mut path_of, local, layer);
-            close_ring(&mut points, &mut below, ring_at(&path_of));
-        }
-    }
-    for k in 1..=v.turns {
-        let local = (base + k) as usize - 1;
-        visit_turn(&mut points, &mut below, &mut path_of, local, base + k);
-    }
-    let rim = base + v.turns + 1;
-    for i in (0..n).map(|m| (v.start + m) % n) {
-        if s.columns[i].top {
-            let local = s.columns[i].passes as usize;
-            visit_column(
-                &mut points,
-                &mut below,
-                &mut path_of,
-                i,
-                local,
-                rim,
-                PointKind::Top,
-            );
-        }
-    }
-    debug_assert!(
-        path_of.iter().all(|&p| p != u32::MAX),
-        "every sample is visited"
-    );
-    let floor_area = if v.floor_layers > 0 {
-        ring_area(&base_ring)
-    } else {
-        0.0
-    };
-    Toolpath {
-        points,
-        below,
-        passes: rim,
-        stages: 1,
-        returning_points: 0,
-        vessel: Some(VesselPath {
-            floor_layers: v.floor_layers,
-            floor_rings: rings.len() as u32,
-            floor_area_mm2: floor_area,
-            turns: v.turns,
-            joins,
-        }),
-    }
-}
-
-/// What the path of a vessel holds beyond its points.
-#[derive(Clone, Debug, PartialEq)]
-pub struct VesselPath {
-    /// Floor layers (0: bottomless).
-    pub floor_layers: u32,
-    /// Inner rings of each floor layer (the base ring not counted).
-    pub floor_rings: u32,
-    /// Area inside the base ring (mm²), 0 for a bottomless vessel.
-    pub floor_area_mm2: f64,
-    /// Spiral turns of the wall.
-    pub turns: u32,
-    /// The points (in order) the move into which is a join: from one floor
-    /// element to the next, or between the floor and the base ring. It
-    /// runs across clay both already cover, so it carries almost no clay
-    /// ([`crate::extrude::JOIN_CLAY`]).
-    pub joins: Vec<u32>,
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::toolpath::{PathPoint, PointKind};
 
     fn circle(r: f64, n: usize) -> Vec<[f64; 2]> {
         (0..n)

@@ -2,126 +2,14 @@
 //! plain serialisable answers out. Every function is a thin composition of
 //! the library's stages (`sweepclay-core`) and the checker.
 
+pub use crate::error::ApiError;
 use crate::guard::Cancel;
+pub use crate::guard::Limits;
 use crate::verify::{verify_until, Verified};
 use serde::Serialize;
 use sweepclay_core::mesh;
 use sweepclay_core::toolpath::PointKind;
-use sweepclay_core::{correct, surface, Design, Error, Sliced};
-
-/// An answer the page shows as an error: an HTTP status and a message that
-/// names the key (or line) at fault.
-#[derive(Clone, Debug, PartialEq, Serialize)]
-pub struct ApiError {
-    /// HTTP status: 400 unreadable input, 413 too large, 422 a valid design
-    /// that cannot be printed or has values out of range.
-    #[serde(skip)]
-    pub status: u16,
-    /// The message, e.g. `params.layer_height: must be between …`.
-    pub error: String,
-    /// The offending key, when there is one.
-    #[serde(skip_serializing_if = "Option::is_none")]
-    pub key: Option<String>,
-    /// The checker's failures, for a design whose G-code is not printable.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub failures: Vec<String>,
-    /// Where in the design the failures are.
-    #[serde(skip_serializing_if = "Vec::is_empty")]
-    pub locations: Vec<String>,
-    /// Seconds after which a busy server may be asked again (503).
-    #[serde(skip)]
-    pub retry_after: Option<u32>,
-}
-
-impl ApiError {
-    /// An error with a status and message.
-    pub fn new(status: u16, error: impl Into<String>) -> Self {
-        ApiError {
-            status,
-            error: error.into(),
-            key: None,
-            failures: Vec::new(),
-            locations: Vec::new(),
-            retry_after: None,
-        }
-    }
-
-    /// The same error, saying when to try again (`Retry-After`).
-    pub fn retry_after(self, secs: u32) -> Self {
-        ApiError {
-            retry_after: Some(secs),
-            ..self
-        }
-    }
-}
-
-impl ApiError {
-    /// The same error, naming the offending key.
-    pub fn with_key(self, key: impl Into<String>) -> Self {
-        ApiError {
-            key: Some(key.into()),
-            ..self
-        }
-    }
-}
-
-impl From<Error> for ApiError {
-    fn from(e: Error) -> Self {
-        let (status, key) = match &e {
-            Error::Parse { .. } => (400, None),
-            Error::Invalid { key, .. } => (422, Some(key.clone())),
-            Error::TooLarge { .. } => (413, Some("params.spacing".into())),
-            _ => (422, None),
-        };
-        ApiError {
-            key,
-            ..ApiError::new(status, e.to_string())
-        }
-    }
-}
-
-/// Limits that keep one request, or many, from exhausting the machine
-/// (docs/MODELER.md, "Limits and safety").
-#[derive(Clone, Debug, PartialEq)]
-pub struct Limits {
-    /// Most surface samples a design may have (estimated before slicing).
-    pub max_samples: f64,
-    /// Slices, checks and meshes run at once (default: the cores).
-    pub workers: usize,
-    /// Requests that may wait for a worker; beyond them, 503 with
-    /// `Retry-After` (default: 4 a worker).
-    pub queue: usize,
-    /// How long a request may wait for a worker and run (default 60 s);
-    /// past it, 503.
-    pub request_timeout: std::time::Duration,
-    /// The names the server answers to in `Host` (with any port):
-    /// `127.0.0.1`, `localhost`, `[::1]` and the address it was started
-    /// on. Empty: any (a server bound to every interface, on purpose).
-    pub hosts: Vec<String>,
-    /// Connections open at once and their idle timeout (default 256 and
-    /// the request timeout plus a minute, so a slice in flight is never
-    /// cut).
-    pub connections: crate::conn::Connections,
-}
-
-impl Default for Limits {
-    fn default() -> Self {
-        let workers = std::thread::available_parallelism().map_or(2, |n| n.get());
-        Limits {
-            max_samples: 1.5e6,
-            workers,
-            queue: 4 * workers,
-            request_timeout: std::time::Duration::from_secs(60),
-            connections: crate::conn::Connections {
-                max: 256,
-                idle: std::time::Duration::from_secs(120),
-            },
-            hosts: ["127.0.0.1", "localhost", "[::1]"]
-                .map(String::from)
-                .to_vec(),
-        }
-    }
-}
+use sweepclay_core::{correct, surface, Design, Sliced};
 
 /// Parses a design and refuses one whose sample count is over the limit.
 /// One that leaves the build volume is let through: slicing refuses it all

@@ -10,7 +10,7 @@
 //! `Content-Type` a browser cannot send cross-origin without a preflight,
 //! which this server never grants (no CORS headers).
 
-use crate::api::{ApiError, Limits};
+use crate::error::ApiError;
 use axum::extract::Request;
 use axum::http::{header, HeaderValue, Method};
 use axum::middleware::Next;
@@ -18,6 +18,49 @@ use axum::response::{IntoResponse, Response};
 use std::sync::atomic::{AtomicUsize, Ordering};
 use std::sync::Arc;
 use tokio::sync::Semaphore;
+
+/// Limits that keep one request, or many, from exhausting the machine
+/// (docs/MODELER.md, "Limits and safety").
+#[derive(Clone, Debug, PartialEq)]
+pub struct Limits {
+    /// Most surface samples a design may have (estimated before slicing).
+    pub max_samples: f64,
+    /// Slices, checks and meshes run at once (default: the cores).
+    pub workers: usize,
+    /// Requests that may wait for a worker; beyond them, 503 with
+    /// `Retry-After` (default: 4 a worker).
+    pub queue: usize,
+    /// How long a request may wait for a worker and run (default 60 s);
+    /// past it, 503.
+    pub request_timeout: std::time::Duration,
+    /// The names the server answers to in `Host` (with any port):
+    /// `127.0.0.1`, `localhost`, `[::1]` and the address it was started
+    /// on. Empty: any (a server bound to every interface, on purpose).
+    pub hosts: Vec<String>,
+    /// Connections open at once and their idle timeout (default 256 and
+    /// the request timeout plus a minute, so a slice in flight is never
+    /// cut).
+    pub connections: crate::conn::Connections,
+}
+
+impl Default for Limits {
+    fn default() -> Self {
+        let workers = std::thread::available_parallelism().map_or(2, |n| n.get());
+        Limits {
+            max_samples: 1.5e6,
+            workers,
+            queue: 4 * workers,
+            request_timeout: std::time::Duration::from_secs(60),
+            connections: crate::conn::Connections {
+                max: 256,
+                idle: std::time::Duration::from_secs(120),
+            },
+            hosts: ["127.0.0.1", "localhost", "[::1]"]
+                .map(String::from)
+                .to_vec(),
+        }
+    }
+}
 
 /// Set when the request that asked for some work is gone (its client
 /// disconnected, or its time ran out): the work stops at its next check,

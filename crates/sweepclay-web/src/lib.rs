@@ -25,6 +25,7 @@
 
 pub mod api;
 pub mod conn;
+pub mod error;
 pub mod guard;
 pub mod verify;
 
