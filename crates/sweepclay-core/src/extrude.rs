@@ -61,7 +61,7 @@ impl Extrusion {
     }
 }
 
-/// The clay of a join ([`crate::vessel::VesselPath::joins`]), as a
+/// The clay of a join ([`crate::toolpath::VesselPath::joins`]), as a
 /// fraction of a bead's cuboid: the step from one floor element to the next
 /// runs across clay both already cover (docs/ALGORITHMS.md §8), so it gets
 /// next to none — but some, so E keeps rising and the clay never stops.

@@ -47,9 +47,9 @@ impl FloorBeads {
 /// line, counter-clockwise or not) inside it, outermost first: its
 /// offsets inward by one pitch, two, … until nothing is left, each
 /// resampled about `spacing` apart and turned the way `outer` turns; then
-/// the core that fills the hole the last ring leaves, if any ([`core_of`]). An offset that splits (a waist narrower than
-/// two beads) gives several rings at one depth; they follow each other
-/// outermost first.
+/// the core that fills the hole the last ring leaves, if any. An offset
+/// that splits (a waist narrower than two beads) gives several rings at one
+/// depth; they follow each other outermost first.
 ///
 /// A ring whose two sides come closer than 3/4 of a pitch (its mean width
 /// 2A/P, area over half the perimeter: the last ring of a long ellipse)
