@@ -690,13 +690,22 @@ impl<'a> Checker<'a> {
     }
 
     /// Ends a stretch of beads on clay at their own height: a failure if
-    /// it is longer than 2 w_max and most of its clay had no room.
+    /// most of its clay had no room and it is longer than 2 w_max, or
+    /// shorter — but at least 3/4 `w_min` long, more than a seam's last
+    /// bead — laying a bead's clay (more than a `w_min`-wide bead of
+    /// `min_layer_mm` a millimetre, over at least `w_min`): the step from
+    /// one ring of a floor to the next laid as a full bead over both
+    /// (docs/CHECKER.md, "Clay on clay"). A join carrying next to no clay
+    /// across them is a smear, not a bead on a bead.
     fn close_stretch(&mut self) {
         if self.stretch.length == 0.0 {
             return;
         }
         let st = std::mem::take(&mut self.stretch);
-        if st.length > 2.0 * self.cfg.width_max && st.excess > 0.75 * st.volume {
+        let cfg = self.cfg;
+        let bead = cfg.width_min * cfg.min_layer_mm * st.length.max(cfg.width_min);
+        let short = st.length >= 0.75 * cfg.width_min && st.excess > bead;
+        if st.excess > 0.75 * st.volume && (st.length > 2.0 * cfg.width_max || short) {
             self.record(Finding::DoubleDeposition, st.first_line, st.excess, false);
         }
     }

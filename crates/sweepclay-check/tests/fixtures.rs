@@ -354,6 +354,49 @@ fn double_deposition_fails() {
     only(&r, "laid on clay at their own height");
 }
 
+/// A floor of concentric rings 0.85 w apart round (100, 100), two layers
+/// (inward, then outward), each ring closed on its entry at angle 0 and the
+/// step to the next ring laid with `step_w`-wide clay.
+fn ring_floor(step_w: f64) -> G {
+    let pitch = 0.85 * W;
+    let radii: Vec<f64> = (0..8).map(|k| 30.0 - pitch * k as f64).collect();
+    let at = |r: f64, a: f64, z: f64| [100.0 + r * a.cos(), 100.0 + r * a.sin(), z];
+    let mut g = G::new(at(radii[0], 0.0, LAYER));
+    for layer in 1..=2 {
+        let z = LAYER * layer as f64;
+        let order: Vec<f64> = if layer == 1 {
+            radii.clone()
+        } else {
+            radii.iter().rev().copied().collect()
+        };
+        for (k, &r) in order.iter().enumerate() {
+            if k > 0 {
+                g.bead(at(r, 0.0, z), step_w, LAYER);
+            } else if layer == 2 {
+                g.bead(at(r, 0.0, z), W, LAYER);
+            }
+            let seg = (std::f64::consts::TAU * r / 1.1).ceil() as usize;
+            for i in 1..=seg {
+                let a = std::f64::consts::TAU * i as f64 / seg as f64;
+                g.bead(at(r, a, z), W, LAYER);
+            }
+        }
+    }
+    g
+}
+
+#[test]
+fn a_floor_whose_ring_steps_lay_beads_on_both_rings_fails() {
+    // The junction fault: each step from one ring to the next runs across
+    // clay both rings cover; laid as a full bead, it is clay on clay.
+    let r = verdict(&ring_floor(W).out);
+    only(&r, "laid on clay at their own height");
+    // The same steps as joins carrying next to no clay are smears: the
+    // floor prints.
+    let r = verdict(&ring_floor(0.05 * W).out);
+    assert!(r.printable, "{}", r.render());
+}
+
 #[test]
 fn first_layer_in_the_air_fails() {
     let mut g = G::new([50.0, 50.0, 8.0]);

@@ -118,6 +118,13 @@ pub fn plan_extrusion(path: &Toolpath, params: &Params, origin: [f64; 2]) -> Ext
             }
         }
     }
+    // A thin floor ring's beads are laid narrower where its sides come
+    // close, whatever lies below them (docs/ALGORITHMS.md §8).
+    if let Some(v) = &path.vessel {
+        for &(i, w) in &v.narrow {
+            width[i as usize] = w;
+        }
+    }
     let mut volume = Vec::with_capacity(n);
     let (mut total, mut length, mut turn, mut turn_cuboid) = (0.0, 0.0, 0.0, 0.0);
     let mut turn_steps = 0;

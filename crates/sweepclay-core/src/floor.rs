@@ -125,12 +125,15 @@ fn rings_of(
                     rings.push(FloorRing {
                         pts: line,
                         open: true,
+                        widths: None,
                     });
                 }
             } else {
+                let widths = narrowed(&ring, beads.width);
                 rings.push(FloorRing {
                     pts: ring,
                     open: false,
+                    widths,
                 });
             }
         }
@@ -172,7 +175,44 @@ fn core_of(ring: &[[f64; 2]], beads: FloorBeads) -> Option<FloorRing> {
             vec![[c[0] - half, c[1]], [c[0] + half, c[1]]]
         }
     };
-    Some(FloorRing { pts, open: true })
+    Some(FloorRing {
+        pts,
+        open: true,
+        widths: None,
+    })
+}
+
+/// The widths a closed ring's beads are laid at where its far side comes
+/// closer than a pitch: two beads `d` apart overlap by the stated fraction
+/// when they are `d / (1 − FLOOR_OVERLAP)` wide. "Far" is more than four
+/// beads along the ring either way: nearer, round a U-turn, the nozzle
+/// lays the two sides in one go. `None` where no point needs it.
+fn narrowed(ring: &[[f64; 2]], width: f64) -> Option<Vec<f64>> {
+    let m = ring.len();
+    let cum = closed_loop(ring).1;
+    let perimeter = cum[m];
+    let reach = width * (1.0 - FLOOR_OVERLAP);
+    let mut grid = crate::grid::Grid2::new(reach);
+    for (i, p) in ring.iter().enumerate() {
+        grid.insert_segment(*p, *p, i as u32);
+    }
+    let mut widths = vec![width; m];
+    let mut any = false;
+    for (i, &p) in ring.iter().enumerate() {
+        let mut d = f64::INFINITY;
+        grid.for_each_near_segment(p, p, reach, |j| {
+            let along = (cum[i] - cum[j as usize]).abs();
+            if along.min(perimeter - along) > 4.0 * width {
+                let q = ring[j as usize];
+                d = d.min((p[0] - q[0]).hypot(p[1] - q[1]));
+            }
+        });
+        if d < reach {
+            widths[i] = d / (1.0 - FLOOR_OVERLAP);
+            any = true;
+        }
+    }
+    any.then_some(widths)
 }
 
 /// The contours of a counter-clockwise closed contour offset inward by
@@ -327,6 +367,10 @@ pub struct FloorRing {
     pub pts: Vec<[f64; 2]>,
     /// An open line (laid end to end), not a ring.
     pub open: bool,
+    /// Where a ring's far side comes closer than a pitch (a thin ring's
+    /// two long sides), the narrower width its beads are laid at there,
+    /// point by point (mm); `None` where every bead is the floor's.
+    pub widths: Option<Vec<f64>>,
 }
 
 /// The line down the middle of a thin closed ring: between the point
@@ -437,12 +481,15 @@ pub fn seam_at(ring: &[[f64; 2]], e: usize, width: f64) -> usize {
 }
 
 /// The distance from `p` to the segment `a`–`b` where its foot falls
-/// inside the segment, else infinity (`p` lies beyond an end).
+/// inside the segment or within 0.3 of its length before it, else
+/// infinity (`p` lies beyond an end): the margin keeps a seam off a
+/// corner whose angle the path's points, moved a little by the
+/// corrections, may sharpen.
 fn beside(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
     let (dx, dy) = (b[0] - a[0], b[1] - a[1]);
     let l2 = dx * dx + dy * dy;
     let t = ((p[0] - a[0]) * dx + (p[1] - a[1]) * dy) / l2;
-    if l2 <= 0.0 || !(0.0..=1.0).contains(&t) {
+    if l2 <= 0.0 || !(-0.3..=1.0).contains(&t) {
         return f64::INFINITY;
     }
     (p[0] - a[0] - t * dx).hypot(p[1] - a[1] - t * dy)

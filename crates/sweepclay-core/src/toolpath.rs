@@ -191,6 +191,7 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
     let mut points = Vec::with_capacity(total);
     let mut below = Vec::with_capacity(total);
     let mut joins = Vec::new();
+    let mut narrow = Vec::new();
     // Path index of each column's samples, and of each floor ring's points
     // on the layer below.
     let mut path_of = vec![u32::MAX; s.samples.len()];
@@ -243,7 +244,11 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
         // The last base layer runs outward, the one before inward, …
         let outward = (base - layer).is_multiple_of(2);
         let mut floor = |points: &mut Vec<PathPoint>, below: &mut Vec<Option<u32>>, r: usize| {
-            let FloorRing { pts: ring, open } = &rings[r];
+            let FloorRing {
+                pts: ring,
+                open,
+                widths,
+            } = &rings[r];
             let m = ring.len();
             // A ring closes on its entry; a line runs inward from its
             // entry end, outward back to it.
@@ -271,6 +276,13 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
                     entered_on = under;
                 }
                 below.push((under != u32::MAX).then_some(under));
+                if let Some(w) = widths
+                    .as_ref()
+                    .map(|w| w[j])
+                    .filter(|&w| w < s.params.width_min)
+                {
+                    narrow.push((points.len() as u32, w));
+                }
                 points.push(PathPoint {
                     pos: [ring[j][0], ring[j][1], z],
                     column: 0,
@@ -342,6 +354,7 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
             floor_area_mm2: floor_area,
             turns: v.turns,
             joins,
+            narrow,
         }),
     }
 }
@@ -362,6 +375,10 @@ pub struct VesselPath {
     /// runs across clay both already cover, so it carries almost no clay
     /// (the extrusion stage's `JOIN_CLAY`).
     pub joins: Vec<u32>,
+    /// The floor points (in order) laid narrower than the floor's bead,
+    /// and their width (mm): where a thin ring's two sides come closer
+    /// than a pitch (`FloorRing::widths` in the floor module).
+    pub narrow: Vec<(u32, f64)>,
 }
 
 #[cfg(test)]
