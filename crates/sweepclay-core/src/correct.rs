@@ -4,7 +4,7 @@
 //! - Support-free: each transition curve is walked upward; a step whose
 //!   horizontal offset exceeds s_max(Δz) is shortened to s_max and every
 //!   point above moves with it.
-//! - Self-intersection: surface points of transition curves more than 1.6
+//! - Self-intersection: surface points of transition curves more than two
 //!   bead widths apart along Ψ that come closer than the widest bead are
 //!   found through a plan grid of each curve's radial segment (one query
 //!   per curve), comparing samples only for curves whose segments come
@@ -251,8 +251,10 @@ fn find_self_intersection(s: &Surface) -> Option<(u32, u32, [f64; 3])> {
     }
     let w = s.params.width_max;
     // A U-turn of radius w/2 is the tightest curve whose sides do not touch:
-    // its opposite points are π·w/2 ≈ 1.57 w apart along Ψ.
-    let far = ((1.6 * w) / s.spacing).ceil() as usize;
+    // its opposite points are π·w/2 ≈ 1.57 w apart along Ψ. Sides nearer
+    // than 2 w along Ψ (a sharp corner's) are laid in one go, as fresh clay
+    // the nozzle rides on (the checker counts them so too).
+    let far = ((2.0 * w) / s.spacing).ceil() as usize;
     let segs: Vec<[[f64; 2]; 2]> = s
         .columns
         .iter()
@@ -646,7 +648,7 @@ mod tests {
     /// The plain definition: every pair of points, far apart along Ψ.
     fn brute_force(s: &Surface) -> bool {
         let w = s.params.width_max;
-        let far = ((1.6 * w) / s.spacing).ceil() as usize;
+        let far = ((2.0 * w) / s.spacing).ceil() as usize;
         // Far apart along Ψ, closer than w, and far apart along the pass
         // that lays them (a converging surface is no contact).
         let pts: Vec<(usize, usize, [f64; 3])> = s

@@ -317,6 +317,31 @@ mod tests {
     }
 
     #[test]
+    fn a_triangular_pot_is_no_trajectory_that_meets_itself() {
+        // Near a 60° corner the two sides come within a wide bead of each
+        // other 12 mm apart along Ψ: laid in one go, round the corner, not
+        // a surface meeting itself (it was refused: "the trajectory comes
+        // within one bead width of itself").
+        let tri: Vec<[f64; 2]> = (0..3)
+            .map(|i| {
+                let a = std::f64::consts::TAU * i as f64 / 3.0;
+                [45.0 * a.cos(), 45.0 * a.sin()]
+            })
+            .collect();
+        let d = crate::Design::from_json(
+            &serde_json::json!({
+                "sweepclay": 1,
+                "profile_start": { "control_points": [[0.0, 0.0], [0.0, 30.0]] },
+                "trajectory": { "points": tri, "closed": true, "offset": "normal" },
+            })
+            .to_string(),
+        )
+        .unwrap();
+        let s = crate::slice(&d).unwrap();
+        assert_eq!(s.corrected.report.intersection, None);
+    }
+
+    #[test]
     fn a_cylinder_is_a_helix_over_a_floor_of_rings() {
         let s = cup(30.0, 40.0, 2);
         let t = &s.toolpath;
