@@ -985,6 +985,14 @@ async fn truthful_state_imports_printers_and_phones() {
     }
     // A tablet: one column, the editors above the 3D view and the side.
     c.set_window_size(768, 1024).await.unwrap();
+    // The resize lands when the page has laid itself out again (slow on a
+    // loaded machine): the phone's tabs are gone then.
+    wait_js(
+        &c,
+        "return document.getElementById('tabs').offsetParent === null",
+        "the tablet layout",
+    )
+    .await;
     tokio::time::sleep(Duration::from_millis(300)).await;
     let b = boxes(
         &c,
