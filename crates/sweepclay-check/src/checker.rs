@@ -929,7 +929,7 @@ impl<'a> Checker<'a> {
                 // A smear (a join across clay) carries no clay to hold up:
                 // what it overlaps or leans over is not judged
                 // (docs/CHECKER.md, "Clay on clay").
-                if width >= crate::support::SMEAR * cfg.width_min {
+                if !crate::support::is_smear(width, cfg) {
                     let bin = if overlap < 0.5 {
                         0
                     } else if overlap < 0.6 {

@@ -125,7 +125,7 @@ impl Query<'_> {
             // clay, a ramp's start) holds nothing up: what it lies on does.
             if mid[2] - z <= cfg.max_gap_mm
                 && d <= cfg.width_max.max(b.width() / 2.0)
-                && b.width() >= SMEAR * cfg.width_min
+                && !is_smear(b.width(), cfg)
             {
                 return Class::Below(Candidate {
                     id: j,
@@ -140,7 +140,7 @@ impl Query<'_> {
         } else if (z - mid[2]).abs() < cfg.min_layer_mm
             && d < 0.5 * b.width().min(cfg.width_min)
             // Nor is a smear clay to be laid on.
-            && b.width() >= SMEAR * cfg.width_min
+            && !is_smear(b.width(), cfg)
             // Clay laid in the last 2 w_max of path is the run's own fresh
             // clay (a corner piles up, it is not laid twice).
             && s_start - b.s_end > 2.0 * cfg.width_max
@@ -440,9 +440,12 @@ pub(crate) fn follow_support(
     Some(best)
 }
 
-/// Below this many `w_min` wide, a bead is a smear of clay, no support
-/// (docs/CHECKER.md, "Support").
-pub(crate) const SMEAR: f64 = 0.25;
+/// Whether a bead `width` mm wide is a smear of clay: under a quarter of
+/// `w_min`, it holds nothing up, is no clay to be laid on, and is not
+/// judged itself (docs/CHECKER.md, "Clay on clay").
+pub(crate) fn is_smear(width: f64, cfg: &CheckConfig) -> bool {
+    width < 0.25 * cfg.width_min
+}
 
 /// Within this many `w_min` of the middle, the shortcut's answer is taken
 /// as the nearest bead below without asking the beads around: passes of

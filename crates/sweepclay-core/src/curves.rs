@@ -14,6 +14,7 @@ use crate::bspline::{dist, BSpline};
 use crate::design::{CurveSpec, TrajectorySpec};
 use crate::error::{Error, Result};
 use crate::grid::Grid2;
+use crate::plane::signed_area2;
 
 fn check_points(key: &str, pts: &[[f64; 2]], min: usize) -> Result<()> {
     if pts.len() < min {
@@ -280,17 +281,6 @@ pub fn periodic_bspline(pts: &[[f64; 2]], per_span: usize) -> Vec<[f64; 2]> {
     }
     out.push(out[0]);
     out
-}
-
-/// Twice the signed area of a closed polygon (positive counter-clockwise).
-pub fn signed_area2(poly: &[[f64; 2]]) -> f64 {
-    let n = poly.len();
-    (0..n)
-        .map(|i| {
-            let (a, b) = (poly[i], poly[(i + 1) % n]);
-            a[0] * b[1] - b[0] * a[1]
-        })
-        .sum()
 }
 
 /// Arc length at each vertex of a polyline (0 at the first).

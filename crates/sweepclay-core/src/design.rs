@@ -470,14 +470,7 @@ impl Design {
             // The closing side; a vessel's floor rings, a pitch apart,
             // fill at most the control polygon's area (docs/ALGORITHMS.md §8).
             length += crate::bspline::dist(pts[pts.len() - 1], pts[0]);
-            // The shoelace formula over the control polygon.
-            let twice: f64 = (0..pts.len())
-                .map(|i| {
-                    let (a, b) = (pts[i], pts[(i + 1) % pts.len()]);
-                    a[0] * b[1] - b[0] * a[1]
-                })
-                .sum();
-            let area = 0.5 * twice.abs();
+            let area = 0.5 * crate::plane::signed_area2(pts).abs();
             let pitch = p.width_min * (1.0 - FLOOR_OVERLAP);
             let layers = p.floor_layers.unwrap_or(DEFAULT_FLOOR_LAYERS);
             floor = 1.5 * area / (pitch * p.spacing) * f64::from(layers);

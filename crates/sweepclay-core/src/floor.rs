@@ -14,7 +14,7 @@
 //! both already cover: it is a *join* ([`floor_entries`]), laid with
 //! almost no clay, never a bead on a bead.
 
-use crate::curves::signed_area2;
+use crate::plane::signed_area2;
 use geo::Simplify;
 use i_overlay::mesh::outline::offset::OutlineOffset;
 use i_overlay::mesh::style::{LineJoin, OutlineStyle};
@@ -443,14 +443,14 @@ pub fn ring_area(ring: &[[f64; 2]]) -> f64 {
     0.5 * signed_area2(ring).abs()
 }
 
-fn d2(a: [f64; 3], b: [f64; 2]) -> f64 {
+fn d2(a: [f64; 2], b: [f64; 2]) -> f64 {
     (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2)
 }
 
-/// The index of the point of `ring` nearest to `p` in plan.
-fn nearest(ring: &[[f64; 2]], p: [f64; 3]) -> usize {
-    (0..ring.len())
-        .min_by(|&a, &b| d2(p, ring[a]).total_cmp(&d2(p, ring[b])))
+/// The index of the point of `pts` nearest to `p`.
+pub fn nearest(pts: &[[f64; 2]], p: [f64; 2]) -> usize {
+    (0..pts.len())
+        .min_by(|&a, &b| d2(p, pts[a]).total_cmp(&d2(p, pts[b])))
         .unwrap_or(0)
 }
 
@@ -501,7 +501,7 @@ fn beside(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
 /// pitches): each ring nearest the previous one's entry,
 /// the first nearest `start` (where the base ring begins); an open line at
 /// its nearer end.
-pub fn floor_entries(rings: &[FloorRing], start: [f64; 3], width: f64) -> (Vec<usize>, f64) {
+pub fn floor_entries(rings: &[FloorRing], start: [f64; 2], width: f64) -> (Vec<usize>, f64) {
     let mut entry = Vec::with_capacity(rings.len());
     let mut at = start;
     let mut longest = 0.0f64;
@@ -524,7 +524,7 @@ pub fn floor_entries(rings: &[FloorRing], start: [f64; 3], width: f64) -> (Vec<u
         let step = d2(at, pts[e]).sqrt();
         longest = longest.max(if r.open { step } else { step * 2.0 / 3.0 });
         entry.push(e);
-        at = [pts[e][0], pts[e][1], 0.0];
+        at = pts[e];
     }
     (entry, longest)
 }
@@ -782,7 +782,7 @@ mod tests {
         let rings = floor_rings(&ellipse(50.0, 35.0, 240), BEADS);
         // From the end of the long axis the rings' nearest points lead
         // down it to the core's end.
-        let (entry, longest) = floor_entries(&rings, [50.0, 0.0, 0.0], BEADS.width);
+        let (entry, longest) = floor_entries(&rings, [50.0, 0.0], BEADS.width);
         assert_eq!(entry.len(), rings.len());
         assert!(longest <= 2.0 * BEADS.pitch(), "{longest}");
     }

@@ -55,6 +55,7 @@ pub mod import;
 pub mod layers;
 pub mod mesh;
 pub mod motion;
+pub mod plane;
 pub mod preview;
 pub mod printer;
 pub mod stability;

@@ -116,26 +116,28 @@ pub fn solid(s: &Sliced) -> Vec<[[f64; 3]; 3]> {
         .as_ref()
         .filter(|v| v.floor_layers > 0)
         .map(|v| v.base_layers as usize);
-    let ring_at = |side: &dyn Fn(usize) -> usize, local: usize| -> Vec<usize> {
+    // A ring of vertices round the loop: `side` 0 is the outer (o), n the
+    // inner, at the samples `local` up their columns.
+    let ring_at = |side: usize, local: usize| -> Vec<usize> {
         cols.iter()
-            .map(|c| side(c.first as usize + local))
+            .map(|c| side + c.first as usize + local)
             .collect()
     };
     let area = |ring: &[usize]| {
         let pts: Vec<[f64; 2]> = ring.iter().map(|&i| [v[i][0], v[i][1]]).collect();
-        crate::curves::signed_area2(&pts).abs()
+        crate::plane::signed_area2(&pts).abs()
     };
     // Which of the two sides is the vessel's inside.
-    let inside_is_inner = floor.is_some() && area(&ring_at(&inner, 0)) < area(&ring_at(&o, 0));
-    let inside = |i: usize| (i >= n) == inside_is_inner;
-    if let Some(base) = floor {
-        if base == 1 {
-            // The inside starts at the floor's top, the first layer's.
-            for c in cols {
-                let si = c.first as usize;
-                let at = if inside_is_inner { inner(si) } else { o(si) };
-                v[at][2] = surface.samples[si].z;
-            }
+    let (outside, inside) = if floor.is_some() && area(&ring_at(n, 0)) < area(&ring_at(0, 0)) {
+        (0, n)
+    } else {
+        (n, 0)
+    };
+    if floor == Some(1) {
+        // The inside starts at the floor's top, the first layer's.
+        for c in cols {
+            let si = c.first as usize;
+            v[inside + si][2] = surface.samples[si].z;
         }
     }
     // Each sample's place up its column (0 at the bed).
@@ -147,7 +149,7 @@ pub fn solid(s: &Sliced) -> Vec<[[f64; 3]; 3]> {
     }
     let local = |i: usize| local_of[i % n];
     let below_floor = |t: &[usize; 3]| match floor {
-        Some(base) => t.iter().all(|&i| inside(i) && local(i) < base),
+        Some(base) => t.iter().all(|&i| i - i % n == inside && local(i) < base),
         None => false,
     };
     let mut idx: Vec<[usize; 3]> = Vec::with_capacity(4 * n + 4 * cols.len());
@@ -192,12 +194,6 @@ pub fn solid(s: &Sliced) -> Vec<[[f64; 3]; 3]> {
     if let Some(base) = floor {
         // The bottom across the outside ring, the floor's top across the
         // inside ring where the wall's inside stands on it.
-        let (outside, inside): (&dyn Fn(usize) -> usize, &dyn Fn(usize) -> usize) =
-            if inside_is_inner {
-                (&o, &inner)
-            } else {
-                (&inner, &o)
-            };
         idx.extend(cap(&v, &ring_at(outside, 0)));
         idx.extend(cap(&v, &ring_at(inside, base - 1)));
     }

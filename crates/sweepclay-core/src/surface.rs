@@ -183,7 +183,7 @@ pub fn sample_surface(design: &Design) -> Result<Surface> {
     let traj = Trajectory::new(&design.trajectory, params.spacing)?;
     let n = traj.points.len();
     // "Outward" for a loop: right of travel on a counter-clockwise one.
-    let outward = if closed && crate::curves::signed_area2(&traj.points) > 0.0 {
+    let outward = if closed && crate::plane::signed_area2(&traj.points) > 0.0 {
         -1.0
     } else {
         1.0
@@ -332,12 +332,7 @@ fn floor_start(
     let Some(inner) = rings.last() else {
         return Ok((vec![0], Some((ring, rings))));
     };
-    let nearest_to = |c: [f64; 2]| {
-        let d2 = |p: [f64; 2]| (p[0] - c[0]).powi(2) + (p[1] - c[1]).powi(2);
-        (0..ring.len())
-            .min_by(|&a, &b| d2(ring[a]).total_cmp(&d2(ring[b])))
-            .unwrap_or(0)
-    };
+    let nearest_to = |c: [f64; 2]| crate::floor::nearest(&ring, c);
     let centre = nearest_to(crate::floor::centroid(&inner.pts));
     // A line down an elongated core is entered at an end: from the column
     // beyond that end, the rings' nearest points lead to it.
@@ -354,8 +349,7 @@ fn floor_start(
         .chain(ends.into_iter().flatten())
         .map(|st| crate::floor::seam_at(&ring, st, params.width_min))
         .filter(|&st| {
-            let (_, step) =
-                floor_entries(&rings, [ring[st][0], ring[st][1], 0.0], params.width_min);
+            let (_, step) = floor_entries(&rings, ring[st], params.width_min);
             worst = worst.max(step);
             step <= 2.0 * pitch
         })

@@ -165,21 +165,19 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
     // Where each ring is entered: nearest the previous ring's entry,
     // the first nearest column 0 (where the base ring starts).
     let c0 = &s.columns[v.start];
-    let entry = floor_entries(
-        &rings,
-        s.position(v.start, c0.first as usize),
-        s.params.width_min,
-    )
-    .0;
+    let entry = floor_entries(&rings, base_ring[v.start], s.params.width_min).0;
     // An outward layer enters its rings about a bead farther along: its
     // joins then lie on the rings of the layer below, not on its joins.
+    // The innermost, where the layer below turned, and a line are entered
+    // where that layer left them.
     let shift = (s.params.width_min / s.spacing).ceil() as usize;
     let outward_entry: Vec<usize> = rings
         .iter()
         .zip(&entry)
-        .map(|(r, &e)| match r.open {
+        .enumerate()
+        .map(|(r, (ring, &e))| match ring.open || r + 1 == rings.len() {
             true => e,
-            false => seam_at(&r.pts, (e + shift) % r.pts.len(), s.params.width_min),
+            false => seam_at(&ring.pts, (e + shift) % ring.pts.len(), s.params.width_min),
         })
         .collect();
     // A ring's points and its closing point again; a line's points.
@@ -256,13 +254,11 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
             if !points.is_empty() {
                 joins.push(points.len() as u32);
             }
+            let e = if outward { outward_entry[r] } else { entry[r] };
             let mut entered_on = u32::MAX;
             for step in 0..steps {
-                let j = match (*open, outward == (entry[r] == 0)) {
-                    // The innermost, where the layer below turned, is
-                    // entered where that layer left it.
-                    (false, _) if outward && r + 1 < rings.len() => (outward_entry[r] + step) % m,
-                    (false, _) => (entry[r] + step) % m,
+                let j = match (*open, outward == (e == 0)) {
+                    (false, _) => (e + step) % m,
                     (true, true) => m - 1 - step,
                     (true, false) => step,
                 };
