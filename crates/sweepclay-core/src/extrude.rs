@@ -119,7 +119,8 @@ pub fn plan_extrusion(path: &Toolpath, params: &Params, origin: [f64; 2]) -> Ext
         }
     }
     // A thin floor ring's beads are laid narrower where its sides come
-    // close, whatever lies below them (docs/ALGORITHMS.md §8).
+    // close, the line down one's middle wider, whatever lies below them
+    // (docs/ALGORITHMS.md §8).
     if let Some(v) = &path.vessel {
         for &(i, w) in &v.narrow {
             width[i as usize] = w;

@@ -33,6 +33,10 @@ pub struct FloorBeads {
     pub width: f64,
     /// Distance between the points of a ring (mm).
     pub spacing: f64,
+    /// Widest bead the floor may lay (mm): the design's `width_max`. The
+    /// line down a thin ring's middle is laid as wide as the ring's two
+    /// sides would have covered, up to this.
+    pub widest: f64,
 }
 
 impl FloorBeads {
@@ -89,7 +93,19 @@ pub fn floor_plan(
     if let Some((depth, count)) = split_of(&offsets, pitch) {
         return Err(FloorRefusal::Islands { depth, count });
     }
-    let rings = rings_of(outer, &offsets, beads);
+    let mut rings = rings_of(outer, &offsets, beads);
+    // The innermost ring of a region that ends in a tail (a lens drawn
+    // out to a point: the last offset of a long polygon or lobed oval) is
+    // laid once, as the line down its middle, instead of the ring and the
+    // core inside it.
+    if let Some(k) = rings.iter().rposition(|r| !r.open) {
+        if lies_on_itself(&rings[k].pts, pitch).is_some() {
+            if let Some(line) = thin_ring_line(&rings[k].pts, beads) {
+                rings.truncate(k);
+                rings.push(line);
+            }
+        }
+    }
     for (k, r) in rings.iter().enumerate().filter(|(_, r)| !r.open) {
         if let Some(at) = lies_on_itself(&r.pts, pitch) {
             // One contour a depth: ring k is k + 1 pitches in.
@@ -121,13 +137,7 @@ fn rings_of(
             }
             let perimeter = closed_loop(&ring).1[ring.len()];
             if 2.0 * ring_area(&ring) / perimeter < 0.75 * pitch {
-                if let Some(line) = midline(&ring, spacing) {
-                    rings.push(FloorRing {
-                        pts: line,
-                        open: true,
-                        widths: None,
-                    });
-                }
+                rings.extend(thin_ring_line(&ring, beads));
             } else {
                 let widths = narrowed(&ring, beads.width);
                 rings.push(FloorRing {
@@ -169,7 +179,7 @@ fn core_of(ring: &[[f64; 2]], beads: FloorBeads) -> Option<FloorRing> {
     let half = 0.5 * beads.spacing;
     let dense = resample_loop(&core, half);
     let pts = match (dense.len() >= 3).then(|| midline(&dense, beads.spacing)) {
-        Some(Some(line)) if line.len() >= 2 => line,
+        Some(Some((line, _))) if line.len() >= 2 => line,
         _ => {
             let c = centroid(&core);
             vec![[c[0] - half, c[1]], [c[0] + half, c[1]]]
@@ -373,10 +383,30 @@ pub struct FloorRing {
     pub widths: Option<Vec<f64>>,
 }
 
+/// The open element that lays a thin closed ring once: the line down
+/// its middle, each bead as wide as the ring's two sides' beads would
+/// have covered together (the sides' distance plus a bead), from the
+/// floor's bead up to the widest, so that it meets the ring outside it
+/// with the stated overlap (docs/ALGORITHMS.md §8).
+fn thin_ring_line(ring: &[[f64; 2]], beads: FloorBeads) -> Option<FloorRing> {
+    let (pts, apart) = midline(ring, beads.spacing)?;
+    let widths: Vec<f64> = apart
+        .iter()
+        .map(|t| (t + beads.width).clamp(beads.width, beads.widest.max(beads.width)))
+        .collect();
+    let wider = widths.iter().any(|&w| w > beads.width + 1e-9);
+    Some(FloorRing {
+        pts,
+        open: true,
+        widths: wider.then_some(widths),
+    })
+}
+
 /// The line down the middle of a thin closed ring: between the point
 /// farthest from its centroid and the point farthest from that, the mean
-/// of its two sides, points about `spacing` apart (`None` for a speck).
-fn midline(ring: &[[f64; 2]], spacing: f64) -> Option<Vec<[f64; 2]>> {
+/// of its two sides, points about `spacing` apart, with the distance
+/// between the two sides at each (`None` for a speck).
+fn midline(ring: &[[f64; 2]], spacing: f64) -> Option<(Vec<[f64; 2]>, Vec<f64>)> {
     let m = ring.len();
     let a = farthest(ring, centroid(ring));
     let b = farthest(ring, ring[a]);
@@ -410,8 +440,13 @@ fn midline(ring: &[[f64; 2]], spacing: f64) -> Option<Vec<[f64; 2]>> {
     Some(
         r1.iter()
             .zip(&r2)
-            .map(|(p, q)| [0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1])])
-            .collect(),
+            .map(|(p, q)| {
+                (
+                    [0.5 * (p[0] + q[0]), 0.5 * (p[1] + q[1])],
+                    (p[0] - q[0]).hypot(p[1] - q[1]),
+                )
+            })
+            .unzip(),
     )
 }
 
@@ -536,6 +571,7 @@ mod tests {
     const BEADS: FloorBeads = FloorBeads {
         width: 3.0,
         spacing: 1.1,
+        widest: 6.0,
     };
 
     fn circle(r: f64, n: usize) -> Vec<[f64; 2]> {
@@ -765,6 +801,46 @@ mod tests {
         assert!(rings.last().unwrap().open);
         for r in rings.iter().filter(|r| !r.open) {
             assert_eq!(lies_on_itself(&r.pts, BEADS.pitch()), None);
+        }
+    }
+
+    /// An oval `rx` × `ry` with `n` lobes `depth` deep.
+    fn lobes(rx: f64, ry: f64, n: f64, depth: f64) -> Vec<[f64; 2]> {
+        (0..240)
+            .map(|i| {
+                let t = std::f64::consts::TAU * i as f64 / 240.0;
+                let r = 1.0 + depth * (n * t).cos();
+                [rx * r * t.cos(), ry * r * t.sin()]
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_floor_that_ends_in_a_point_is_laid_down_its_middle() {
+        // The innermost ring of a lobed oval runs out to points whose sides
+        // lie on each other (once refused: "the floor narrows to a sliver
+        // thinner than a bead"): it is laid once, down its middle, as wide
+        // as its two sides would have covered.
+        for (rx, ry, n, depth) in [
+            (50.0, 20.0, 3.0, 0.05),
+            (60.0, 20.0, 5.0, 0.1),
+            (40.0, 30.0, 5.0, 0.1),
+        ] {
+            let outer = lobes(rx, ry, n, depth);
+            let plain = floor_rings(&outer, BEADS);
+            let innermost = plain.iter().rfind(|r| !r.open).unwrap();
+            assert!(lies_on_itself(&innermost.pts, BEADS.pitch()).is_some());
+            let rings = floor_plan(&outer, BEADS).unwrap();
+            let last = rings.last().unwrap();
+            assert!(last.open, "{rx} × {ry}: {} rings", rings.len());
+            let widths = last.widths.as_ref().expect("a wider line");
+            let widest = widths.iter().copied().fold(0.0, f64::max);
+            assert!(widest > BEADS.width && widest <= BEADS.widest, "{widest}");
+            let cov = coverage(&outer, &rings, 1.5);
+            assert!(cov > 0.95, "{rx} × {ry}: {cov}");
+            for r in rings.iter().filter(|r| !r.open) {
+                assert_eq!(lies_on_itself(&r.pts, BEADS.pitch()), None);
+            }
         }
     }
 

@@ -330,7 +330,7 @@ fn floor_start(
         )),
     };
     let Some(inner) = rings.last() else {
-        return Ok((vec![0], Some((ring, rings))));
+        return Ok((spread_starts(ring.len()).collect(), Some((ring, rings))));
     };
     let nearest_to = |c: [f64; 2]| crate::floor::nearest(&ring, c);
     let centre = nearest_to(crate::floor::centroid(&inner.pts));
@@ -344,9 +344,13 @@ fn floor_start(
     let mut worst = 0.0f64;
     // Each moved off any corner where the base ring's seam would lay its
     // last beads alongside its first.
+    // Then eight columns evenly round the loop, for a seam the extruder
+    // body clears where the rim rises and falls.
+    let n = ring.len();
     let ok: Vec<usize> = [0, centre]
         .into_iter()
         .chain(ends.into_iter().flatten())
+        .chain(spread_starts(n).skip(1))
         .map(|st| crate::floor::seam_at(&ring, st, params.width_min))
         .filter(|&st| {
             let (_, step) = floor_entries(&rings, ring[st], params.width_min);
@@ -363,6 +367,40 @@ fn floor_start(
         ));
     }
     Ok((ok, Some((ring, rings))))
+}
+
+/// Where a spiral may begin on a loop of `n` columns when the start of Ψ
+/// will not do: Ψ's start, then seven more evenly round the loop.
+fn spread_starts(n: usize) -> impl Iterator<Item = usize> {
+    (0..8).map(move |m| m * n / 8).filter(move |&c| c < n)
+}
+
+/// The layering with the most turns, from `v.turns` down to
+/// `v.fewest_turns`, and the first of `starts`, whose spiral the extruder
+/// body clears; else the worst collision (column, mm above the nozzle) of
+/// the thickest layering from the first start.
+fn clear_layering(
+    v: &VesselPlan,
+    starts: &[usize],
+    near: &crate::vessel::Neighbours,
+    heights: &[f64],
+    exempt: usize,
+) -> std::result::Result<VesselPlan, (usize, f64)> {
+    for turns in (v.fewest_turns..=v.turns).rev() {
+        let mut w = v.with_turns(turns);
+        for &st in starts {
+            w.start = st;
+            if w.body_violation(near, heights, exempt).is_none() {
+                return Ok(w);
+            }
+        }
+    }
+    let mut w = v.with_turns(v.fewest_turns);
+    w.start = starts[0];
+    match w.body_violation(near, heights, exempt) {
+        None => Ok(w),
+        Some(worst) => Err(worst),
+    }
 }
 
 /// The samples of a vessel (docs/ALGORITHMS.md §8): each column's base
@@ -390,7 +428,7 @@ fn sample_vessel(
         v.floor = floor;
         starts
     } else {
-        vec![0]
+        spread_starts(n).collect()
     };
     // The extruder body's reach, and the clay just laid along the loop
     // that it may touch, as the checker counts them; columns where the
@@ -409,28 +447,46 @@ fn sample_vessel(
         })
         .collect();
     let near = crate::vessel::Neighbours::new(&points, reach);
-    // The first start whose seam the extruder body clears.
-    let mut violation = None;
-    for &st in &starts {
-        v.start = st;
-        violation = v.body_violation(&near, &heights, exempt);
-        if violation.is_none() {
-            break;
+    // The most turns (the thinnest layers) whose spiral the extruder body
+    // clears, from the first start whose seam it clears; where a rim rises
+    // and falls, thicker layers keep the turn below out of its way.
+    match clear_layering(&v, &starts, &near, &heights, exempt) {
+        Ok(clear) => v = clear,
+        Err((i, over)) => {
+            let c = &columns[i];
+            let lo = heights.iter().copied().fold(f64::INFINITY, f64::min);
+            let hi = heights.iter().copied().fold(0.0, f64::max);
+            // How far the rim's heights must come together: the largest
+            // share of today's spread whose spiral clears, by bisection.
+            let clears = |share: f64| {
+                let h: Vec<f64> = heights.iter().map(|&h| lo + share * (h - lo)).collect();
+                VesselPlan::choose(&h, &params, floor)
+                    .is_ok_and(|w| clear_layering(&w, &starts, &near, &h, exempt).is_ok())
+            };
+            let (mut ok, mut bad) = (0.0, 1.0);
+            for _ in 0..12 {
+                let mid = 0.5 * (ok + bad);
+                if clears(mid) {
+                    ok = mid;
+                } else {
+                    bad = mid;
+                }
+            }
+            return Err(Error::invalid(
+                "interpolation",
+                format!(
+                    "the rim rises or falls too steeply for a spiral near ({:.1}, {:.1}) mm, u = {:.3}: even with the thickest layers ({} turns of up to {:.2} mm) the extruder body ({} mm radius) would meet clay {over:.2} mm above the nozzle there; bring the two profiles' heights within {:.1} mm of each other round the loop (now {:.1} mm apart), or make the interpolation change more gently along the loop",
+                    c.p[0],
+                    c.p[1],
+                    c.u,
+                    v.fewest_turns,
+                    v.with_turns(v.fewest_turns).turn_mm[1],
+                    printer.nozzle_radius,
+                    ok * (hi - lo),
+                    hi - lo
+                ),
+            ));
         }
-    }
-    if violation.is_some() {
-        v.start = starts[0];
-        violation = v.body_violation(&near, &heights, exempt);
-    }
-    if let Some((i, over)) = violation {
-        let c = &columns[i];
-        return Err(Error::invalid(
-            "interpolation",
-            format!(
-                "the rim rises or falls too steeply for a spiral near ({:.1}, {:.1}) mm, u = {:.3}: the extruder body ({} mm radius) would meet clay {over:.2} mm above the nozzle there; bring the two profiles' heights closer, or make the interpolation change more gently along the loop",
-                c.p[0], c.p[1], c.u, printer.nozzle_radius
-            ),
-        ));
     }
     let rim = v.rim_beads(&near, &heights, exempt);
     let layers = v.base_layers + v.turns;

@@ -275,7 +275,7 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
                 if let Some(w) = widths
                     .as_ref()
                     .map(|w| w[j])
-                    .filter(|&w| w < s.params.width_min)
+                    .filter(|&w| (w - s.params.width_min).abs() > 1e-9)
                 {
                     narrow.push((points.len() as u32, w));
                 }
@@ -371,9 +371,10 @@ pub struct VesselPath {
     /// runs across clay both already cover, so it carries almost no clay
     /// (the extrusion stage's `JOIN_CLAY`).
     pub joins: Vec<u32>,
-    /// The floor points (in order) laid narrower than the floor's bead,
-    /// and their width (mm): where a thin ring's two sides come closer
-    /// than a pitch (`FloorRing::widths` in the floor module).
+    /// The floor points (in order) laid at another width than the floor's
+    /// bead, and that width (mm): narrower where a thin ring's two sides
+    /// come closer than a pitch, wider along the line down a thin ring's
+    /// middle (`FloorRing::widths` in the floor module).
     pub narrow: Vec<(u32, f64)>,
 }
 

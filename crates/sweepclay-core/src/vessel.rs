@@ -34,6 +34,10 @@ pub struct VesselPlan {
     pub base_layer_mm: f64,
     /// K: spiral turns of the wall.
     pub turns: u32,
+    /// The fewest turns that keep every layer within `max_layer_height`:
+    /// thicker layers the sampling may fall back on where the extruder
+    /// body would meet the turn below on a rim that rises and falls.
+    pub fewest_turns: u32,
     /// Thinnest and thickest spiral layer δ_i round the loop (mm).
     pub turn_mm: [f64; 2],
     /// The column each layer and turn begins at (the path's start in
@@ -103,10 +107,22 @@ impl VesselPlan {
             base_layers,
             base_layer_mm: dmin,
             turns,
+            fewest_turns: fewest,
             turn_mm: [(lo - base) / k, (hi - base) / k],
             start: 0,
             floor: None,
         })
+    }
+
+    /// The same layering with `turns` spiral turns (between
+    /// [`VesselPlan::fewest_turns`] and the most `choose` found).
+    pub fn with_turns(&self, turns: u32) -> VesselPlan {
+        let scale = f64::from(self.turns) / f64::from(turns);
+        VesselPlan {
+            turns,
+            turn_mm: self.turn_mm.map(|d| d * scale),
+            ..self.clone()
+        }
     }
 
     /// The height of spiral turn `k` (1-based) at column `i` of `n`, whose
@@ -283,6 +299,7 @@ pub fn floor_beads(params: &Params, spacing: f64) -> FloorBeads {
     FloorBeads {
         width: params.width_min,
         spacing,
+        widest: params.width_max,
     }
 }
 
