@@ -78,12 +78,14 @@ pub struct CorrectionReport {
     pub support: Vec<SupportFix>,
     /// Present when the surface intersected itself.
     pub intersection: Option<IntersectionFix>,
+    /// The sharp corners of a polyline Ψ that were rounded.
+    pub corners: Vec<crate::curves::CornerFix>,
 }
 
 impl CorrectionReport {
     /// Whether nothing was changed.
     pub fn is_empty(&self) -> bool {
-        self.support.is_empty() && self.intersection.is_none()
+        self.support.is_empty() && self.intersection.is_none() && self.corners.is_empty()
     }
 
     /// One line per kind of correction, for summaries.
@@ -110,6 +112,21 @@ impl CorrectionReport {
                 worst.max_shift_mm,
                 worst.curve,
                 worst.z_mm
+            ));
+        }
+        if let Some(worst) = self
+            .corners
+            .iter()
+            .max_by(|a, b| a.deviation_mm.total_cmp(&b.deviation_mm))
+        {
+            out.push(format!(
+                "corners: {} corner(s) of Ψ sharper than {}° rounded (radius up to {:.1} mm); the printed path passes up to {:.1} mm inside the drawn corner at ({:.1}, {:.1}) mm",
+                self.corners.len(),
+                crate::curves::SHARPEST_CORNER_DEG,
+                self.corners.iter().map(|c| c.radius_mm).fold(0.0, f64::max),
+                worst.deviation_mm,
+                worst.at[0],
+                worst.at[1]
             ));
         }
         if let Some(x) = &self.intersection {
@@ -177,6 +194,7 @@ pub fn correct(surface: &Surface) -> Result<Corrected> {
         report: CorrectionReport {
             support,
             intersection,
+            corners: surface.corners.clone(),
         },
     })
 }

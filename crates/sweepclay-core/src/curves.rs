@@ -255,6 +255,104 @@ pub struct Trajectory {
     pub length: f64,
     /// Whether Ψ is a loop (a vessel, docs/ALGORITHMS.md §8).
     pub closed: bool,
+    /// The corners of a polyline Ψ that were rounded.
+    pub corners: Vec<CornerFix>,
+}
+
+/// Corners of a polyline Ψ sharper than this (interior angle, degrees)
+/// are rounded: nearer the tip than about a bead, the wall's beads on the
+/// two arms, laid more than two beads apart along Ψ, would lie on each
+/// other (docs/ALGORITHMS.md §4).
+pub const SHARPEST_CORNER_DEG: f64 = 60.0;
+
+/// A sharp corner of a polyline Ψ, rounded by a circular arc tangent to
+/// both arms (docs/ALGORITHMS.md §4).
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct CornerFix {
+    /// The drawn corner (mm, relative to `o`).
+    pub at: [f64; 2],
+    /// Its interior angle (degrees).
+    pub angle_deg: f64,
+    /// The arc's radius (mm): 1.1 w_max / (2 cos(θ/2)), the least that
+    /// keeps the two arms a bead apart where they meet the arc, or less
+    /// where an arm is too short for it.
+    pub radius_mm: f64,
+    /// How far the printed path lies from the drawn corner (mm).
+    pub deviation_mm: f64,
+}
+
+/// A polyline (`closed`: its last vertex joins its first, not repeated)
+/// with every corner sharper than [`SHARPEST_CORNER_DEG`] replaced by an
+/// arc of points about `step` apart, and the corners it rounded. `bead`
+/// is the widest bead the wall lays.
+pub fn round_corners(
+    v: &[[f64; 2]],
+    closed: bool,
+    bead: f64,
+    step: f64,
+) -> (Vec<[f64; 2]>, Vec<CornerFix>) {
+    let m = v.len();
+    let mut out = Vec::with_capacity(m);
+    let mut fixes = Vec::new();
+    let unit = |p: [f64; 2], l: f64| [p[0] / l, p[1] / l];
+    for i in 0..m {
+        let inner = closed || (i > 0 && i + 1 < m);
+        if !inner || m < 3 {
+            out.push(v[i]);
+            continue;
+        }
+        let (a, b, c) = (v[(i + m - 1) % m], v[i], v[(i + 1) % m]);
+        let (e1, e2) = ([a[0] - b[0], a[1] - b[1]], [c[0] - b[0], c[1] - b[1]]);
+        let (l1, l2) = (e1[0].hypot(e1[1]), e2[0].hypot(e2[1]));
+        if l1 < 1e-9 || l2 < 1e-9 {
+            out.push(b);
+            continue;
+        }
+        let (u1, u2) = (unit(e1, l1), unit(e2, l2));
+        let theta = (u1[0] * u2[0] + u1[1] * u2[1]).clamp(-1.0, 1.0).acos();
+        if theta.to_degrees() >= SHARPEST_CORNER_DEG || theta < 1e-6 {
+            out.push(b);
+            continue;
+        }
+        let half = 0.5 * theta;
+        // Half of each arm at most: the next corner may round the rest.
+        let tangent = (1.1 * bead / (2.0 * half.cos()) / half.tan()).min(0.5 * l1.min(l2));
+        let radius = tangent * half.tan();
+        let bis = unit(
+            [u1[0] + u2[0], u1[1] + u2[1]],
+            (u1[0] + u2[0]).hypot(u1[1] + u2[1]),
+        );
+        let to_centre = radius / half.sin();
+        let centre = [b[0] + bis[0] * to_centre, b[1] + bis[1] * to_centre];
+        let (t1, t2) = (
+            [b[0] + u1[0] * tangent, b[1] + u1[1] * tangent],
+            [b[0] + u2[0] * tangent, b[1] + u2[1] * tangent],
+        );
+        let a1 = (t1[1] - centre[1]).atan2(t1[0] - centre[0]);
+        let a2 = (t2[1] - centre[1]).atan2(t2[0] - centre[0]);
+        let mut sweep = a2 - a1;
+        while sweep > std::f64::consts::PI {
+            sweep -= std::f64::consts::TAU;
+        }
+        while sweep < -std::f64::consts::PI {
+            sweep += std::f64::consts::TAU;
+        }
+        let k = ((radius * sweep.abs() / step).ceil() as usize).max(2);
+        for j in 0..=k {
+            let ang = a1 + sweep * j as f64 / k as f64;
+            out.push([
+                centre[0] + radius * ang.cos(),
+                centre[1] + radius * ang.sin(),
+            ]);
+        }
+        fixes.push(CornerFix {
+            at: b,
+            angle_deg: theta.to_degrees(),
+            radius_mm: radius,
+            deviation_mm: to_centre - radius,
+        });
+    }
+    (out, fixes)
 }
 
 /// The polyline of a periodic uniform cubic B-spline whose control polygon
@@ -319,11 +417,13 @@ pub fn resample_polyline(poly: &[[f64; 2]], cum: &[f64], n: usize) -> Vec<[f64; 
 }
 
 impl Trajectory {
-    /// Validates Ψ (no self-intersection, non-zero length) and resamples
-    /// it into `round(length / spacing) + 1` points (open), or
-    /// `round(length / spacing)` round the loop (closed).
-    pub fn new(spec: &TrajectorySpec, spacing: f64) -> Result<Trajectory> {
+    /// Validates Ψ (no self-intersection, non-zero length), rounds a
+    /// polyline's corners sharper than [`SHARPEST_CORNER_DEG`] for beads
+    /// up to `bead` wide, and resamples it: `round(length / spacing) + 1`
+    /// points open, `round(length / spacing)` round a loop.
+    pub fn new(spec: &TrajectorySpec, spacing: f64, bead: f64) -> Result<Trajectory> {
         let closed = spec.closed;
+        let mut corners = Vec::new();
         let poly = match (&spec.control_points, &spec.points) {
             (Some(_), Some(_)) => {
                 return Err(Error::invalid(
@@ -373,6 +473,10 @@ impl Trajectory {
                             "a closed trajectory needs at least 3 distinct points",
                         ));
                     }
+                }
+                let (mut v, fixes) = round_corners(&v, closed, bead, 0.25 * spacing);
+                corners = fixes;
+                if closed {
                     v.push(v[0]);
                 }
                 v
@@ -406,6 +510,7 @@ impl Trajectory {
             points,
             length,
             closed,
+            corners,
         };
         traj.check_self_intersection()?;
         Ok(traj)
@@ -567,7 +672,7 @@ mod tests {
             closed: false,
             offset: Default::default(),
         };
-        let t = Trajectory::new(&spec, 1.0).unwrap();
+        let t = Trajectory::new(&spec, 1.0, 6.0).unwrap();
         assert!((t.length - 70.0).abs() < 1e-9);
         assert_eq!(t.points.len(), 71);
         for w in t.points.windows(2) {
@@ -590,7 +695,7 @@ mod tests {
             closed: false,
             offset: Default::default(),
         };
-        let e = Trajectory::new(&spec, 1.1).unwrap_err();
+        let e = Trajectory::new(&spec, 1.1, 6.0).unwrap_err();
         assert!(e.to_string().contains("crosses itself"), "{e}");
         // Closed, it crosses itself too; a loop's two ends are neighbours,
         // not a crossing.
@@ -598,17 +703,51 @@ mod tests {
             closed: true,
             ..spec
         };
-        let e = Trajectory::new(&spec, 1.1).unwrap_err();
+        let e = Trajectory::new(&spec, 1.1, 6.0).unwrap_err();
         assert!(e.to_string().contains("crosses itself"), "{e}");
         let square = TrajectorySpec {
             points: Some(vec![[0.0, 0.0], [40.0, 0.0], [40.0, 40.0], [0.0, 40.0]]),
             ..spec
         };
-        let t = Trajectory::new(&square, 1.0).unwrap();
+        let t = Trajectory::new(&square, 1.0, 6.0).unwrap();
         assert!(t.closed && (t.length - 160.0).abs() < 1e-9);
         assert_eq!(t.points.len(), 160, "p_0 is not repeated");
         let wrap = dist(t.points[159], t.points[0]);
         assert!((wrap - 1.0).abs() < 1e-9, "the loop closes evenly: {wrap}");
+    }
+
+    #[test]
+    fn sharp_corners_are_rounded_by_the_least_arc_that_keeps_the_arms_apart() {
+        // A 40° corner at o: the arc of radius 1.1 w / (2 cos 20°) meets
+        // the arms where they are 1.1 w apart, and passes ρ / sin 20° − ρ
+        // inside the drawn tip. A square's corners stay.
+        let a = 20f64.to_radians();
+        let v = [
+            [-100.0 * a.cos(), 100.0 * a.sin()],
+            [0.0, 0.0],
+            [-100.0 * a.cos(), -100.0 * a.sin()],
+        ];
+        let (out, fixes) = round_corners(&v, false, 6.0, 0.05);
+        assert_eq!(fixes.len(), 1);
+        let rho = 1.1 * 6.0 / (2.0 * a.cos());
+        assert!((fixes[0].radius_mm - rho).abs() < 1e-9);
+        assert!((fixes[0].angle_deg - 40.0).abs() < 1e-9);
+        let tip = rho / a.sin() - rho;
+        assert!((fixes[0].deviation_mm - tip).abs() < 1e-9);
+        let nearest = out
+            .iter()
+            .map(|p| p[0].hypot(p[1]))
+            .fold(f64::MAX, f64::min);
+        assert!((nearest - tip).abs() < 0.01, "{nearest} {tip}");
+        let (t1, t2) = (out[1], out[out.len() - 2]);
+        assert!((dist(t1, t2) - 6.6).abs() < 1e-9, "{}", dist(t1, t2));
+        // Ends of an open Ψ are no corners; a square's are not sharp.
+        let square = [[0.0, 0.0], [40.0, 0.0], [40.0, 40.0], [0.0, 40.0]];
+        assert!(round_corners(&square, true, 6.0, 0.05).1.is_empty());
+        // A corner between short arms is rounded within half of each.
+        let short = [[-4.0, 1.0], [0.0, 0.0], [-4.0, -1.0]];
+        let (_, f) = round_corners(&short, false, 6.0, 0.05);
+        assert!(f[0].radius_mm < rho && f[0].radius_mm > 0.0);
     }
 
     #[test]

@@ -98,15 +98,29 @@ pub fn floor_plan(
     // out to a point: the last offset of a long polygon or lobed oval) is
     // laid once, as the line down its middle, instead of the ring and the
     // core inside it.
+    // A ring too fat somewhere for the widest bead down its middle stays
+    // (and is refused below).
     if let Some(k) = rings.iter().rposition(|r| !r.open) {
+        let fits = |pts: &[[f64; 2]]| {
+            midline(pts, beads.spacing)
+                .is_some_and(|(_, apart)| apart.iter().all(|t| t + beads.width <= beads.widest))
+        };
         if lies_on_itself(&rings[k].pts, pitch).is_some() {
-            if let Some(line) = thin_ring_line(&rings[k].pts, beads) {
-                rings.truncate(k);
-                rings.push(line);
+            if fits(&rings[k].pts) {
+                if let Some(line) = thin_ring_line(&rings[k].pts, beads) {
+                    rings.truncate(k);
+                    rings.push(line);
+                }
+            } else {
+                // Fat in the middle: the ring stays, its tail's two sides
+                // laid narrower down to a U-turn of two pitches.
+                let r = &mut rings[k];
+                r.widths = narrowed_within(&r.pts, beads.width, 2.0 * pitch);
+                r.tail = true;
             }
         }
     }
-    for (k, r) in rings.iter().enumerate().filter(|(_, r)| !r.open) {
+    for (k, r) in rings.iter().enumerate().filter(|(_, r)| !r.open && !r.tail) {
         if let Some(at) = lies_on_itself(&r.pts, pitch) {
             // One contour a depth: ring k is k + 1 pitches in.
             return Err(FloorRefusal::Tail {
@@ -144,6 +158,7 @@ fn rings_of(
                     pts: ring,
                     open: false,
                     widths,
+                    tail: false,
                 });
             }
         }
@@ -189,6 +204,7 @@ fn core_of(ring: &[[f64; 2]], beads: FloorBeads) -> Option<FloorRing> {
         pts,
         open: true,
         widths: None,
+        tail: false,
     })
 }
 
@@ -198,6 +214,11 @@ fn core_of(ring: &[[f64; 2]], beads: FloorBeads) -> Option<FloorRing> {
 /// beads along the ring either way: nearer, round a U-turn, the nozzle
 /// lays the two sides in one go. `None` where no point needs it.
 fn narrowed(ring: &[[f64; 2]], width: f64) -> Option<Vec<f64>> {
+    narrowed_within(ring, width, 4.0 * width)
+}
+
+/// [`narrowed`], "far" being more than `far` along the ring.
+fn narrowed_within(ring: &[[f64; 2]], width: f64, far: f64) -> Option<Vec<f64>> {
     let m = ring.len();
     let cum = closed_loop(ring).1;
     let perimeter = cum[m];
@@ -212,7 +233,7 @@ fn narrowed(ring: &[[f64; 2]], width: f64) -> Option<Vec<f64>> {
         let mut d = f64::INFINITY;
         grid.for_each_near_segment(p, p, reach, |j| {
             let along = (cum[i] - cum[j as usize]).abs();
-            if along.min(perimeter - along) > 4.0 * width {
+            if along.min(perimeter - along) > far {
                 let q = ring[j as usize];
                 d = d.min((p[0] - q[0]).hypot(p[1] - q[1]));
             }
@@ -378,9 +399,14 @@ pub struct FloorRing {
     /// An open line (laid end to end), not a ring.
     pub open: bool,
     /// Where a ring's far side comes closer than a pitch (a thin ring's
-    /// two long sides), the narrower width its beads are laid at there,
-    /// point by point (mm); `None` where every bead is the floor's.
+    /// two long sides), the narrower width its beads are laid at there;
+    /// along a line down a thin ring's middle, the wider width that covers
+    /// both its sides: point by point (mm); `None` where every bead is the
+    /// floor's.
     pub widths: Option<Vec<f64>>,
+    /// The innermost ring of a region that ends in a tail, laid with its
+    /// tail's two sides side by side (docs/ALGORITHMS.md §8).
+    pub tail: bool,
 }
 
 /// The open element that lays a thin closed ring once: the line down
@@ -399,6 +425,7 @@ fn thin_ring_line(ring: &[[f64; 2]], beads: FloorBeads) -> Option<FloorRing> {
         pts,
         open: true,
         widths: wider.then_some(widths),
+        tail: false,
     })
 }
 
@@ -816,32 +843,48 @@ mod tests {
     }
 
     #[test]
-    fn a_floor_that_ends_in_a_point_is_laid_down_its_middle() {
+    fn a_floor_that_ends_in_a_point_is_laid_without_beads_on_beads() {
         // The innermost ring of a lobed oval runs out to points whose sides
         // lie on each other (once refused: "the floor narrows to a sliver
-        // thinner than a bead"): it is laid once, down its middle, as wide
-        // as its two sides would have covered.
+        // thinner than a bead"). Thin all along, it is laid once down its
+        // middle, as wide as its two sides would have covered; fatter in
+        // its middle, it stays a ring whose tail's two sides are laid
+        // narrower, touching with the stated overlap.
         for (rx, ry, n, depth) in [
+            (40.0, 20.0, 5.0, 0.05),
             (50.0, 20.0, 3.0, 0.05),
             (60.0, 20.0, 5.0, 0.1),
-            (40.0, 30.0, 5.0, 0.1),
         ] {
             let outer = lobes(rx, ry, n, depth);
             let plain = floor_rings(&outer, BEADS);
             let innermost = plain.iter().rfind(|r| !r.open).unwrap();
             assert!(lies_on_itself(&innermost.pts, BEADS.pitch()).is_some());
             let rings = floor_plan(&outer, BEADS).unwrap();
-            let last = rings.last().unwrap();
-            assert!(last.open, "{rx} × {ry}: {} rings", rings.len());
-            let widths = last.widths.as_ref().expect("a wider line");
-            let widest = widths.iter().copied().fold(0.0, f64::max);
-            assert!(widest > BEADS.width && widest <= BEADS.widest, "{widest}");
             let cov = coverage(&outer, &rings, 1.5);
             assert!(cov > 0.95, "{rx} × {ry}: {cov}");
-            for r in rings.iter().filter(|r| !r.open) {
-                assert_eq!(lies_on_itself(&r.pts, BEADS.pitch()), None);
+            let tail = rings.iter().find(|r| r.tail).expect("a tail ring");
+            let w = tail.widths.as_ref().expect("narrowed");
+            let (m, cum) = (tail.pts.len(), closed_loop(&tail.pts).1);
+            for i in 0..m {
+                for j in 0..m {
+                    let along = (cum[i] - cum[j]).abs();
+                    let d = d2(tail.pts[i], tail.pts[j]).sqrt();
+                    if along.min(cum[m] - along) > 2.0 * BEADS.pitch() && d < BEADS.pitch() {
+                        let overlap = 0.5 * (w[i] + w[j]) - d;
+                        assert!(
+                            overlap <= FLOOR_OVERLAP * w[i].max(w[j]) + 1e-6,
+                            "{overlap} at {i} {j}"
+                        );
+                    }
+                }
             }
         }
+        // A thin ring of the same kind is one line down its middle.
+        let thin = vec![[0.0, 0.0], [30.0, -1.0], [34.0, 0.0], [30.0, 1.0]];
+        let line = thin_ring_line(&resample_loop(&thin, 0.5), BEADS).unwrap();
+        assert!(line.open);
+        let widest = line.widths.unwrap().into_iter().fold(0.0, f64::max);
+        assert!((widest - (2.0 + BEADS.width)).abs() < 0.1, "{widest}");
     }
 
     #[test]

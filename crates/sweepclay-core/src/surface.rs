@@ -97,6 +97,8 @@ pub struct Surface {
     pub params: Params,
     /// The printer.
     pub printer: Printer,
+    /// The corners of a polyline Ψ rounded before sampling.
+    pub corners: Vec<crate::curves::CornerFix>,
 }
 
 impl Surface {
@@ -180,7 +182,7 @@ pub fn sample_surface(design: &Design) -> Result<Surface> {
     } else {
         Interpolation::new(design.interpolation.as_ref())?
     };
-    let traj = Trajectory::new(&design.trajectory, params.spacing)?;
+    let traj = Trajectory::new(&design.trajectory, params.spacing, params.width_max)?;
     let n = traj.points.len();
     // "Outward" for a loop: right of travel on a counter-clockwise one.
     let outward = if closed && crate::plane::signed_area2(&traj.points) > 0.0 {
@@ -224,7 +226,9 @@ pub fn sample_surface(design: &Design) -> Result<Surface> {
         });
     }
     if closed {
-        return sample_vessel(design, columns, traj.length, params, printer, start, end);
+        let corners = traj.corners.clone();
+        return sample_vessel(design, columns, traj.length, params, printer, start, end)
+            .map(|s| Surface { corners, ..s });
     }
     let tall_at_end = end.height >= start.height;
     // Columns from the short end (the order the layering works in).
@@ -257,6 +261,7 @@ pub fn sample_surface(design: &Design) -> Result<Surface> {
         spacing,
         params,
         printer,
+        corners: traj.corners.clone(),
     };
     let mut samples = Vec::new();
     let mut columns = std::mem::take(&mut surface.columns);
@@ -512,6 +517,7 @@ fn sample_vessel(
         spacing,
         params,
         printer,
+        corners: Vec::new(),
     };
     for (i, col) in columns.iter_mut().enumerate() {
         col.first = surface.samples.len() as u32;

@@ -246,6 +246,7 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
                 pts: ring,
                 open,
                 widths,
+                ..
             } = &rings[r];
             let m = ring.len();
             // A ring closes on its entry; a line runs inward from its

@@ -120,10 +120,11 @@ proptest! {
         let d = Design::from_json(&v.to_string()).unwrap();
         let s = match slice(&d) {
             Ok(s) => s,
-            // Refusals that name their reason are correct: Ψ too tight, a
-            // radial loop round o's wrong side, a rim too steep or too
-            // uneven for a spiral.
-            Err(Error::SelfIntersection(_)) => return Ok(()),
+            // Refusals that name their reason are correct: a radial loop
+            // round o's wrong side, a rim too steep or too uneven for a
+            // spiral, a floor in islands or with a tail (docs/ALGORITHMS.md
+            // §8, "Known limitations"). Sharp corners are rounded, so a
+            // polygon no longer meets itself.
             Err(e @ Error::Invalid { .. }) => {
                 let m = e.to_string();
                 prop_assert!(
@@ -258,4 +259,35 @@ fn floor_coverage(s: &sweepclay_core::Sliced) -> f64 {
         y += 0.5;
     }
     covered as f64 / n.max(1) as f64
+}
+
+#[test]
+fn a_diamond_pot_has_its_sharp_corners_rounded_and_prints() {
+    // Two 53° corners: the wall's beads on their arms would lie on each
+    // other (it was refused: "the trajectory comes within one bead width
+    // of itself"). Rounded, reported, and printable; its rim rises by
+    // 8 mm round the loop.
+    let d = Design::from_json(
+        &serde_json::json!({
+            "sweepclay": 1,
+            "profile_start": { "control_points": [[0.0, 0.0], [0.0, 40.0]] },
+            "profile_end": { "control_points": [[0.0, 0.0], [0.0, 48.0]] },
+            "trajectory": { "points": [[50.0, 0.0], [0.0, 25.0], [-50.0, 0.0], [0.0, -25.0]],
+                            "closed": true, "offset": "normal" },
+        })
+        .to_string(),
+    )
+    .unwrap();
+    let s = slice(&d).unwrap();
+    let corners = &s.corrected.report.corners;
+    assert_eq!(corners.len(), 2, "{corners:?}");
+    assert!(corners.iter().all(|c| (c.angle_deg - 53.13).abs() < 0.01));
+    assert!(s
+        .corrected
+        .report
+        .summary()
+        .iter()
+        .any(|l| l.starts_with("corners: 2 corner(s)")));
+    let r = common::check_full(&s);
+    assert!(r.printable, "{}", r.render());
 }
