@@ -14,12 +14,22 @@ pub struct Count {
     pub first_line: Option<usize>,
     /// Worst value (meaning depends on the check), with its line.
     pub worst: Option<(f64, usize)>,
+    /// The lines of the first [`Count::LINES_KEPT`] occurrences (not in
+    /// the JSON report): where a slicer's correction loop tightens.
+    #[serde(skip)]
+    pub lines: Vec<usize>,
 }
 
 impl Count {
+    /// How many occurrences' lines [`Count::lines`] keeps.
+    pub const LINES_KEPT: usize = 256;
+
     /// Records one occurrence at `line` with value `v` (larger is worse).
     pub fn add(&mut self, line: usize, v: f64) {
         self.count += 1;
+        if self.lines.len() < Self::LINES_KEPT {
+            self.lines.push(line);
+        }
         self.first_line.get_or_insert(line);
         if self.worst.is_none_or(|(w, _)| v > w) {
             self.worst = Some((v, line));

@@ -7,7 +7,8 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use sweepclay_check::{check_reader, CheckConfig};
 use sweepclay_core::{examples, printer::PRESETS, Design, Printer, PrinterRef};
-use sweepclay_web::verify::{printer_check, verify_into};
+use sweepclay_web::guard::Cancel;
+use sweepclay_web::verify::{printer_check, slice_checked, Checked, Unchecked};
 
 /// mimalloc keeps freed pages for reuse; glibc's allocator returns large
 /// blocks to the system and faults them in again, which cost a third of
@@ -327,7 +328,6 @@ fn slice(a: SliceArgs) -> Result<i32> {
     design
         .check_size(a.max_samples as f64)
         .with_context(|| source.clone())?;
-    let sliced = sweepclay_core::slice(&design).with_context(|| source.clone())?;
     let out = a.output.clone().unwrap_or_else(|| {
         let stem = Path::new(&a.design)
             .file_stem()
@@ -336,16 +336,40 @@ fn slice(a: SliceArgs) -> Result<i32> {
         PathBuf::from(stem).with_extension("gcode")
     });
     // The G-code streams into a temporary file beside the output and
-    // through the checker in one pass; it becomes the output only if it
-    // passes (or with --force).
+    // through the checker in one pass, again for each round of the
+    // correction loop; it becomes the output only if it passes (or with
+    // --force).
     let out = output_target(&out)?;
     let tmp = temp_beside(&out)?;
-    let (report, locations) = verify_into(
-        &sliced,
-        a.min_overlap,
-        std::io::BufWriter::with_capacity(1 << 16, tmp.as_file()),
-    )
-    .with_context(|| format!("writing {}", tmp.path().display()))?;
+    let file = tmp
+        .reopen()
+        .with_context(|| format!("opening {}", tmp.path().display()))?;
+    let checked = match slice_checked(&design, a.min_overlap, &Cancel::new(), || {
+        use std::io::{Seek, SeekFrom};
+        let mut f = &file;
+        f.set_len(0)?;
+        f.seek(SeekFrom::Start(0))?;
+        Ok(std::io::BufWriter::with_capacity(1 << 16, f))
+    }) {
+        Ok(c) => c,
+        Err(Unchecked::Design(e)) => return Err(e).with_context(|| source.clone()),
+        Err(Unchecked::Io(e)) => {
+            return Err(e).with_context(|| format!("writing {}", tmp.path().display()))
+        }
+    };
+    let advice = checked.advice();
+    let Checked {
+        sliced,
+        out: written,
+        report,
+        locations,
+        point_lines,
+    } = checked;
+    drop((written, point_lines));
+    let reshaped = sliced
+        .corrected
+        .report
+        .reshaped(sliced.corrected.surface.params.max_correction_mm);
     let printer = &sliced.corrected.surface.printer;
     if let Some(p) = &a.preview {
         write_atomic(p, sweepclay_core::preview::svg(&sliced).as_bytes())?;
@@ -355,6 +379,7 @@ fn slice(a: SliceArgs) -> Result<i32> {
         let v = serde_json::json!({
             "output": out, "stats": st, "corrections": sliced.corrected.report,
             "check": report, "written": report.printable || a.force,
+            "reshaped": reshaped, "advice": advice,
         });
         say!("{}", serde_json::to_string_pretty(&v)?);
     } else {
@@ -439,7 +464,9 @@ fn slice(a: SliceArgs) -> Result<i32> {
         }
         say!(
             "  check              {}",
-            if report.printable {
+            if let (true, Some(r)) = (report.printable, &reshaped) {
+                format!("printable, but reshaped: {r}")
+            } else if report.printable {
                 "printable".to_string()
             } else {
                 format!("NOT printable: {}", report.failures.join("; "))
@@ -450,7 +477,10 @@ fn slice(a: SliceArgs) -> Result<i32> {
         }
     }
     if !report.printable && !a.force {
-        eprintln!("error: the G-code fails the clay printability check; nothing written (use --force to write it anyway)");
+        eprintln!("error: {source}: the design does not print in clay as drawn, and the corrections could not fix it; nothing written (--force writes it anyway). Change the design:");
+        for line in &advice {
+            eprintln!("  - {line}");
+        }
         return Ok(1);
     }
     if !report.printable {

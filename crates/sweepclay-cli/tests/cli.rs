@@ -213,9 +213,19 @@ fn a_wide_extruder_body_gets_flatter_layers_not_collisions() {
 #[test]
 fn failing_check_writes_nothing_unless_forced() {
     let tmp = tempfile::tempdir().unwrap();
-    // t5's smallest bead overlap is 85 %: demanding 95 % fails the check.
+    // t5's smallest bead overlap is 85 %: demanding 95 %, the correction
+    // loop leans its profiles less until every bead reaches it (and says
+    // so); 99 % it cannot reach, and says what to change, and where.
     sweepclay(tmp.path())
-        .args(["slice", "t5", "-o", "x.gcode", "--min-overlap", "0.95"])
+        .args(["slice", "t5", "-o", "y.gcode", "--min-overlap", "0.95"])
+        .assert()
+        .success()
+        .stdout(
+            predicate::str::is_match(r"correction loop: the G-code failed its check \d round")
+                .unwrap(),
+        );
+    sweepclay(tmp.path())
+        .args(["slice", "t5", "-o", "x.gcode", "--min-overlap", "0.99"])
         .assert()
         .code(1)
         .stdout(predicate::str::contains("NOT printable"))
@@ -223,7 +233,11 @@ fn failing_check_writes_nothing_unless_forced() {
             predicate::str::is_match(r"where +line \d+: pass \d+, transition curve \d+ \(u = ")
                 .unwrap(),
         )
-        .stderr(predicate::str::contains("nothing written"));
+        .stderr(predicate::str::contains("nothing written"))
+        .stderr(
+            predicate::str::is_match(r"(?m)^  - a bead overlapping the one below by too little \(after 8 round\(s\) of tightened corrections\): lean the profiles less there.* at line \d+: pass \d+, transition curve")
+                .unwrap(),
+        );
     assert!(!tmp.path().join("x.gcode").exists());
     sweepclay(tmp.path())
         .args([
@@ -232,7 +246,7 @@ fn failing_check_writes_nothing_unless_forced() {
             "-o",
             "x.gcode",
             "--min-overlap",
-            "0.95",
+            "0.99",
             "--force",
         ])
         .assert()

@@ -80,12 +80,59 @@ pub struct CorrectionReport {
     pub intersection: Option<IntersectionFix>,
     /// The sharp corners of a polyline Ψ that were rounded.
     pub corners: Vec<crate::curves::CornerFix>,
+    /// The factor on all offsets that keeps the extruder body off a far
+    /// part of the wall, when the correction loop needed one (beyond any
+    /// self-intersection compression).
+    pub body_compression: Option<f64>,
+    /// Rounds of the correction loop after the first slicing (0: the
+    /// first passed its check, or no loop ran).
+    pub rounds: u32,
+    /// The largest distance of the printed surface from the drawn one.
+    pub deviation: Option<Deviation>,
+}
+
+/// How far the printed shape lies from the drawn one at its farthest.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Deviation {
+    /// The distance (mm).
+    pub mm: f64,
+    /// Where: on the bed relative to `o`, the height included (mm).
+    pub at: [f64; 3],
+    /// Normalised arc length along Ψ there.
+    pub u: f64,
+    /// What moved it: `support-free`, `self-intersection`, `extruder body`
+    /// or `corner`.
+    pub by: &'static str,
+    /// Which way: `narrower` or `wider` than drawn (a vessel), `off` the
+    /// drawn surface (a wall).
+    pub way: &'static str,
+}
+
+impl CorrectionReport {
+    /// The verdict's words when the corrections moved the shape more than
+    /// `max_mm` from the drawing: "up to 29.9 mm narrower than drawn at z
+    /// 230 mm (u = 0.50, support-free correction)".
+    pub fn reshaped(&self, max_mm: f64) -> Option<String> {
+        let d = self.deviation.as_ref().filter(|d| d.mm > max_mm)?;
+        let way = match d.way {
+            "off" => "off the drawn surface",
+            "narrower" => "narrower than drawn",
+            _ => "wider than drawn",
+        };
+        Some(format!(
+            "up to {:.1} mm {way} at z {:.0} mm (u = {:.2}, {} correction)",
+            d.mm, d.at[2], d.u, d.by
+        ))
+    }
 }
 
 impl CorrectionReport {
     /// Whether nothing was changed.
     pub fn is_empty(&self) -> bool {
-        self.support.is_empty() && self.intersection.is_none() && self.corners.is_empty()
+        self.support.is_empty()
+            && self.intersection.is_none()
+            && self.corners.is_empty()
+            && self.body_compression.is_none()
     }
 
     /// One line per kind of correction, for summaries.
@@ -129,6 +176,17 @@ impl CorrectionReport {
                 worst.at[1]
             ));
         }
+        if self.rounds > 0 {
+            out.push(format!(
+                "correction loop: the G-code failed its check {} round(s); the corrections were tightened where it failed",
+                self.rounds
+            ));
+        }
+        if let Some(c) = self.body_compression {
+            out.push(format!(
+                "extruder body: profiles compressed along x by a further {c:.3}, the least that keeps the nozzle's body off the far parts of the wall"
+            ));
+        }
         if let Some(x) = &self.intersection {
             out.push(format!(
                 "self-intersection: transition curves {} and {} met at ({:.1}, {:.1}, {:.1}) mm; profiles compressed along x by {:.3} ({} steps)",
@@ -148,11 +206,33 @@ pub struct Corrected {
     pub report: CorrectionReport,
 }
 
+/// How the correction loop tightens the corrections where the pipeline's
+/// own check of the planned G-code failed (docs/ALGORITHMS.md §4, "The
+/// loop closes"). The default tightens nothing.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Tightening {
+    /// Per transition curve, a factor (at most 1) on the support-free
+    /// step limit s_max; missing curves (or an empty list) keep 1.
+    pub support: Vec<f64>,
+    /// A factor (below 1) on all offsets, on top of any self-intersection
+    /// compression: keeps the extruder body off a far part of the wall.
+    pub body: Option<f64>,
+    /// Rounds of the loop so far (reported).
+    pub rounds: u32,
+}
+
 /// Applies both corrections.
 pub fn correct(surface: &Surface) -> Result<Corrected> {
+    correct_with(surface, &Tightening::default())
+}
+
+/// [`correct`], tightened as the correction loop asks.
+pub fn correct_with(surface: &Surface, tight: &Tightening) -> Result<Corrected> {
+    let scale = &tight.support;
     let mut out = surface.clone();
-    let mut support = support_free(&mut out);
+    let mut support = support_free(&mut out, scale);
     let mut intersection = None;
+    let mut compression = 1.0;
     if let Some((a, b, at)) = find_self_intersection(&out) {
         // Compressing to nothing must fix it; else Ψ itself is too tight.
         let mut flat = surface.clone();
@@ -172,22 +252,53 @@ pub fn correct(surface: &Surface) -> Result<Corrected> {
             let c = 0.5 * (clear + meets);
             iterations += 1;
             scale_offsets(&mut out, surface, c);
-            support_free(&mut out);
+            support_free(&mut out, scale);
             if find_self_intersection(&out).is_none() {
                 clear = c;
             } else {
                 meets = c;
             }
         }
-        let c = clear;
-        scale_offsets(&mut out, surface, c);
-        support = support_free(&mut out);
+        compression = clear;
+        scale_offsets(&mut out, surface, compression);
+        support = support_free(&mut out, scale);
         intersection = Some(IntersectionFix {
             at,
             curves: [a, b],
-            compression: c,
+            compression,
             iterations,
         });
+    }
+    if let Some(body) = tight.body {
+        scale_offsets(&mut out, surface, compression * body);
+        support = support_free(&mut out, scale);
+    }
+    let by = if tight.body.is_some() {
+        "extruder body"
+    } else if intersection.is_some() {
+        "self-intersection"
+    } else {
+        "support-free"
+    };
+    let mut deviation = deviation(surface, &out, by);
+    if let Some(c) = surface
+        .corners
+        .iter()
+        .max_by(|a, b| a.deviation_mm.total_cmp(&b.deviation_mm))
+    {
+        if deviation.as_ref().is_none_or(|d| c.deviation_mm > d.mm) {
+            deviation = Some(Deviation {
+                mm: c.deviation_mm,
+                at: [c.at[0], c.at[1], 0.0],
+                u: nearest_u(surface, c.at),
+                by: "corner",
+                way: if surface.vessel.is_some() {
+                    "narrower"
+                } else {
+                    "off"
+                },
+            });
+        }
     }
     Ok(Corrected {
         surface: out,
@@ -195,8 +306,61 @@ pub fn correct(surface: &Surface) -> Result<Corrected> {
             support,
             intersection,
             corners: surface.corners.clone(),
+            body_compression: tight.body,
+            rounds: tight.rounds,
+            deviation,
         },
     })
+}
+
+/// The sample moved farthest from the design by the corrections, if any
+/// moved more than a hundredth of a millimetre.
+fn deviation(design: &Surface, out: &Surface, by: &'static str) -> Option<Deviation> {
+    let mut worst: Option<(f64, usize, usize)> = None;
+    for (c, col) in design.columns.iter().enumerate() {
+        for i in col.samples() {
+            let d = (out.samples[i].xi - design.samples[i].xi).abs();
+            if d > 0.01 && worst.is_none_or(|w| d > w.0) {
+                worst = Some((d, c, i));
+            }
+        }
+    }
+    let (mm, c, i) = worst?;
+    let at = out.position(c, i);
+    // A vessel's point that came nearer the loop's middle is narrower.
+    let way = if design.vessel.is_some() {
+        let m = design.columns.len().max(1) as f64;
+        let mid = design.columns.iter().fold([0.0, 0.0], |a, col| {
+            [a[0] + col.p[0] / m, a[1] + col.p[1] / m]
+        });
+        let drawn = design.position(c, i);
+        let r = |p: [f64; 3]| (p[0] - mid[0]).hypot(p[1] - mid[1]);
+        if r(at) < r(drawn) {
+            "narrower"
+        } else {
+            "wider"
+        }
+    } else {
+        "off"
+    };
+    Some(Deviation {
+        mm,
+        at,
+        u: design.columns[c].u,
+        by,
+        way,
+    })
+}
+
+/// u of the column nearest `p` in plan.
+fn nearest_u(s: &Surface, p: [f64; 2]) -> f64 {
+    s.columns
+        .iter()
+        .min_by(|a, b| {
+            let d = |c: &&crate::surface::Column| (c.p[0] - p[0]).hypot(c.p[1] - p[1]);
+            d(a).total_cmp(&d(b))
+        })
+        .map_or(0.0, |c| c.u)
 }
 
 /// Sets every offset to `c` times the design's.
@@ -206,8 +370,9 @@ fn scale_offsets(out: &mut Surface, design: &Surface, c: f64) {
     }
 }
 
-/// Walks every column upward and shortens steps that overhang too far.
-fn support_free(s: &mut Surface) -> Vec<SupportFix> {
+/// Walks every column upward and shortens steps that overhang too far
+/// (s_max times the column's factor in `scale`, if it has one).
+fn support_free(s: &mut Surface, scale: &[f64]) -> Vec<SupportFix> {
     let n = s.columns.len();
     let mut fixes = Vec::new();
     for (c, col) in s.columns.iter().enumerate() {
@@ -219,6 +384,7 @@ fn support_free(s: &mut Surface) -> Vec<SupportFix> {
             let design = s.samples[i];
             let mut xi = design.xi + carry;
             let (limit, by_angle) = s.params.offset_limit(design.z - prev.z);
+            let limit = limit * scale.get(c).copied().unwrap_or(1.0);
             let step = xi - prev.xi;
             if step.abs() > limit + 1e-12 {
                 let clamped = prev.xi + limit.copysign(step);
@@ -623,7 +789,7 @@ mod tests {
         // 1 % more compression-free offset meets itself again.
         let mut more = s.clone();
         scale_offsets(&mut more, &s, (f + 0.01).min(1.0));
-        support_free(&mut more);
+        support_free(&mut more, &[]);
         assert!(
             find_self_intersection(&more).is_some(),
             "{f} is not the largest"

@@ -137,6 +137,10 @@ pub struct Params {
     pub shrinkage_xy: f64,
     /// Firing shrinkage in height, the same way. Default 0.
     pub shrinkage_z: f64,
+    /// How far (mm) the corrections may move the printed shape from the
+    /// drawn one before the verdict says "printable, but reshaped"
+    /// (docs/ALGORITHMS.md §4). Default 5 mm.
+    pub max_correction_mm: f64,
 }
 
 /// Floor layers of a vessel when `params.floor_layers` is omitted.
@@ -161,6 +165,7 @@ impl Default for Params {
             even_turn_flow: true,
             shrinkage_xy: 0.0,
             shrinkage_z: 0.0,
+            max_correction_mm: 5.0,
         }
     }
 }
@@ -197,6 +202,12 @@ impl Params {
             ));
         }
         range("params.width_min", self.width_min, 0.1, 50.0)?;
+        range(
+            "params.max_correction_mm",
+            self.max_correction_mm,
+            0.0,
+            10_000.0,
+        )?;
         range("params.width_max", self.width_max, self.width_min, 50.0)?;
         range("params.overlap", self.overlap, 0.5, 0.95)?;
         range("params.max_overhang_deg", self.max_overhang_deg, 1.0, 80.0)?;
@@ -263,6 +274,7 @@ impl Params {
         "even_turn_flow",
         "shrinkage_xy",
         "shrinkage_z",
+        "max_correction_mm",
     ];
 
     /// Sets one parameter by name (`--set key=value`).
@@ -298,6 +310,7 @@ impl Params {
             "max_overhang_deg" => &mut self.max_overhang_deg,
             "feedrate" => &mut self.feedrate,
             "shrinkage_xy" => &mut self.shrinkage_xy,
+            "max_correction_mm" => &mut self.max_correction_mm,
             "shrinkage_z" => &mut self.shrinkage_z,
             _ => {
                 return Err(Error::invalid(

@@ -295,7 +295,21 @@ pub fn emit_typed_moves<W: Write>(
     let (mut last_w, mut last_h) = (i64::MIN, i64::MIN);
     let mut feeds = ex.feed_factors();
     let mut was_slow = false;
+    // The position as written (thousandths of a mm): a move that rounds
+    // to no motion would be read as extrusion without motion, so its
+    // clay goes with the next move instead.
+    let written = |p: [f64; 3]| [p[0] + o[0], p[1] + o[1], p[2]].map(|v| (v * 1e3).round() as i64);
+    let mut last_at = written(pos(0));
+    let mut carried = 0.0f64;
     for i in 1..n {
+        let at = written(pos(i));
+        if at == last_at {
+            carried += ex.volume[i] * f.e_per_mm3;
+            feeds.next();
+            lines.push(line);
+            continue;
+        }
+        last_at = at;
         let w = 0.5 * (ex.width[i] + ex.width[i - 1]);
         let h = 0.5 * (ex.layer_height[i] + ex.layer_height[i - 1]);
         let (wq, hq) = ((w * 1e3).round() as i64, (h * 1e3).round() as i64);
@@ -321,7 +335,7 @@ pub fn emit_typed_moves<W: Write>(
             next_type = types.next();
             next_at = next_type.map_or(usize::MAX, |t| t.0);
         }
-        let de = ex.volume[i] * f.e_per_mm3;
+        let de = ex.volume[i] * f.e_per_mm3 + std::mem::take(&mut carried);
         let e = if f.relative_e {
             de.max(1e-5)
         } else {
@@ -555,7 +569,7 @@ mod tests {
 
     #[test]
     fn relative_e_and_tiny_volumes_still_extrude() {
-        let pts = [[0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [1.0, 1e-6, 1.0]];
+        let pts = [[0.0, 0.0, 1.0], [1.0, 0.0, 1.0], [1.0, 1e-3, 1.0]];
         let e = ex(vec![3.0; 3], vec![1.0; 3], vec![0.0, 3.0, 1e-9]);
         let mut out = Vec::new();
         emit_moves(
@@ -571,7 +585,7 @@ mod tests {
         .unwrap();
         let text = String::from_utf8(out).unwrap();
         assert!(
-            text.ends_with("E0.30000\nG1 X101.000 Y50.000 Z1.000 E0.00001\n"),
+            text.ends_with("E0.30000\nG1 X101.000 Y50.001 Z1.000 E0.00001\n"),
             "{text}"
         );
         // Absolute E never repeats a value, so every move extrudes.
@@ -579,6 +593,33 @@ mod tests {
         emit_moves(&mut out, pts.len(), |i| pts[i], &e, &FMT).unwrap();
         assert!(String::from_utf8(out)
             .unwrap()
-            .ends_with("E0.30000\nG1 X101.000 Y50.000 Z1.000 E0.30001\n"));
+            .ends_with("E0.30000\nG1 X101.000 Y50.001 Z1.000 E0.30001\n"));
+    }
+
+    #[test]
+    fn a_move_that_rounds_to_no_motion_gives_its_clay_to_the_next() {
+        // Written to a thousandth of a millimetre, point 2 is point 1: a
+        // move there would read as extrusion without motion (a blob and a
+        // second extrusion run to the checker).
+        let pts = [
+            [0.0, 0.0, 1.0],
+            [1.0, 0.0, 1.0],
+            [1.0, 2e-4, 1.0],
+            [2.0, 0.0, 1.0],
+        ];
+        let e = ex(vec![3.0; 4], vec![1.0; 4], vec![0.0, 3.0, 1.0, 3.0]);
+        let mut out = Vec::new();
+        let lines = emit_moves(&mut out, pts.len(), |i| pts[i], &e, &FMT).unwrap();
+        let text = String::from_utf8(out).unwrap();
+        assert_eq!(
+            text.lines().filter(|l| l.starts_with("G1")).count(),
+            2,
+            "{text}"
+        );
+        assert!(
+            text.ends_with("E0.30000\nG1 X102.000 Y50.000 Z1.000 E0.70000\n"),
+            "{text}"
+        );
+        assert_eq!(lines[2], lines[1]);
     }
 }

@@ -536,6 +536,11 @@ function setVerdict(v) {
     el.textContent = '— no verdict: the design does not slice';
   } else if (v === 'checking') {
     el.textContent = 'checking…';
+  } else if (v.printable && v.reshaped) {
+    // The corrections moved the shape beyond params.max_correction_mm:
+    // printable, but not as drawn (docs/ALGORITHMS.md §4).
+    el.className = 'warn';
+    el.textContent = `⚠ printable, but reshaped: ${v.reshaped}`;
   } else if (v.printable) {
     el.className = 'ok';
     const ov = v.min_overlap != null ? `, smallest overlap ${(100 * v.min_overlap).toFixed(0)} %` : '';
@@ -543,7 +548,7 @@ function setVerdict(v) {
   } else {
     el.className = 'bad';
     el.innerHTML = '✗ not printable<ul></ul>';
-    list(el.querySelector('ul'), [...v.failures, ...v.locations]);
+    list(el.querySelector('ul'), [...v.failures, ...(v.advice || []).map((a) => `change: ${a}`), ...v.locations]);
   }
   el.dataset.printable = v && v !== 'checking' ? String(!!v.printable) : '';
 }

@@ -5,7 +5,7 @@
 pub use crate::error::ApiError;
 use crate::guard::Cancel;
 pub use crate::guard::Limits;
-use crate::verify::{verify_until, Verified};
+use crate::verify::{slice_checked, Unchecked, Verified};
 use serde::Serialize;
 use sweepclay_core::mesh;
 use sweepclay_core::toolpath::PointKind;
@@ -327,6 +327,11 @@ pub struct Verdict {
     pub failures: Vec<String>,
     /// Where in the design.
     pub locations: Vec<String>,
+    /// What to change in the design, failure by failure.
+    pub advice: Vec<String>,
+    /// "up to 29.9 mm narrower than drawn at z 230 mm …" when the
+    /// corrections moved the shape beyond `params.max_correction_mm`.
+    pub reshaped: Option<String>,
     /// Smallest overlap with the bead below (fraction of the width).
     pub min_overlap: Option<f64>,
     /// Lines of G-code.
@@ -346,10 +351,25 @@ pub fn sliced(design: &Design, cancel: &Cancel) -> Result<Sliced, ApiError> {
     Ok(s)
 }
 
-/// Slices, emits and checks a design (stopping once `cancel` is set).
+/// Slices, emits and checks a design, through the correction loop
+/// (stopping once `cancel` is set).
 pub fn verified(design: &Design, cancel: &Cancel) -> Result<Verified, ApiError> {
-    let s = sliced(design, cancel)?;
-    verify_until(&s, 0.5, cancel).map_err(|e| cancel.io_error("writing G-code", e))
+    match slice_checked(design, 0.5, cancel, || Ok(Vec::new())) {
+        Ok(c) => {
+            let advice = c.advice();
+            let r = &c.sliced.corrected;
+            let reshaped = r.report.reshaped(r.surface.params.max_correction_mm);
+            Ok(Verified {
+                gcode: String::from_utf8(c.out).expect("G-code is UTF-8"),
+                report: c.report,
+                locations: c.locations,
+                advice,
+                reshaped,
+            })
+        }
+        Err(Unchecked::Design(e)) => Err(e.into()),
+        Err(Unchecked::Io(e)) => Err(cancel.io_error("writing G-code", e)),
+    }
 }
 
 /// The verdict of [`verified`].
@@ -358,6 +378,8 @@ pub fn verdict(v: &Verified) -> Verdict {
         printable: v.report.printable,
         failures: v.report.failures.clone(),
         locations: v.locations.clone(),
+        advice: v.advice.clone(),
+        reshaped: v.reshaped.clone(),
         min_overlap: v.report.support.min_overlap.map(|(f, _)| f),
         lines: v.report.lines,
     }
@@ -370,11 +392,17 @@ pub fn gcode(design: &Design, cancel: &Cancel) -> Result<String, ApiError> {
         gcode,
         report,
         locations,
+        advice,
+        ..
     } = verified(design, cancel)?;
     if report.printable {
         Ok(gcode)
     } else {
-        let error = format!("not printable: {}", report.failures.join("; "));
+        let error = format!(
+            "not printable: {}; change the design: {}",
+            report.failures.join("; "),
+            advice.join("; ")
+        );
         Err(ApiError {
             failures: report.failures,
             locations,

@@ -4,9 +4,10 @@
 
 use crate::guard::{Cancel, CancelWriter};
 use std::io::{self, Write};
-use sweepclay_check::{CheckConfig, CheckWriter, Report};
+use sweepclay_check::{CheckConfig, CheckWriter, Finding, Report};
+use sweepclay_core::correct::{correct_with, Tightening};
 use sweepclay_core::toolpath::PointKind;
-use sweepclay_core::{gcode, Params, Printer, Sliced};
+use sweepclay_core::{gcode, surface, Design, Params, Printer, Sliced};
 
 /// The checker's defaults with the printer's build volume, calibration and
 /// extruder body.
@@ -46,6 +47,12 @@ pub struct Verified {
     pub report: Report,
     /// Where in the design the first failure of each kind is (see [`locate`]).
     pub locations: Vec<String>,
+    /// What to change in the design, failure by failure (see
+    /// [`Checked::advice`]; empty when printable or not asked for).
+    pub advice: Vec<String>,
+    /// How far the corrections moved the shape, when beyond
+    /// `params.max_correction_mm` (`CorrectionReport::reshaped`).
+    pub reshaped: Option<String>,
 }
 
 /// Writes to two writers.
@@ -72,6 +79,15 @@ pub fn verify_into<W: Write>(
     min_overlap: f64,
     out: W,
 ) -> io::Result<(Report, Vec<String>)> {
+    verify_lines(s, min_overlap, out).map(|(r, l, _)| (r, l))
+}
+
+/// [`verify_into`], with the G-code line of each path point.
+fn verify_lines<W: Write>(
+    s: &Sliced,
+    min_overlap: f64,
+    out: W,
+) -> io::Result<(Report, Vec<String>, Vec<usize>)> {
     let surface = &s.corrected.surface;
     let cfg = CheckConfig {
         overlap_min: min_overlap,
@@ -90,7 +106,206 @@ pub fn verify_into<W: Write>(
         .take(5)
         .filter_map(|l| locate(s, &point_lines, l))
         .collect();
-    Ok((report, locations))
+    Ok((report, locations, point_lines))
+}
+
+/// Most rounds of the correction loop after the first slicing.
+pub const MAX_ROUNDS: u32 = 8;
+
+/// What the correction loop ends with: the last slicing, its G-code's
+/// writer, and the check of it.
+pub struct Checked<W> {
+    /// The design as sliced in the last round.
+    pub sliced: Sliced,
+    /// Where its G-code went.
+    pub out: W,
+    /// The check of that G-code.
+    pub report: Report,
+    /// Where in the design its failures are.
+    pub locations: Vec<String>,
+    /// The G-code line of each path point.
+    pub point_lines: Vec<usize>,
+}
+
+impl<W> Checked<W> {
+    /// For each kind of failure the loop could not correct: the cause,
+    /// the place (G-code line, pass, curve, u, z) and the change to the
+    /// design that would fix it. Empty when printable.
+    pub fn advice(&self) -> Vec<String> {
+        let s = &self.sliced;
+        let p = &s.corrected.surface.params;
+        let r = s.corrected.surface.printer.nozzle_radius;
+        let rounds = s.corrected.report.rounds;
+        let tried = if rounds > 0 {
+            format!(" (after {rounds} round(s) of tightened corrections)")
+        } else {
+            String::new()
+        };
+        Finding::ALL
+            .iter()
+            .filter_map(|&k| {
+                let c = &self.report.findings[k];
+                let line = c.first_line?;
+                let worst = c.worst.map_or(0.0, |w| w.0);
+                let place = locate(s, &self.point_lines, line)
+                    .unwrap_or_else(|| format!("line {line}"));
+                let change = match k {
+                    Finding::Overhang => format!(
+                        "an overhang of {worst:.0}° beyond the {}° limit{tried}: lean the profiles less there, or raise params.max_overhang_deg if your clay stands steeper",
+                        p.max_overhang_deg
+                    ),
+                    Finding::UnderMinOverlap => format!(
+                        "a bead overlapping the one below by too little{tried}: lean the profiles less there, or raise params.width_max ({} mm) so a wider bead reaches",
+                        p.width_max
+                    ),
+                    Finding::NozzleCollision => format!(
+                        "the extruder body ({r} mm radius) meets clay {worst:.1} mm above the nozzle{tried}: keep that part of the wall more than {:.0} mm in plan from the rest of it, or bring the two profiles' heights closer so the passes tilt less",
+                        r + p.width_max / 2.0
+                    ),
+                    Finding::DoubleDeposition => "clay laid on clay of its own layer: move those parts of the trajectory apart, or lower params.width_max".to_string(),
+                    Finding::TurnPile => "clay piling up where the path turns: lower params.max_layer_height, or set params.even_turn_flow".to_string(),
+                    Finding::Unsupported => "a bead with no clay under it: lean the profiles less there".to_string(),
+                    Finding::OutOfBounds => "outside the printer's build volume: make the design smaller or choose a larger printer".to_string(),
+                    other => other.failure().to_string(),
+                };
+                Some(format!("{change} — at {place}"))
+            })
+            .collect()
+    }
+}
+
+/// Why a slicing whose check fails cannot be corrected: the error
+/// [`slice_checked`] ends with.
+#[derive(Debug)]
+pub enum Unchecked {
+    /// The design does not slice (validation, sampling, corrections).
+    Design(sweepclay_core::Error),
+    /// Writing the G-code failed, or the work was cancelled.
+    Io(io::Error),
+}
+
+impl From<sweepclay_core::Error> for Unchecked {
+    fn from(e: sweepclay_core::Error) -> Self {
+        Unchecked::Design(e)
+    }
+}
+
+impl From<io::Error> for Unchecked {
+    fn from(e: io::Error) -> Self {
+        Unchecked::Io(e)
+    }
+}
+
+impl std::fmt::Display for Unchecked {
+    fn fmt(&self, f: &mut std::fmt::Formatter<'_>) -> std::fmt::Result {
+        match self {
+            Unchecked::Design(e) => e.fmt(f),
+            Unchecked::Io(e) => e.fmt(f),
+        }
+    }
+}
+
+impl std::error::Error for Unchecked {}
+
+/// Ends the work once `cancel` is set.
+fn go_on(cancel: &Cancel) -> Result<(), Unchecked> {
+    match cancel.check() {
+        Ok(()) => Ok(()),
+        Err(e) => Err(Unchecked::Io(io::Error::other(e.error))),
+    }
+}
+
+/// Slices `design`, writes its G-code to a writer `out` makes and checks
+/// it in the same pass; while the check fails for a reason a correction
+/// can fix, tightens the corrections where it failed and does it again,
+/// at most [`MAX_ROUNDS`] more times (docs/ALGORITHMS.md §4, "The loop
+/// closes"). An overhang or a bead short of the overlap tightens the
+/// support-free correction on the transition curves within a bead of
+/// each failure; the extruder body meeting clay compresses all offsets,
+/// by steps and then by bisection, to the least compression that
+/// clears. A design that passes at once costs one slicing and one check.
+/// Returns the printable slicing the loop found, or else its last.
+pub fn slice_checked<W: Write>(
+    design: &Design,
+    min_overlap: f64,
+    cancel: &Cancel,
+    mut out: impl FnMut() -> io::Result<W>,
+) -> Result<Checked<W>, Unchecked> {
+    let sampled = surface::sample_surface(design)?;
+    go_on(cancel)?;
+    let n = sampled.columns.len();
+    let reach = (sampled.params.width_max / sampled.spacing).ceil() as usize;
+    let has_offsets = sampled.samples.iter().any(|s| s.xi.abs() > 1e-9);
+    let mut tight = Tightening::default();
+    // Body compression factors: the smallest known to collide, the
+    // largest known to clear (with the tightening that cleared).
+    let mut collides = 1.0f64;
+    let mut clears: Option<(f64, Tightening)> = None;
+    let mut round = |tight: &Tightening| -> Result<(Checked<W>, Vec<usize>, bool), Unchecked> {
+        let corrected = correct_with(&sampled, tight)?;
+        go_on(cancel)?;
+        let sliced = sweepclay_core::finish(corrected)?;
+        let mut w = out()?;
+        let (report, locations, lines) =
+            verify_lines(&sliced, min_overlap, CancelWriter(&mut w, cancel.clone()))?;
+        let mut support: Vec<usize> = [Finding::Overhang, Finding::UnderMinOverlap]
+            .iter()
+            .flat_map(|&k| report.findings[k].lines.iter())
+            .filter_map(|&l| {
+                let i = lines.partition_point(|&x| x < l);
+                (lines.get(i) == Some(&l)).then(|| sliced.toolpath.points[i].column as usize)
+            })
+            .collect();
+        support.sort_unstable();
+        support.dedup();
+        let body = report.findings[Finding::NozzleCollision].count > 0;
+        let checked = Checked {
+            sliced,
+            out: w,
+            report,
+            locations,
+            point_lines: lines,
+        };
+        Ok((checked, support, body))
+    };
+    loop {
+        let (checked, support, body) = round(&tight)?;
+        let printable = checked.report.printable;
+        if printable {
+            let Some(f) = tight.body else {
+                return Ok(checked);
+            };
+            clears = Some((f, tight.clone()));
+            if collides - f <= 0.02 || tight.rounds >= MAX_ROUNDS {
+                return Ok(checked);
+            }
+        } else if let Some(f) = tight.body.filter(|_| body) {
+            collides = collides.min(f);
+        }
+        let fixable = !support.is_empty() || (body && has_offsets);
+        if tight.rounds >= MAX_ROUNDS || (!printable && !fixable) {
+            // The last printable round, if the bisection went past it.
+            return match clears {
+                Some((_, t)) if !printable => Ok(round(&t)?.0),
+                _ => Ok(checked),
+            };
+        }
+        tight.rounds += 1;
+        if !support.is_empty() {
+            tight.support.resize(n, 1.0);
+            for c in support {
+                for k in c.saturating_sub(reach)..(c + reach + 1).min(n) {
+                    tight.support[k] = (tight.support[k] * 0.7).max(0.05);
+                }
+            }
+        }
+        if printable || (body && has_offsets) {
+            tight.body = Some(match &clears {
+                Some((f, _)) => 0.5 * (f + collides),
+                None => 0.8 * tight.body.unwrap_or(1.0),
+            });
+        }
+    }
 }
 
 /// [`verify_into`] a string.
@@ -107,6 +322,11 @@ pub fn verify_until(s: &Sliced, min_overlap: f64, cancel: &Cancel) -> io::Result
         gcode: String::from_utf8(text).expect("G-code is UTF-8"),
         report,
         locations,
+        advice: Vec::new(),
+        reshaped: s
+            .corrected
+            .report
+            .reshaped(s.corrected.surface.params.max_correction_mm),
     })
 }
 
@@ -162,5 +382,88 @@ mod tests {
             "{:?}",
             strict.locations
         );
+    }
+
+    fn checked(d: &Design, min_overlap: f64) -> Checked<Vec<u8>> {
+        match slice_checked(d, min_overlap, &Cancel::new(), || Ok(Vec::new())) {
+            Ok(c) => c,
+            Err(e) => panic!("{e}"),
+        }
+    }
+
+    #[test]
+    fn a_design_that_passes_at_once_is_sliced_once() {
+        let d = Design::from_json(examples::example("t4").unwrap()).unwrap();
+        let c = checked(&d, 0.5);
+        assert!(c.report.printable);
+        assert_eq!(c.sliced.corrected.report.rounds, 0);
+        assert!(c.advice().is_empty());
+        // The G-code handed back is the one checked.
+        assert_eq!(c.out, verify(&c.sliced, 0.5).gcode.into_bytes());
+    }
+
+    #[test]
+    fn the_loop_tightens_where_the_check_failed_until_it_passes() {
+        // t5's beads overlap the bead below by 85 % at least: asked for
+        // 95 %, the loop narrows the support-free limit on the curves
+        // where beads fell short, and reports how far that moved them.
+        let d = Design::from_json(examples::example("t5").unwrap()).unwrap();
+        let c = checked(&d, 0.95);
+        assert!(c.report.printable, "{:?}", c.report.failures);
+        let r = &c.sliced.corrected.report;
+        assert!(r.rounds >= 1 && r.rounds <= MAX_ROUNDS, "{}", r.rounds);
+        assert!(r
+            .deviation
+            .as_ref()
+            .is_some_and(|d| d.mm > 0.0 && d.by == "support-free"));
+        assert!(r
+            .summary()
+            .iter()
+            .any(|l| l.starts_with("correction loop:")));
+        // 99 % no tightening reaches: the loop stops, with what to change
+        // and where.
+        let c = checked(&d, 0.99);
+        assert!(!c.report.printable);
+        assert_eq!(c.sliced.corrected.report.rounds, MAX_ROUNDS);
+        let advice = c.advice();
+        assert!(
+            advice[0].contains("lean the profiles less") && advice[0].contains("transition curve"),
+            "{advice:?}"
+        );
+    }
+
+    #[test]
+    fn the_extruder_body_is_kept_off_a_far_part_of_the_wall() {
+        // An S whose end flares out over its middle: the nozzle's body
+        // (not the beads: no self-intersection) meets the clay there. The
+        // loop compresses the offsets to the least factor that clears.
+        let d = Design::from_json(
+            r#"{"sweepclay": 1, "name": "S flaring over itself",
+            "profile_start": {"control_points": [[0, 0], [0.518, 9.06], [0.518, 18.12], [0, 27.18]]},
+            "profile_end": {"control_points": [[0, 0], [0, 18.65], [22.66, 37.31]]},
+            "trajectory": {"control_points": [[-47.46, 0], [-23.73, 23.73], [0, 0], [23.73, -23.73], [47.46, 0]], "offset": "normal"},
+            "params": {"layer_height": 1.4, "max_layer_height": 2.8, "width_min": 7.03, "width_max": 14.06},
+            "printer": "wasp-2040-clay"}"#,
+        )
+        .unwrap();
+        let first = verify(&sweepclay_core::slice(&d).unwrap(), 0.5);
+        assert!(first.report.findings[Finding::NozzleCollision].count > 0);
+        let c = checked(&d, 0.5);
+        assert!(c.report.printable, "{:?}", c.report.failures);
+        let r = &c.sliced.corrected.report;
+        let f = r.body_compression.expect("compressed for the body");
+        assert!(f > 0.5 && f < 1.0, "{f}");
+        assert_eq!(r.intersection, None);
+        // The least compression that clears, to within the bisection's
+        // step: a little less compression collides again.
+        let t = Tightening {
+            body: Some((f + 0.05).min(1.0)),
+            ..Tightening::default()
+        };
+        let looser = sweepclay_core::finish(
+            correct_with(&surface::sample_surface(&d).unwrap(), &t).unwrap(),
+        )
+        .unwrap();
+        assert!(!verify(&looser, 0.5).report.printable);
     }
 }
