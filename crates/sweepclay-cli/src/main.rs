@@ -325,9 +325,7 @@ fn slice(a: SliceArgs) -> Result<i32> {
         design.params.set(k, v)?;
     }
     // Refused before anything is sampled, as the server refuses it.
-    design
-        .check_size(a.max_samples as f64)
-        .with_context(|| source.clone())?;
+    sweepclay_core::check_size(&design, a.max_samples as f64).with_context(|| source.clone())?;
     let out = a.output.clone().unwrap_or_else(|| {
         let stem = Path::new(&a.design)
             .file_stem()

@@ -401,35 +401,14 @@ impl Design {
         serde_json::to_string_pretty(self).expect("a design always serialises")
     }
 
-    /// Refuses, before anything is sampled, a design with a parameter out
-    /// of its range or whose estimated sample count
-    /// ([`Design::estimated_samples`]) is over `max_samples`
-    /// ([`Error::TooLarge`]): the cap on work, without [`Design::check_size`]'s
-    /// early fit check (for a preview that shows what leaves the printer).
-    pub fn check_samples(&self, max_samples: f64) -> crate::Result<()> {
-        // A parameter out of its range is that, not a huge estimate (a
-        // layer height of 0 is no "infinitely many samples").
-        self.params.validate()?;
-        let estimate = self.printed().estimated_samples();
-        if estimate > max_samples {
-            return Err(Error::TooLarge {
-                estimate,
-                limit: max_samples,
-            });
-        }
-        Ok(())
-    }
-
-    /// Refuses, before anything is sampled, a design whose estimated sample
-    /// count ([`Design::estimated_samples`]) is over `max_samples`
-    /// ([`Error::TooLarge`]), or that cannot fit its printer: the surface
-    /// starts and ends at Ψ's first and last points on the bed and is as
-    /// tall there as the profiles, so if those leave the build volume the
-    /// whole does ([`Error::DoesNotFit`], as slicing would say). A closed
-    /// B-spline Ψ does not pass through its control points, so for a
-    /// closed Ψ only the height is checked here (slicing checks the rest).
-    pub fn check_size(&self, max_samples: f64) -> crate::Result<()> {
-        self.check_samples(max_samples)?;
+    /// Refuses, before anything is sampled, a design that cannot fit its
+    /// printer: the surface starts and ends at Ψ's first and last points
+    /// on the bed and is as tall there as the profiles, so if those leave
+    /// the build volume the whole does ([`Error::DoesNotFit`], as slicing
+    /// would say). A closed B-spline Ψ does not pass through its control
+    /// points, so for a closed Ψ only the height is checked here (slicing
+    /// checks the rest). [`crate::check_size`] adds the cap on work.
+    pub fn check_fit(&self) -> crate::Result<()> {
         let printed = self.printed();
         let this = &printed;
         let pr = self.printer.resolve()?;
@@ -467,30 +446,56 @@ impl Design {
         Ok(())
     }
 
-    /// An upper bound on the number of surface samples, computed from the
-    /// control polygons without sampling anything: (polygon length of Ψ /
-    /// spacing + 1) × (tallest profile / layer height + 1). A server can
-    /// refuse a design before it allocates anything for it. NaN when a
-    /// coordinate is not a number (slicing then names it).
-    pub fn estimated_samples(&self) -> f64 {
+    /// The length of Ψ (mm) without resampling it: a spline flattened to
+    /// a few dozen points a span (its control polygon can be twice as
+    /// long as the curve), a polyline's own. NaN when a coordinate is not
+    /// a number.
+    pub fn trajectory_length(&self) -> f64 {
         use crate::bspline::polyline_length as poly;
         let t = &self.trajectory;
         let pts = t.given_points();
-        let mut length = poly(pts);
-        let mut floor = 0.0;
+        match (&t.control_points, pts.len()) {
+            (Some(cp), m) if t.closed && m >= 3 => poly(&crate::curves::periodic_bspline(cp, 32)),
+            (Some(cp), m) if m >= 2 => crate::bspline::BSpline::clamped(cp.clone())
+                .map_or(poly(pts), |c| poly(&c.flatten(32))),
+            (None, m) if t.closed && m > 1 => poly(pts) + crate::bspline::dist(pts[m - 1], pts[0]),
+            _ => poly(pts),
+        }
+    }
+
+    /// A bound on the number of path points, from the curves without
+    /// sampling anything (a server refuses a design before it allocates
+    /// anything for it): columns (Ψ's length / spacing + 1) times the
+    /// samples a column can get — a wall's mean height over the layer
+    /// height (flat layers, the most the layering chooses), a vessel's
+    /// lowest (its spiral turns) — plus a vessel's floor rings, a pitch
+    /// apart over the control polygon's area. [`crate::estimated_samples`]
+    /// narrows it for walls. NaN when a coordinate is not a number
+    /// (slicing then names it).
+    pub fn samples_bound(&self) -> f64 {
+        let t = &self.trajectory;
+        let pts = t.given_points();
         let p = &self.params;
+        let mut floor = 0.0;
         if t.closed && pts.len() > 1 {
-            // The closing side; a vessel's floor rings, a pitch apart,
-            // fill at most the control polygon's area (docs/ALGORITHMS.md §8).
-            length += crate::bspline::dist(pts[pts.len() - 1], pts[0]);
             let area = 0.5 * crate::plane::signed_area2(pts).abs();
             let pitch = p.width_min * (1.0 - FLOOR_OVERLAP);
             let layers = p.floor_layers.unwrap_or(DEFAULT_FLOOR_LAYERS);
             floor = 1.5 * area / (pitch * p.spacing) * f64::from(layers);
         }
         let top = |c: &CurveSpec| c.control_points.iter().map(|p| p[1]).fold(0.0, f64::max);
-        let height = top(&self.profile_start).max(top(self.end_profile()));
-        (length / p.spacing + 1.0) * (height / p.layer_height + 1.0) + floor
+        let (zs, zt) = (top(&self.profile_start), top(self.end_profile()));
+        let height = if t.closed {
+            zs.min(zt)
+        } else {
+            // The mean of λ(u) (0.5 for the default f(u) = u).
+            let f = crate::curves::Interpolation::new(self.interpolation.as_ref());
+            let mean = f.map_or(0.5, |f| {
+                (0..=64).map(|k| f.eval(k as f64 / 64.0)).sum::<f64>() / 65.0
+            });
+            (1.0 - mean) * zs + mean * zt
+        };
+        (self.trajectory_length() / p.spacing + 1.0) * (height / p.layer_height + 1.0) + floor
     }
 }
 
@@ -511,16 +516,27 @@ mod tests {
             let d = Design::from_json(text).unwrap();
             // Path points: the surface's samples and a vessel's floor.
             let real = crate::slice(&d).unwrap().toolpath.points.len() as f64;
-            let est = d.estimated_samples();
-            assert!(est >= real && est < 3.0 * real, "{name}: {est} vs {real}");
+            let est = crate::estimated_samples(&d);
+            assert!((est / real - 1.0).abs() < 0.2, "{name}: {est} vs {real}");
+            assert!(d.samples_bound() >= real, "{name}");
         }
+        // A wall of about a million samples (once estimated at 2.2 M and
+        // refused by the default cap of 1.5 M).
+        let mut d = Design::from_json(crate::examples::example("t1").unwrap()).unwrap();
+        d.params.spacing = 0.02;
+        let real = crate::slice(&d).unwrap().toolpath.points.len() as f64;
+        let est = crate::estimated_samples(&d);
+        assert!(
+            real > 0.9e6 && (est / real - 1.0).abs() < 0.2,
+            "{est} vs {real}"
+        );
     }
 
     #[test]
     fn a_parameter_out_of_range_is_named_before_any_size_estimate() {
         let mut d = Design::from_json(MINIMAL).unwrap();
         d.params.layer_height = 0.0;
-        let e = d.check_size(1e6).unwrap_err().to_string();
+        let e = crate::check_size(&d, 1e6).unwrap_err().to_string();
         assert!(e.starts_with("params.layer_height"), "{e}");
     }
 
@@ -539,10 +555,10 @@ mod tests {
             )
         };
         let closed = Design::from_json(&text(true)).unwrap();
-        closed.check_size(1e6).unwrap();
+        crate::check_size(&closed, 1e6).unwrap();
         let open = Design::from_json(&text(false)).unwrap();
         assert!(matches!(
-            open.check_size(1e6),
+            crate::check_size(&open, 1e6),
             Err(Error::DoesNotFit { .. })
         ));
     }

@@ -65,7 +65,7 @@ pub enum Error {
     /// (estimated from its control polygons before anything is sampled).
     #[error("params.spacing / params.layer_height: the design would have about {:.1} million samples, over the limit of {:.1} million; raise the spacing or the layer height", .estimate / 1e6, .limit / 1e6)]
     TooLarge {
-        /// The estimate ([`crate::Design::estimated_samples`]).
+        /// The estimate ([`crate::estimated_samples`]).
         estimate: f64,
         /// The limit.
         limit: f64,

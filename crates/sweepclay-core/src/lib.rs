@@ -261,6 +261,66 @@ pub struct Sliced {
     pub stats: Stats,
 }
 
+/// Most columns the estimate samples a wall at (coarser than its spacing
+/// where it has more): enough to see its layering, far from its cost.
+const ESTIMATE_COLUMNS: f64 = 2000.0;
+
+/// Most samples the estimate's coarse sampling may take.
+const ESTIMATE_SAMPLES: f64 = 200_000.0;
+
+/// The number of path points a design will have, within about 20 %
+/// (docs/PERFORMANCE.md, "The size cap"): for a wall, the samples a
+/// column gets in a sampling of at most 2,000 columns (the layering as
+/// slicing will choose it: tilted passes give every column the short
+/// end's count, flat ones each its own height's) times the columns at
+/// the design's spacing; for a vessel, or where that coarse sampling
+/// would be large or fails, [`Design::samples_bound`].
+pub fn estimated_samples(design: &Design) -> f64 {
+    let d = design.printed();
+    let bound = d.samples_bound();
+    let length = d.trajectory_length();
+    let columns = length / d.params.spacing + 1.0;
+    let per_column = bound / columns;
+    if d.trajectory.closed || !bound.is_finite() || !length.is_finite() {
+        return bound;
+    }
+    let coarse_columns = ESTIMATE_COLUMNS.min(ESTIMATE_SAMPLES / per_column.max(1.0));
+    if coarse_columns < 50.0 {
+        return bound;
+    }
+    let mut coarse = d.clone();
+    coarse.params.spacing = d.params.spacing.max(length / coarse_columns);
+    match surface::sample_surface(&coarse) {
+        Ok(s) if !s.columns.is_empty() => s.samples.len() as f64 / s.columns.len() as f64 * columns,
+        _ => bound,
+    }
+}
+
+/// Refuses, before the design is sampled at its spacing, one with a
+/// parameter out of its range or whose [`estimated_samples`] is over
+/// `max_samples` ([`Error::TooLarge`]): the cap on work, without
+/// [`check_size`]'s early fit check (for a preview that shows what
+/// leaves the printer).
+pub fn check_samples(design: &Design, max_samples: f64) -> Result<()> {
+    // A parameter out of its range is that, not a huge estimate (a layer
+    // height of 0 is no "infinitely many samples").
+    design.params.validate()?;
+    let estimate = estimated_samples(design);
+    if estimate > max_samples {
+        return Err(Error::TooLarge {
+            estimate,
+            limit: max_samples,
+        });
+    }
+    Ok(())
+}
+
+/// [`check_samples`], then [`Design::check_fit`].
+pub fn check_size(design: &Design, max_samples: f64) -> Result<()> {
+    check_samples(design, max_samples)?;
+    design.check_fit()
+}
+
 /// Runs the whole pipeline: validate, sample, correct, plan the path and the
 /// extrusion, and check that the result fits the printer.
 pub fn slice(design: &Design) -> Result<Sliced> {

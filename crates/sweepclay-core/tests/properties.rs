@@ -130,6 +130,14 @@ fn prints_in_clay(d: &Design) -> Result<(), TestCaseError> {
     // Every surface sample is on the path exactly once.
     prop_assert_eq!(t.points.len(), sliced.corrected.surface.samples.len());
 
+    // The size cap's estimate is within 20 % of the real count
+    // (docs/PERFORMANCE.md, "The size cap").
+    let est = sweepclay_core::estimated_samples(d) / t.points.len() as f64;
+    prop_assert!(
+        (est - 1.0).abs() < 0.2,
+        "estimate {est:.2} of the real count"
+    );
+
     // Layer steps within [Δz_min, Δz_max]; top-edge beads may be thinner.
     for (i, b) in t.below.iter().enumerate() {
         let z = t.points[i].pos[2];

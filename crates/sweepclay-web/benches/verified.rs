@@ -1,6 +1,6 @@
 //! The whole job, design → verified G-code (docs/PERFORMANCE.md): slice, write
-//! the G-code and check it in the same pass (`verify_into`, output
-//! discarded), on the examples, on a 44k wall and a 44k vessel, and on the
+//! the G-code and check it in the same pass, through the correction loop
+//! as `slice` runs it (`slice_checked`, output discarded), on the examples, on a 44k wall and a 44k vessel, and on the
 //! scaling series of
 //! `examples::scaled` (10 thousand to 10 million samples).
 //!
@@ -10,7 +10,8 @@
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use std::hint::black_box;
 use sweepclay_core::{examples, Design};
-use sweepclay_web::verify::verify_into;
+use sweepclay_web::guard::Cancel;
+use sweepclay_web::verify::slice_checked;
 
 /// The allocator the `sweepclay` binary ships with (mimalloc: it keeps
 /// freed pages for reuse, where glibc's returns large blocks to the system
@@ -20,8 +21,10 @@ use sweepclay_web::verify::verify_into;
 static ALLOC: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 fn verified(d: &Design) -> bool {
-    let s = sweepclay_core::slice(d).unwrap();
-    verify_into(&s, 0.5, std::io::sink()).unwrap().0.printable
+    match slice_checked(d, 0.5, &Cancel::new(), || Ok(std::io::sink())) {
+        Ok(c) => c.report.printable,
+        Err(e) => panic!("{e}"),
+    }
 }
 
 fn bench(c: &mut Criterion) {

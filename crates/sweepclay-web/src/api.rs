@@ -16,7 +16,7 @@ use sweepclay_core::{correct, surface, Design, Sliced};
 /// the same, and the preview shows it with the part outside marked.
 pub fn parse_design(text: &str, limits: &Limits) -> Result<Design, ApiError> {
     let d = Design::from_json(text)?;
-    d.check_samples(limits.max_samples)?;
+    sweepclay_core::check_samples(&d, limits.max_samples)?;
     Ok(d)
 }
 
