@@ -167,9 +167,8 @@ impl CorrectionReport {
             .max_by(|a, b| a.deviation_mm.total_cmp(&b.deviation_mm))
         {
             out.push(format!(
-                "corners: {} corner(s) of Ψ sharper than {}° rounded (radius up to {:.1} mm); the printed path passes up to {:.1} mm inside the drawn corner at ({:.1}, {:.1}) mm",
+                "corners: {} sharp corner(s) of Ψ rounded (radius up to {:.1} mm); the printed path passes up to {:.1} mm inside the drawn corner at ({:.1}, {:.1}) mm",
                 self.corners.len(),
-                crate::curves::SHARPEST_CORNER_DEG,
                 self.corners.iter().map(|c| c.radius_mm).fold(0.0, f64::max),
                 worst.deviation_mm,
                 worst.at[0],

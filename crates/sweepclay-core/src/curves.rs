@@ -291,6 +291,22 @@ pub fn round_corners(
     bead: f64,
     step: f64,
 ) -> (Vec<[f64; 2]>, Vec<CornerFix>) {
+    round_corners_by(v, closed, step, |_, theta| {
+        let half = 0.5 * theta;
+        (theta.to_degrees() < SHARPEST_CORNER_DEG).then(|| 1.1 * bead / (2.0 * half.cos()))
+    })
+}
+
+/// [`round_corners`] with the radius each vertex asks for: `radius(i,
+/// θ)` for vertex `i` of interior angle θ (radians), `None` to keep it.
+/// The correction loop rounds a corner where the check keeps failing
+/// (docs/ALGORITHMS.md §4).
+pub fn round_corners_by(
+    v: &[[f64; 2]],
+    closed: bool,
+    step: f64,
+    radius: impl Fn(usize, f64) -> Option<f64>,
+) -> (Vec<[f64; 2]>, Vec<CornerFix>) {
     let m = v.len();
     let mut out = Vec::with_capacity(m);
     let mut fixes = Vec::new();
@@ -310,13 +326,15 @@ pub fn round_corners(
         }
         let (u1, u2) = (unit(e1, l1), unit(e2, l2));
         let theta = (u1[0] * u2[0] + u1[1] * u2[1]).clamp(-1.0, 1.0).acos();
-        if theta.to_degrees() >= SHARPEST_CORNER_DEG || theta < 1e-6 {
+        let wanted =
+            radius(i, theta).filter(|_| theta > 1e-6 && theta < std::f64::consts::PI - 1e-6);
+        let Some(wanted) = wanted else {
             out.push(b);
             continue;
-        }
+        };
         let half = 0.5 * theta;
         // Half of each arm at most: the next corner may round the rest.
-        let tangent = (1.1 * bead / (2.0 * half.cos()) / half.tan()).min(0.5 * l1.min(l2));
+        let tangent = (wanted / half.tan()).min(0.5 * l1.min(l2));
         let radius = tangent * half.tan();
         let bis = unit(
             [u1[0] + u2[0], u1[1] + u2[1]],

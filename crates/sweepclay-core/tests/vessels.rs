@@ -287,7 +287,7 @@ fn a_diamond_pot_has_its_sharp_corners_rounded_and_prints() {
         .report
         .summary()
         .iter()
-        .any(|l| l.starts_with("corners: 2 corner(s)")));
+        .any(|l| l.starts_with("corners: 2 sharp corner(s)")));
     let r = common::check_full(&s);
     assert!(r.printable, "{}", r.render());
 }

@@ -231,18 +231,25 @@ pub fn slice_checked<W: Write>(
     cancel: &Cancel,
     mut out: impl FnMut() -> io::Result<W>,
 ) -> Result<Checked<W>, Unchecked> {
-    let sampled = surface::sample_surface(design)?;
+    let mut sampled = surface::sample_surface(design)?;
     go_on(cancel)?;
-    let n = sampled.columns.len();
-    let reach = (sampled.params.width_max / sampled.spacing).ceil() as usize;
+    let w_max = sampled.params.width_max;
+    let reach = (w_max / sampled.spacing).ceil() as usize;
     let has_offsets = sampled.samples.iter().any(|s| s.xi.abs() > 1e-9);
     let mut tight = Tightening::default();
     // Body compression factors: the smallest known to collide, the
     // largest known to clear (with the tightening that cleared).
     let mut collides = 1.0f64;
     let mut clears: Option<(f64, Tightening)> = None;
-    let mut round = |tight: &Tightening| -> Result<(Checked<W>, Vec<usize>, bool), Unchecked> {
-        let corrected = correct_with(&sampled, tight)?;
+    // Corners of a polyline Ψ where failures stay: how often each was
+    // hit, and the radius it is rounded by.
+    let vertices = design.trajectory.points.clone().unwrap_or_default();
+    let mut hits = vec![0u32; vertices.len()];
+    let mut radius: Vec<Option<f64>> = vec![None; vertices.len()];
+    let mut round = |sampled: &surface::Surface,
+                     tight: &Tightening|
+     -> Result<(Checked<W>, Vec<usize>, bool), Unchecked> {
+        let corrected = correct_with(sampled, tight)?;
         go_on(cancel)?;
         let sliced = sweepclay_core::finish(corrected)?;
         let mut w = out()?;
@@ -269,7 +276,7 @@ pub fn slice_checked<W: Write>(
         Ok((checked, support, body))
     };
     loop {
-        let (checked, support, body) = round(&tight)?;
+        let (checked, support, body) = round(&sampled, &tight)?;
         let printable = checked.report.printable;
         if printable {
             let Some(f) = tight.body else {
@@ -286,12 +293,54 @@ pub fn slice_checked<W: Write>(
         if tight.rounds >= MAX_ROUNDS || (!printable && !fixable) {
             // The last printable round, if the bisection went past it.
             return match clears {
-                Some((_, t)) if !printable => Ok(round(&t)?.0),
+                Some((_, t)) if !printable => Ok(round(&sampled, &t)?.0),
                 _ => Ok(checked),
             };
         }
         tight.rounds += 1;
+        // A failure that stays by a corner of a polyline Ψ (the second
+        // round it is within two beads of it) rounds that corner, by w_max
+        // and then by at most 2 w_max (reported with the corners).
+        let mut rounded = false;
+        for &c in &support {
+            let p = checked.sliced.corrected.surface.columns[c].p;
+            let near = (0..vertices.len())
+                .filter(|&i| design.trajectory.closed || (i > 0 && i + 1 < vertices.len()))
+                .map(|i| (i, (vertices[i][0] - p[0]).hypot(vertices[i][1] - p[1])))
+                .filter(|&(_, d)| d < 2.0 * w_max)
+                .min_by(|a, b| a.1.total_cmp(&b.1));
+            if let Some((i, _)) = near {
+                hits[i] += 1;
+                let next = match radius[i] {
+                    None => Some(w_max),
+                    Some(r) if r < 2.0 * w_max => Some(2.0 * w_max),
+                    keep => keep,
+                };
+                if hits[i] >= 2 && next != radius[i] {
+                    radius[i] = next;
+                    rounded = true;
+                }
+            }
+        }
+        if rounded {
+            let mut d = design.clone();
+            let (pts, fixes) = sweepclay_core::curves::round_corners_by(
+                &vertices,
+                design.trajectory.closed,
+                0.25 * sampled.params.spacing,
+                |i, _| radius[i],
+            );
+            d.trajectory.points = Some(pts);
+            sampled = surface::sample_surface(&d)?;
+            sampled.corners.extend(fixes);
+            // Columns are new: the tightening starts again from here.
+            tight.support.clear();
+            clears = None;
+            collides = 1.0;
+            continue;
+        }
         if !support.is_empty() {
+            let n = checked.sliced.corrected.surface.columns.len();
             tight.support.resize(n, 1.0);
             for c in support {
                 for k in c.saturating_sub(reach)..(c + reach + 1).min(n) {
