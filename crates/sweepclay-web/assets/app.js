@@ -33,6 +33,8 @@ const PARAMS = [
 ];
 
 const state = {
+  // The curves as printed where the corrections moved them (showPrinted).
+  printed: {},
   meta: null,
   design: null,
   history: [],
@@ -143,6 +145,7 @@ function profileEditor(id, key, otherKey) {
     set: (pts, final) => edit((d) => { d[key].control_points = pts; }, final),
     curve,
     ghost: () => (state.design ? state.design[otherKey].control_points : null),
+    printed: () => state.printed?.[key] ?? null,
     ground: true,
     snap: 1,
     grid: 5,
@@ -166,6 +169,7 @@ const editors = [
   profileEditor('ed-end', 'profile_end', 'profile_start'),
   new CurveEditor($('ed-traj'), {
     get: () => (state.design ? trajectoryPoints(state.design) : []),
+    printed: () => state.printed?.trajectory ?? null,
     set: (pts, final) => edit((d) => {
       if (d.trajectory.points) d.trajectory.points = pts;
       else d.trajectory.control_points = pts;
@@ -357,6 +361,7 @@ function requestSlice(fit) {
 /** The design did not slice: the error, no verdict, the old preview greyed. */
 function sliceFailed(msg, key) {
   showError(msg, key);
+  showPrinted({});
   cancelVerify();
   setVerdict(null);
   setStale(true);
@@ -485,6 +490,22 @@ function render(data, fit) {
   $('stats').innerHTML = rows.map(([k, v]) => `<tr><td>${k}</td><td data-stat="${k}">${v}</td></tr>`).join('');
   list($('corrections'), data.corrections);
   list($('warnings'), data.warnings);
+  showPrinted(data.printed || {});
+}
+
+/**
+ * The curves as the corrections left them, drawn beside the drawn ones in
+ * the editors (docs/MODELER.md): a potter sees where the print departs
+ * from the drawing before reading any number.
+ */
+function showPrinted(printed) {
+  const t = printed.trajectory;
+  state.printed = {
+    ...printed,
+    // A loop's printed outline closes on itself, as its editor draws it.
+    trajectory: t && state.design?.trajectory?.closed ? [...t, t[0]] : t,
+  };
+  editors.forEach((e) => e.draw());
 }
 
 function showTiming() {

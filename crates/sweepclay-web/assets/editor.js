@@ -22,6 +22,8 @@ export class CurveEditor {
    *   ground: draw the line y = 0
    *   centre: draw and drag the centre o (the trajectory's top view)
    *   ghost(): another curve to draw faintly, e.g. the other profile
+   *   printed(): the curve as printed, where the corrections moved it
+   *     (a polyline in model coordinates, or null): drawn dashed green
    *   label(p): text beside the selected point
    *   onSelect(editor): the selection changed (or its point moved)
    */
@@ -313,6 +315,15 @@ export class CurveEditor {
     // Control polygon, curve, points.
     this.polyline(c, this.points, '#bbb', 1, [3, 3]);
     this.polyline(c, this.o.curve(this.points), '#b5653a', 2.2);
+    // The curve as printed over the drawn one: dashes where they agree,
+    // a second line where the corrections moved it.
+    const printed = this.o.printed ? this.o.printed() : null;
+    if (printed && printed.length >= 2) {
+      this.polyline(c, printed, '#1b7d3a', 2, [6, 4]);
+      c.fillStyle = '#1b7d3a';
+      c.font = '11px system-ui';
+      c.fillText('- - as printed (corrected)', 6, 14);
+    }
     const many = this.points.length > 150;
     this.points.forEach((p, i) => {
       // A dense import is drawn as its curve: dots would hide it.

@@ -109,6 +109,61 @@ pub struct SliceView {
     /// shows it, but it cannot be printed.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub fit_error: Option<FitError>,
+    /// The curves as printed, where the corrections moved them: the
+    /// editors draw them beside the drawn ones.
+    pub printed: PrintedCurves,
+}
+
+/// The design's curves as the corrections left them (design units: the
+/// firing scale taken out), each only where it differs from the drawing
+/// by more than 0.05 mm: C_s and C_t as `[offset, height]` along their
+/// transition curves, Ψ as the columns' points (docs/ALGORITHMS.md §4).
+#[derive(Clone, Debug, Default, PartialEq, Serialize)]
+pub struct PrintedCurves {
+    /// C_s as printed.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub profile_start: Option<Vec<[f32; 2]>>,
+    /// C_t as printed.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub profile_end: Option<Vec<[f32; 2]>>,
+    /// Ψ as printed (its corners rounded).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub trajectory: Option<Vec<[f32; 2]>>,
+}
+
+/// The printed curves of a corrected surface against the sampled one.
+fn printed_curves(drawn: &surface::Surface, s: &surface::Surface) -> PrintedCurves {
+    let [kx, kz] = s.params.print_scale();
+    let n = s.columns.len();
+    if n == 0 || drawn.columns.len() != n {
+        return PrintedCurves::default();
+    }
+    // C_t lies where λ is largest (the last column of a wall, half way
+    // round a vessel's default interpolation).
+    let end = (0..n)
+        .max_by(|&a, &b| s.columns[a].lambda.total_cmp(&s.columns[b].lambda))
+        .unwrap_or(n - 1);
+    let profile = |c: usize| {
+        let col = &s.columns[c];
+        let moved = col
+            .samples()
+            .any(|i| (s.samples[i].xi - drawn.samples[i].xi).abs() > 0.05);
+        moved.then(|| {
+            col.samples()
+                .map(|i| [(s.samples[i].xi / kx) as f32, (s.samples[i].z / kz) as f32])
+                .collect()
+        })
+    };
+    PrintedCurves {
+        profile_start: profile(0),
+        profile_end: profile(end),
+        trajectory: (!s.corners.is_empty()).then(|| {
+            s.columns
+                .iter()
+                .map(|c| [(c.p[0] / kx) as f32, (c.p[1] / kx) as f32])
+                .collect()
+        }),
+    }
 }
 
 impl SliceView {
@@ -130,6 +185,7 @@ impl SliceView {
             "slice_ms": self.slice_ms,
             "printer": self.printer,
             "fit_error": self.fit_error,
+            "printed": self.printed,
         }))
         .expect("plain data serialises");
         while !json.len().is_multiple_of(4) {
@@ -197,6 +253,7 @@ pub fn slice_view(design: &Design, cancel: &Cancel) -> Result<SliceView, ApiErro
         .filter(|(_, (a, b))| (a.xi - b.xi).abs() > 0.05)
         .map(|(i, _)| i as u32)
         .collect();
+    let printed = printed_curves(&sampled, &corrected.surface);
     drop(sampled);
     let sliced = sweepclay_core::finish_unchecked(corrected);
     // A print that leaves the build volume is still shown, with what lies
@@ -209,7 +266,10 @@ pub fn slice_view(design: &Design, cancel: &Cancel) -> Result<SliceView, ApiErro
         }
     });
     let slice_ms = t0.elapsed().as_secs_f64() * 1e3;
-    Ok(view(&sliced, moved, slice_ms, fit_error))
+    Ok(SliceView {
+        printed,
+        ..view(&sliced, moved, slice_ms, fit_error)
+    })
 }
 
 /// Why a sliced design cannot be printed on its printer (it leaves the
@@ -315,6 +375,7 @@ fn view(s: &Sliced, moved: Vec<u32>, slice_ms: f64, fit_error: Option<FitError>)
             nozzle_radius: pr.nozzle_radius,
         },
         fit_error,
+        printed: PrintedCurves::default(),
     }
 }
 

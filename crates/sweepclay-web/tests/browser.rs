@@ -609,6 +609,48 @@ async fn draw_preview_and_download_verified_gcode() {
     let report = sweepclay_check::check(&text, &sweepclay_web::verify::printer_check(&printer));
     assert!(report.printable, "{:?}", report.failures);
     assert_eq!(report.extrusion_runs, 1);
+    // A pot whose flare the support-free correction narrows by 16 mm:
+    // the verdict says it is reshaped, and the profile editor draws the
+    // profile as printed beside the drawn one (docs/MODELER.md).
+    let flared = tmp.path().join("flared.json");
+    std::fs::write(
+        &flared,
+        r#"{"sweepclay":1,"name":"flared pot","profile_start":{"control_points":[[0,0],[0,200],[140,240]]},
+        "trajectory":{"control_points":[[50,0],[35.4,35.4],[0,50],[-35.4,35.4],[-50,0],[-35.4,-35.4],[0,-50],[35.4,-35.4]],"closed":true,"offset":"normal"},
+        "printer":"wasp-40100-clay"}"#,
+    )
+    .unwrap();
+    c.find(fantoccini::Locator::Id("open-file"))
+        .await
+        .unwrap()
+        .send_keys(flared.to_str().unwrap())
+        .await
+        .unwrap();
+    let verdict = wait_js(
+        &c,
+        "const v = document.getElementById('verdict'); return window.sweepclay.design.name === 'flared pot' && !window.sweepclay.inFlight && !window.sweepclay.pending && v.classList.contains('warn') ? v.textContent : null",
+        "the reshaped verdict",
+    )
+    .await;
+    assert!(
+        verdict
+            .as_str()
+            .unwrap()
+            .starts_with("⚠ printable, but reshaped: up to ")
+            && verdict.as_str().unwrap().contains("narrower than drawn"),
+        "{verdict}"
+    );
+    let printed = js(
+        &c,
+        "return (window.sweepclay.printed.profile_start || []).length",
+    )
+    .await;
+    assert!(printed.as_u64().unwrap() > 10, "{printed}");
+    if let Ok(path) = std::env::var("SWEEPCLAY_RESHAPED_SCREENSHOT") {
+        tokio::time::sleep(Duration::from_millis(500)).await;
+        std::fs::write(&path, c.screenshot().await.unwrap()).unwrap();
+        eprintln!("reshaped screenshot written to {path}");
+    }
     assert_eq!(js(&c, "return window.sweepclayErrors").await, json!([]));
     c.close().await.unwrap();
 }
