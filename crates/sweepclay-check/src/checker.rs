@@ -114,7 +114,7 @@ impl<'a> CheckWriter<'a> {
     /// included).
     pub fn finish(mut self) -> Report {
         if self.overlong {
-            self.checker.overlong();
+            self.checker.overlong(&self.partial);
         } else if !self.partial.is_empty() {
             self.checker.bytes(&self.partial);
         }
@@ -131,7 +131,7 @@ impl<'a> CheckWriter<'a> {
             } else {
                 self.keep(&buf[start..nl]);
                 if self.overlong {
-                    self.checker.overlong();
+                    self.checker.overlong(&self.partial);
                 } else {
                     self.checker.bytes(&self.partial);
                 }
@@ -144,13 +144,15 @@ impl<'a> CheckWriter<'a> {
     }
 
     /// Keeps the start of a line that goes on in the next write, up to
-    /// [`MAX_LINE`] bytes: memory never grows with a line's length.
+    /// [`MAX_LINE`] bytes (the command before a long comment is in them):
+    /// memory never grows with a line's length.
     fn keep(&mut self, part: &[u8]) {
-        if self.partial.len() + part.len() > MAX_LINE {
+        let room = MAX_LINE.saturating_sub(self.partial.len());
+        if part.len() > room {
             self.overlong = true;
-        } else {
-            self.partial.extend_from_slice(part);
         }
+        self.partial
+            .extend_from_slice(&part[..part.len().min(room)]);
     }
 }
 
@@ -383,8 +385,14 @@ impl<'a> Checker<'a> {
         self.blocks.reserve(moves);
     }
 
-    /// A line over [`MAX_LINE`] bytes: counted, noted, skipped.
-    fn overlong(&mut self) {
+    /// A line over [`MAX_LINE`] bytes, of which `head` is the start.
+    /// Firmware drops a comment whatever its length, so a command before a
+    /// `;` in the head is judged as it stands; a longer command is
+    /// counted, noted and skipped (no firmware reads it).
+    fn overlong(&mut self, head: &[u8]) {
+        if let Some(cut) = memchr::memchr(b';', &head[..head.len().min(MAX_LINE)]) {
+            return self.bytes(&head[..cut]);
+        }
         self.r.lines += 1;
         self.diagnose(Diagnostic {
             line: self.r.lines,
@@ -408,7 +416,7 @@ impl<'a> Checker<'a> {
     /// A line as bytes, without its `\n`: a `\r` before it is dropped.
     fn bytes(&mut self, mut raw: &[u8]) {
         if raw.len() > MAX_LINE {
-            return self.overlong();
+            return self.overlong(raw);
         }
         if raw.last() == Some(&b'\r') {
             raw = &raw[..raw.len() - 1];
@@ -429,20 +437,29 @@ impl<'a> Checker<'a> {
                 self.pending.push(((Finding::Pause), line, 0.0));
                 self.in_run = false;
             }
-            Some(Event::Move(mut m)) => {
-                // Into the box's own frame: its lowest corner at 0.
-                let b = self.cfg.bed_min;
-                if b != [0.0; 3] {
-                    for p in [&mut m.from, &mut m.to] {
-                        for (v, o) in p.iter_mut().zip(b) {
-                            *v -= o;
-                        }
-                    }
+            Some(Event::Move(m)) => {
+                self.framed(m);
+                // The rest of an arc's segments.
+                while let Some(m) = self.replayer.next_segment() {
+                    self.framed(m);
                 }
-                self.step(&m)
             }
             None => {}
         }
+    }
+
+    /// A move into the box's own frame (its lowest corner at 0), then
+    /// judged.
+    fn framed(&mut self, mut m: crate::replay::Move) {
+        let b = self.cfg.bed_min;
+        if b != [0.0; 3] {
+            for p in [&mut m.from, &mut m.to] {
+                for (v, o) in p.iter_mut().zip(b) {
+                    *v -= o;
+                }
+            }
+        }
+        self.step(&m)
     }
 
     /// Records a finding: at once in the print, held back while it is not
@@ -1098,6 +1115,10 @@ impl<'a> Checker<'a> {
         if ambiguous.count > 0 {
             r.findings[Finding::AmbiguousNumber] = ambiguous.clone();
         }
+        let unreadable = &self.parser.unreadable;
+        if unreadable.count > 0 {
+            r.findings[Finding::UnreadableNumber] = unreadable.clone();
+        }
         let (lo, hi) = (self.lo, self.hi);
         if r.extruding_moves > 0 {
             r.size_mm = [hi[0] - lo[0], hi[1] - lo[1], hi[2].max(0.0)];
@@ -1118,6 +1139,11 @@ impl<'a> Checker<'a> {
         r.diagnostics = self.diags;
         r.printer = self.cfg.printer.clone();
         r.firmware = self.cfg.firmware.name().to_string();
+        r.cannot_judge = self
+            .replayer
+            .cannot_judge
+            .take()
+            .map(|(line, message)| Diagnostic { line, message });
         verdict(r, self.cfg);
         self.r
     }

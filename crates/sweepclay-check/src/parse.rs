@@ -73,6 +73,30 @@ pub struct LineParser {
     /// Numbers in exponent form met so far, with the line of the first:
     /// firmwares read them differently, so each is a failure.
     pub ambiguous: crate::Count,
+    /// Moves (G0–G3) with a number no firmware reads as written (`X-`,
+    /// `X-inf`): Marlin reads 0 and moves there, so each is a failure.
+    pub unreadable: crate::Count,
+}
+
+/// Whether a line's command, after any `N` line number, is a move: G0,
+/// G1, G2 or G3 (`G01` too).
+fn is_move(raw: &str) -> bool {
+    let s = raw.trim_start();
+    let s = match s.strip_prefix(['N', 'n']) {
+        Some(rest) => rest
+            .trim_start_matches(|c: char| c.is_ascii_digit())
+            .trim_start(),
+        None => s,
+    };
+    let Some(rest) = s.strip_prefix(['G', 'g']) else {
+        return false;
+    };
+    let digits: String = rest
+        .trim_start()
+        .chars()
+        .take_while(char::is_ascii_digit)
+        .collect();
+    matches!(digits.trim_start_matches('0'), "" | "1" | "2" | "3") && !digits.is_empty()
 }
 
 /// Whether `s` from byte `i` on starts an exponent: `e` or `E`, then a
@@ -291,9 +315,17 @@ impl LineParser {
                 match num.parse::<f64>() {
                     Ok(v) if v.is_finite() => v,
                     _ => {
+                        let on_move = is_move(raw);
+                        if on_move {
+                            self.unreadable.add(n, 0.0);
+                        }
                         diags.push(Diagnostic {
                             line: n,
-                            message: format!("`{letter}{num}` is not a number"),
+                            message: if on_move {
+                                format!("`{letter}{num}` is not a number: Marlin reads {letter}0 and moves there")
+                            } else {
+                                format!("`{letter}{num}` is not a number")
+                            },
                         });
                         return false;
                     }

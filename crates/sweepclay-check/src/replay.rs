@@ -1,7 +1,10 @@
 //! Replays parsed G-code into a list of moves in absolute millimetres and
-//! absolute E: G0/G1 with any subset of X Y Z E F, G90/G91, M82/M83, G92,
-//! G20/G21, G28; G4, M0, M1 and M600 are pauses; unknown commands are
-//! reported, not fatal.
+//! absolute E: G0/G1 with any subset of X Y Z E F, G2/G3 arcs in the XY
+//! plane (`I J` or `R`, split into segments of at most 1 mm as Marlin and
+//! Klipper do), G90/G91, M82/M83, G92, G20/G21, G28; G4, M0, M1 and M600
+//! are pauses; unknown commands are reported, not fatal. An arc this does
+//! not replay as firmware would (another plane, no centre, a radius too
+//! short for its chord) makes the file one it cannot judge.
 
 use crate::parse::{Diagnostic, Line};
 
@@ -55,6 +58,9 @@ pub fn replay(lines: &[Line], diags: &mut Vec<Diagnostic>) -> Vec<Event> {
     for l in lines {
         if let Some(ev) = r.feed(l, diags) {
             out.push(ev);
+            while let Some(m) = r.next_segment() {
+                out.push(Event::Move(m));
+            }
         }
     }
     out
@@ -72,7 +78,18 @@ pub struct Replayer {
     unknown_reported: std::collections::BTreeSet<String>,
     /// Whose reading of `G90`/`G91` to follow (they switch E in Marlin).
     pub firmware: crate::Firmware,
+    /// The plane arcs turn in: 17 (XY), 18 (ZX) or 19 (YZ).
+    plane: u8,
+    /// The segments of the last arc after the one `feed` returned, last
+    /// first (taken by [`Replayer::next_segment`]).
+    segments: Vec<Move>,
+    /// The first line the replay cannot follow as firmware would, and why.
+    pub cannot_judge: Option<(usize, String)>,
 }
+
+/// Longest segment an arc is split into (mm): Marlin's
+/// `MM_PER_ARC_SEGMENT` and about Klipper's `resolution`.
+pub const ARC_SEGMENT_MM: f64 = 1.0;
 
 impl Default for Replayer {
     fn default() -> Self {
@@ -85,11 +102,147 @@ impl Default for Replayer {
             feed: 0.0,
             unknown_reported: Default::default(),
             firmware: crate::Firmware::Marlin,
+            plane: 17,
+            segments: Vec::new(),
+            cannot_judge: None,
         }
     }
 }
 
 impl Replayer {
+    /// The next segment of the arc the last [`Replayer::feed`] began, if
+    /// any is left.
+    pub fn next_segment(&mut self) -> Option<Move> {
+        self.segments.pop()
+    }
+
+    /// Notes the first line the replay cannot follow.
+    fn cannot(&mut self, line: usize, why: String) {
+        self.cannot_judge.get_or_insert((line, why));
+    }
+
+    /// An arc (`clockwise` for G2) from the current position, as firmware
+    /// splits it: the first segment, the rest left for
+    /// [`Replayer::next_segment`].
+    fn arc(&mut self, l: &Line, clockwise: bool, diags: &mut Vec<Diagnostic>) -> Option<Event> {
+        let scale = self.scale;
+        if self.plane != 17 {
+            self.cannot(
+                l.line,
+                format!(
+                    "an arc in the G{} plane (only G17, XY, is replayed)",
+                    self.plane
+                ),
+            );
+            return None;
+        }
+        let mut to = self.pos;
+        for (a, k) in ['X', 'Y', 'Z'].into_iter().enumerate() {
+            if let Some(v) = l.get(k) {
+                to[a] = if self.abs_xyz {
+                    v * scale
+                } else {
+                    self.pos[a] + v * scale
+                };
+            }
+        }
+        let (p1, q1, p2, q2) = (self.pos[0], self.pos[1], to[0], to[1]);
+        let centre = match (l.get('I'), l.get('J'), l.get('R')) {
+            (i, j, _) if i.is_some() || j.is_some() => {
+                [p1 + i.unwrap_or(0.0) * scale, q1 + j.unwrap_or(0.0) * scale]
+            }
+            (_, _, Some(r)) => {
+                let r = r * scale;
+                let (dx, dy) = (p2 - p1, q2 - q1);
+                let d = dx.hypot(dy);
+                if d == 0.0 || r.abs() < 0.5 * d - 1e-9 {
+                    self.cannot(
+                        l.line,
+                        format!(
+                            "an arc of radius {} mm between points {d:.3} mm apart",
+                            r.abs()
+                        ),
+                    );
+                    return None;
+                }
+                // Marlin's pivot: on the chord's bisector, on the side the
+                // direction and the radius's sign choose.
+                let e = if clockwise ^ (r < 0.0) { -1.0 } else { 1.0 };
+                let h = (r * r - 0.25 * d * d).max(0.0).sqrt();
+                [
+                    0.5 * (p1 + p2) - e * h * dy / d,
+                    0.5 * (q1 + q2) + e * h * dx / d,
+                ]
+            }
+            _ => {
+                self.cannot(l.line, "an arc with neither I J nor R".into());
+                return None;
+            }
+        };
+        let (rp, rq) = (p1 - centre[0], q1 - centre[1]);
+        let (tp, tq) = (p2 - centre[0], q2 - centre[1]);
+        let radius = rp.hypot(rq);
+        let mut travel = (rp * tq - rq * tp).atan2(rp * tp + rq * tq);
+        if travel < 0.0 {
+            travel += std::f64::consts::TAU;
+        }
+        if clockwise {
+            travel -= std::f64::consts::TAU;
+        }
+        if travel == 0.0 && p1 == p2 && q1 == q2 {
+            travel = std::f64::consts::TAU;
+        }
+        let mut de = 0.0;
+        if let Some(v) = l.get('E') {
+            let v = v * scale;
+            de = if self.abs_e { v - self.e } else { v };
+            self.e += de;
+        }
+        if let Some(f) = l.get('F') {
+            self.feed = f * scale;
+        }
+        let length = (travel * radius).hypot(to[2] - self.pos[2]);
+        if !length.is_finite() || radius > 1e6 {
+            self.cannot(l.line, "an arc whose centre is not a number".into());
+            return None;
+        }
+        // Firmware moves the last segment to the target itself.
+        let n = ((length / ARC_SEGMENT_MM).ceil() as usize).clamp(1, 1 << 16);
+        let start = self.pos;
+        let a0 = rq.atan2(rp);
+        let at = |k: usize| -> [f64; 3] {
+            if k == n {
+                return to;
+            }
+            let f = k as f64 / n as f64;
+            let a = a0 + travel * f;
+            [
+                centre[0] + radius * a.cos(),
+                centre[1] + radius * a.sin(),
+                start[2] + (to[2] - start[2]) * f,
+            ]
+        };
+        self.segments.clear();
+        for k in (1..=n).rev() {
+            self.segments.push(Move {
+                line: l.line,
+                from: at(k - 1),
+                to: at(k),
+                de: de / n as f64,
+                feed: self.feed,
+            });
+        }
+        if (to[0] - at(n - 1)[0]).hypot(to[1] - at(n - 1)[1]) > 2.0 * ARC_SEGMENT_MM + 1e-6 && n > 1
+        {
+            diags.push(Diagnostic {
+                line: l.line,
+                message: "the arc's end is not on its circle; firmware jumps to it".into(),
+            });
+        }
+        self.pos = to;
+        self.segments.pop().map(Event::Move)
+    }
+
     /// Applies one line; returns the move or pause it makes, if any.
     pub fn feed(&mut self, l: &Line, diags: &mut Vec<Diagnostic>) -> Option<Event> {
         let Some(letter) = l.letter else {
@@ -131,10 +284,10 @@ impl Replayer {
                 self.pos = to;
                 return Some(Event::Move(m));
             }
-            ('G', 2.0) | ('G', 3.0) => diags.push(Diagnostic {
-                line: l.line,
-                message: "arc moves (G2/G3) are not replayed".into(),
-            }),
+            ('G', 2.0) | ('G', 3.0) => return self.arc(l, l.code == 2.0, diags),
+            ('G', 17.0) => self.plane = 17,
+            ('G', 18.0) => self.plane = 18,
+            ('G', 19.0) => self.plane = 19,
             ('G', 4.0) | ('M', 0.0) | ('M', 1.0) | ('M', 600.0) => {
                 return Some(Event::Pause(l.line))
             }
@@ -194,7 +347,7 @@ impl Replayer {
                     107.0,
                 ]
                 .contains(&c) => {}
-            ('G', c) if [29.0, 17.0, 80.0].contains(&c) => {}
+            ('G', c) if [29.0, 80.0].contains(&c) => {}
             ('T', _) => {}
             (k, c) => {
                 // One note a command, for the first 64 distinct ones.
@@ -274,5 +427,46 @@ mod tests {
         assert!(matches!(ev[1], Event::Pause(2)));
         assert_eq!(d.len(), 1);
         assert_eq!(d[0].line, 3);
+    }
+
+    #[test]
+    fn arcs_are_split_as_firmware_splits_them() {
+        // A full circle of radius 10 (I J, back to its start): 63 segments
+        // of at most 1 mm, 2π·10 long but for the chords' sag, E shared
+        // out evenly, ending where it began.
+        let m = moves("G1 X20 Y10 Z1 F600\nG2 X20 Y10 I-10 J0 E6.25\n");
+        let arc = &m[1..];
+        assert_eq!(arc.len(), 63);
+        let len: f64 = arc.iter().map(Move::length).sum();
+        let closed_form = std::f64::consts::TAU * 10.0;
+        assert!((len - closed_form).abs() < 0.01 * closed_form, "{len}");
+        let e: f64 = arc.iter().map(|m| m.de).sum();
+        assert!((e - 6.25).abs() < 1e-9);
+        assert_eq!(arc.last().unwrap().to, [20.0, 10.0, 1.0]);
+        // Clockwise: the first segment heads down (−y) from (20, 10).
+        assert!(arc[0].to[1] < 10.0, "{:?}", arc[0].to);
+        // R form, counter-clockwise, a half circle from (0, 0) to (20, 0)
+        // through (10, −10): 10π long.
+        let m = moves("G1 X0 Y0 Z1\nG3 X20 Y0 R10 E1\n");
+        let len: f64 = m[1..].iter().map(Move::length).sum();
+        assert!((len - 10.0 * std::f64::consts::PI).abs() < 0.05, "{len}");
+        assert!(m[1..].iter().all(|m| m.to[1] <= 1e-9), "{:?}", m[5].to);
+    }
+
+    #[test]
+    fn arcs_firmware_would_not_run_as_written_are_not_judged() {
+        for (text, why) in [
+            ("G18\nG2 X10 Z5 I5 K0\n", "G18 plane"),
+            ("G1 X0 Y0\nG2 X10 Y0\n", "neither I J nor R"),
+            ("G1 X0 Y0\nG2 X10 Y0 R2\n", "radius 2 mm"),
+        ] {
+            let mut r = Replayer::default();
+            let mut d = Vec::new();
+            for l in parse(text, &mut d) {
+                r.feed(&l, &mut d);
+            }
+            let (_, msg) = r.cannot_judge.expect(why);
+            assert!(msg.contains(why), "{msg}");
+        }
     }
 }

@@ -74,6 +74,9 @@ pub enum Finding {
     Overhang,
     /// A number firmwares read differently (`Z5e-05`).
     AmbiguousNumber,
+    /// A number on a move no firmware reads as written (`X-`, `X-inf`,
+    /// `X.`): Marlin reads it as 0 and moves there.
+    UnreadableNumber,
     /// A turnaround step carrying more than [`TURN_FACTOR`] times the clay
     /// the end of the bead after it needs: clay piles up at the turn
     /// (docs/CHECKER.md, "Turns"). Worst: that ratio.
@@ -86,7 +89,7 @@ pub const TURN_FACTOR: f64 = 2.0;
 
 impl Finding {
     /// Every kind, in the order reports list them.
-    pub const ALL: [Finding; 15] = [
+    pub const ALL: [Finding; 16] = [
         Finding::TravelMove,
         Finding::Retraction,
         Finding::Pause,
@@ -101,6 +104,7 @@ impl Finding {
         Finding::UnderMinOverlap,
         Finding::Overhang,
         Finding::AmbiguousNumber,
+        Finding::UnreadableNumber,
         Finding::TurnPile,
     ];
 
@@ -121,6 +125,7 @@ impl Finding {
             Finding::UnderMinOverlap => "overlap < minimum",
             Finding::Overhang => "overhang > limit (deg)",
             Finding::AmbiguousNumber => "ambiguous numbers",
+            Finding::UnreadableNumber => "unreadable numbers",
             Finding::TurnPile => "clay piled at turns (x)",
         }
     }
@@ -142,6 +147,9 @@ impl Finding {
             Finding::UnderMinOverlap => "bead(s) overlapping the bead below by less than half",
             Finding::Overhang => "overhang(s) beyond the limit",
             Finding::AmbiguousNumber => "number(s) that firmwares read differently",
+            Finding::UnreadableNumber => {
+                "move(s) with a number no firmware reads as written (Marlin moves to 0 there)"
+            }
             Finding::TurnPile => {
                 "turnaround step(s) carrying more than twice the clay the end of the next bead needs (it piles up at the turn)"
             }
@@ -298,6 +306,12 @@ pub struct Report {
     pub size_mm: [f64; 3],
     /// Estimated layer count: height over the median layer height.
     pub layers: usize,
+    /// Set when the file holds a command the replay cannot follow as
+    /// firmware would (an arc in another plane, with no centre, or with
+    /// a radius shorter than half its chord): no verdict is given
+    /// (`printable` is false, and `sweepclay check` exits with 3).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub cannot_judge: Option<Diagnostic>,
     /// Parse and replay diagnostics (the first 50).
     pub diagnostics: Vec<Diagnostic>,
     /// How many diagnostics there were in all.
@@ -316,7 +330,13 @@ impl Report {
     /// The readable report: a verdict line, then a table.
     pub fn render(&self) -> String {
         let mut s = String::new();
-        if self.printable {
+        if let Some(d) = &self.cannot_judge {
+            let _ = writeln!(
+                s,
+                "CANNOT JUDGE: line {}: {}; no verdict is given",
+                d.line, d.message
+            );
+        } else if self.printable {
             let _ = writeln!(
                 s,
                 "PRINTABLE in clay: one continuous extrusion, collision-free, every bead supported"
@@ -354,6 +374,7 @@ impl Report {
                     Finding::IntoBed
                         | Finding::FirstLayerHigh
                         | Finding::AmbiguousNumber
+                        | Finding::UnreadableNumber
                         | Finding::TurnPile
                 )
             {

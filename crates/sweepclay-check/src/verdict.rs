@@ -53,6 +53,9 @@ pub(crate) fn verdict(r: &mut Report, cfg: &CheckConfig) {
             cfg.width_min * (1.0 - WIDTH_TOLERANCE)
         ));
     }
+    if let Some(d) = &r.cannot_judge {
+        f.insert(0, format!("cannot judge: line {}: {}", d.line, d.message));
+    }
     r.printable = f.is_empty();
     r.failures = f;
     r.warnings = w;

@@ -415,7 +415,13 @@ fn diagnostics_name_lines_and_unknown_commands_are_not_fatal() {
     g.line("M999 ; unknown");
     g.line("G1 X1..2");
     let r = verdict(&g.out);
-    assert!(r.printable, "{}", r.render());
+    // An unreadable number on a move is a failure (Marlin moves to 0),
+    // with its line; the unknown command only a note.
+    assert!(!r.printable, "{}", r.render());
+    assert_eq!(
+        r.findings[Finding::UnreadableNumber].first_line,
+        Some(g.out.lines().count())
+    );
     let n = g.out.lines().count();
     assert_eq!(r.diagnostics.len(), 2, "{:?}", r.diagnostics);
     assert_eq!(r.diagnostics[0].line, n - 1);
@@ -851,4 +857,111 @@ fn hostile_files_check_in_bounded_time_and_memory() {
     let r = verdict(&noise);
     assert_eq!(r.diagnostics.len(), 50);
     assert!(r.diagnostics_total >= 500, "{}", r.diagnostics_total);
+}
+
+/// A cup of `layers` full circles of radius 20 as G2 arcs, each layer's
+/// centre `shift` mm further along x (a true cylinder at 0).
+fn arc_cup(layers: usize, shift: f64) -> String {
+    let mut g = G::new([120.0, 100.0, LAYER]);
+    let circle = 2.0 * std::f64::consts::PI * 20.0;
+    for k in 0..layers {
+        let z = LAYER * (k + 1) as f64;
+        let cx = 100.0 + shift * k as f64;
+        if k > 0 {
+            g.bead([cx + 20.0, 100.0, z], W, LAYER);
+        }
+        g.e += circle * W * LAYER * E;
+        let line = format!("G2 X{:.3} Y100 Z{z:.3} I-20 J0 E{:.5}", cx + 20.0, g.e);
+        g.line(&line);
+        g.at = [cx + 20.0, 100.0, z];
+    }
+    g.out
+}
+
+#[test]
+fn arcs_are_replayed_as_firmware_runs_them() {
+    // A cup of 20 circles as G2 arcs: its size and clay are the circles'
+    // (it was "size 0.0 x 0.0 x 24.0 mm" and a fraction of the clay,
+    // judged from the arcs' end points).
+    let r = verdict(&arc_cup(20, 0.0));
+    assert!(r.printable, "{:?}", r.failures);
+    assert!(
+        (r.size_mm[0] - 40.0).abs() < 1.0 && (r.size_mm[1] - 40.0).abs() < 1.0,
+        "{:?}",
+        r.size_mm
+    );
+    let clay_ml = 20.0 * 2.0 * std::f64::consts::PI * 20.0 * W * LAYER / 1000.0;
+    assert!(
+        (r.volume_ml - clay_ml).abs() < 0.03 * clay_ml,
+        "{} vs {clay_ml}",
+        r.volume_ml
+    );
+    // The same circles 8 mm out of true, layer on layer: nothing holds
+    // the beads up (it was called PRINTABLE).
+    let r = verdict(&arc_cup(20, 8.0));
+    assert!(!r.printable);
+    assert!(
+        r.findings[Finding::Unsupported].count + r.findings[Finding::Overhang].count > 0,
+        "{:?}",
+        r.failures
+    );
+}
+
+#[test]
+fn an_arc_no_firmware_runs_as_written_gets_no_verdict() {
+    let text = arc_cup(3, 0.0).replace("I-20 J0", "R0.5");
+    let r = verdict(&text);
+    assert!(!r.printable);
+    let d = r.cannot_judge.as_ref().expect("cannot judge");
+    assert!(d.message.contains("radius 0.5 mm"), "{}", d.message);
+    assert!(
+        r.render().starts_with("CANNOT JUDGE: line "),
+        "{}",
+        r.render()
+    );
+}
+
+#[test]
+fn a_number_firmware_reads_as_zero_on_a_move_fails() {
+    // Marlin reads `X-`, `X-inf`, `X.` as X0 and drives there; the file
+    // is not judged as if the line were a note.
+    for bad in ["X-", "X-inf", "X.", "X1-", "E-", "X+"] {
+        let mut g = wall(4);
+        g.line(&format!("G1 {bad} Y10"));
+        let r = verdict(&g.out);
+        assert!(!r.printable, "{bad}");
+        assert_eq!(
+            r.findings[Finding::UnreadableNumber].count,
+            1,
+            "{bad}: {:?}",
+            r.failures
+        );
+    }
+    // A message is no move: `M117 Printing...` stays a note.
+    let mut g = wall(4);
+    g.line("M117 Printing 1-2-3...");
+    assert!(verdict(&g.out).printable);
+}
+
+#[test]
+fn a_command_before_a_long_comment_is_judged() {
+    // Firmware drops a comment whatever its length, and runs the travel
+    // before it: a travel between beads, not a line "no firmware reads".
+    let g = wall(4);
+    assert!(verdict(&g.out).printable);
+    // Between two beads half way up: a travel away and back.
+    let lines: Vec<&str> = g.out.lines().collect();
+    let mid = lines.len() / 2;
+    let long = format!(
+        "{}\nG0 X150 Y150 ;{}\n{}\n",
+        lines[..mid].join("\n"),
+        "x".repeat(5000),
+        lines[mid..].join("\n")
+    );
+    let r = verdict(&long);
+    assert!(
+        r.findings[Finding::TravelMove].count >= 1,
+        "{:?}",
+        r.failures
+    );
 }

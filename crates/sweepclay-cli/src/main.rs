@@ -583,7 +583,13 @@ fn check_cmd(a: CheckArgs) -> Result<i32> {
     } else {
         say(format_args!("{}", report.render()))?;
     }
-    Ok(if report.printable { 0 } else { 1 })
+    Ok(if report.cannot_judge.is_some() {
+        3
+    } else if report.printable {
+        0
+    } else {
+        1
+    })
 }
 
 /// The file an output path names: itself if missing, its target if it is
