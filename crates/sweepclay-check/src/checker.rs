@@ -779,8 +779,9 @@ impl<'a> Checker<'a> {
             ..
         } = self;
         // Its failures, recorded once the borrows below end (at most one
-        // each of: no clay below, too little overlap, overhang).
-        let mut held = [(Finding::Unsupported, 0.0); 3];
+        // each of: no clay below, too little overlap, overhang, more clay
+        // than fits).
+        let mut held = [(Finding::Unsupported, 0.0); 4];
         let mut n_held = 0;
         let mut hold = |kind, v| {
             held[n_held] = (kind, v);
@@ -817,6 +818,14 @@ impl<'a> Checker<'a> {
         } else {
             recent.turn(d, xy, s_start)
         };
+        // Clay no nozzle can lay along this bead: a cross-section beyond
+        // OVERFLOW_SECTIONS widest beads of half their width in height
+        // (E switched to relative half way, a lost G92).
+        let section = volume / len.max(1e-9);
+        if !step && section > crate::report::OVERFLOW_SECTIONS * 0.5 * cfg.width_max * cfg.width_max
+        {
+            hold(Finding::ClayOverflow, section);
+        }
         let mut on_clay = false;
         if step {
             r.support.steps += 1;
@@ -887,9 +896,15 @@ impl<'a> Checker<'a> {
                 if gap > 0.05 {
                     width = volume / (len * gap);
                     height = gap;
-                    minmax(&mut r.support.width, width, m.line);
-                    if width > cfg.width_max * (1.0 + WIDTH_TOLERANCE) {
-                        r.support.wide.add(m.line, width);
+                    // A gap thinner than the thinnest layer gives no width
+                    // a person could measure on the print (287 mm for a
+                    // 75 mm pot): such a reading is left out of the
+                    // report's figures.
+                    if gap >= cfg.min_layer_mm {
+                        minmax(&mut r.support.width, width, m.line);
+                        if width > cfg.width_max * (1.0 + WIDTH_TOLERANCE) {
+                            r.support.wide.add(m.line, width);
+                        }
                     }
                 } else {
                     // No gap to measure it by: as wide as its clay would
@@ -1097,12 +1112,19 @@ impl<'a> Checker<'a> {
                 moves: self.r.moves - moves_at,
                 ..Segment::default()
             };
-            for (kind, line, _) in &self.pending {
+            for &(kind, line, v) in &self.pending {
                 end.note(match kind {
                     Finding::Retraction => format!("end retraction (line {line})"),
                     Finding::TravelMove => "lifting off and travel".into(),
                     Finding::Pause => format!("pause (line {line})"),
-                    _ => "moves through the clay after the print (homing), not judged".into(),
+                    // Not printing, but into the piece just printed: a
+                    // crash like any other (an end code's `G1 Z+30` read
+                    // as Z30 from above the rim).
+                    Finding::NozzleCollision | Finding::CarriageCollision => {
+                        self.r.findings[kind].add(line, v);
+                        format!("drives the nozzle into the printed piece (line {line})")
+                    }
+                    _ => "moves after the print, not judged".into(),
                 });
             }
             if end.items.is_empty() {

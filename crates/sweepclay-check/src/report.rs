@@ -77,11 +77,21 @@ pub enum Finding {
     /// A number on a move no firmware reads as written (`X-`, `X-inf`,
     /// `X.`): Marlin reads it as 0 and moves there.
     UnreadableNumber,
+    /// A bead carrying more clay a millimetre than fits under the nozzle
+    /// ([`OVERFLOW_SECTIONS`]); its cross-section (mm²).
+    ClayOverflow,
     /// A turnaround step carrying more than [`TURN_FACTOR`] times the clay
     /// the end of the bead after it needs: clay piles up at the turn
     /// (docs/CHECKER.md, "Turns"). Worst: that ratio.
     TurnPile,
 }
+
+/// A bead whose clay cross-section (volume over length) exceeds this many
+/// times that of the widest bead laid half as high as it is wide carries
+/// more clay than fits under the nozzle: `M83` half way through an
+/// absolute-E file, a lost `G92 E0` (docs/CHECKER.md, "Clay that cannot
+/// fit").
+pub const OVERFLOW_SECTIONS: f64 = 4.0;
 
 /// How much more clay than the end of the next bead needs a turnaround
 /// step may carry before it counts as a pile (docs/CHECKER.md, "Turns").
@@ -89,7 +99,7 @@ pub const TURN_FACTOR: f64 = 2.0;
 
 impl Finding {
     /// Every kind, in the order reports list them.
-    pub const ALL: [Finding; 16] = [
+    pub const ALL: [Finding; 17] = [
         Finding::TravelMove,
         Finding::Retraction,
         Finding::Pause,
@@ -105,6 +115,7 @@ impl Finding {
         Finding::Overhang,
         Finding::AmbiguousNumber,
         Finding::UnreadableNumber,
+        Finding::ClayOverflow,
         Finding::TurnPile,
     ];
 
@@ -126,6 +137,7 @@ impl Finding {
             Finding::Overhang => "overhang > limit (deg)",
             Finding::AmbiguousNumber => "ambiguous numbers",
             Finding::UnreadableNumber => "unreadable numbers",
+            Finding::ClayOverflow => "clay beyond the nozzle (mm²)",
             Finding::TurnPile => "clay piled at turns (x)",
         }
     }
@@ -147,6 +159,9 @@ impl Finding {
             Finding::UnderMinOverlap => "bead(s) overlapping the bead below by less than half",
             Finding::Overhang => "overhang(s) beyond the limit",
             Finding::AmbiguousNumber => "number(s) that firmwares read differently",
+            Finding::ClayOverflow => {
+                "bead(s) carrying more clay than fits under the nozzle (a cross-section over 4 widest beads of half their width in height)"
+            }
             Finding::UnreadableNumber => {
                 "move(s) with a number no firmware reads as written (Marlin moves to 0 there)"
             }
@@ -375,6 +390,7 @@ impl Report {
                         | Finding::FirstLayerHigh
                         | Finding::AmbiguousNumber
                         | Finding::UnreadableNumber
+                        | Finding::ClayOverflow
                         | Finding::TurnPile
                 )
             {

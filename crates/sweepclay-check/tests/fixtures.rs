@@ -965,3 +965,56 @@ fn a_command_before_a_long_comment_is_judged() {
         r.failures
     );
 }
+
+#[test]
+fn clay_that_cannot_fit_under_the_nozzle_fails() {
+    // `M83` half way through an absolute-E file: each move's E, meant as
+    // the total so far, is read as that move's clay (beads hundreds of
+    // metres wide; it passed with a warning).
+    let g = wall(10);
+    let lines: Vec<&str> = g.out.lines().collect();
+    let mid = lines.len() / 2;
+    let text = format!(
+        "{}\nM83\n{}\n",
+        lines[..mid].join("\n"),
+        lines[mid..].join("\n")
+    );
+    let r = verdict(&text);
+    assert!(!r.printable);
+    let c = &r.findings[Finding::ClayOverflow];
+    assert!(
+        c.count > 0 && c.first_line == Some(mid + 2),
+        "{:?} {:?}",
+        c,
+        r.failures
+    );
+    // A wide bead pressed flat is no overflow: the clean wall passes.
+    assert!(verdict(&g.out).printable);
+}
+
+#[test]
+fn an_end_code_that_drives_the_nozzle_into_the_piece_fails() {
+    // `G1 Z+30` meant as a lift, read in absolute mode as Z30: from the
+    // top of a 48 mm wall the nozzle goes down through it. A lift in
+    // relative mode and homing X and Y stay clear.
+    let mut g = wall(40);
+    let top = g.at[2];
+    assert!(top > 40.0);
+    let ok = format!("{}G91\nG1 Z30\nG90\nG28 X0 Y0\n", g.out);
+    assert!(verdict(&ok).printable, "{}", verdict(&ok).render());
+    g.line("G1 Z+30 ; lift");
+    let r = verdict(&g.out);
+    assert!(!r.printable);
+    assert_eq!(
+        r.findings[Finding::NozzleCollision].first_line,
+        Some(g.out.lines().count())
+    );
+    let end = r.end_code.as_ref().unwrap();
+    assert!(
+        end.items
+            .iter()
+            .any(|i| i.contains("into the printed piece")),
+        "{:?}",
+        end.items
+    );
+}
