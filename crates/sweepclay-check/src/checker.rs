@@ -323,6 +323,14 @@ impl<'a> Checker<'a> {
         parser.firmware = cfg.firmware;
         let mut replayer = Replayer::default();
         replayer.firmware = cfg.firmware;
+        // A round bed is a delta's: G28 takes it up to the top, centred.
+        replayer.delta_home = cfg.bed_diameter.map(|_| {
+            [
+                cfg.bed_min[0] + 0.5 * cfg.build_volume[0],
+                cfg.bed_min[1] + 0.5 * cfg.build_volume[1],
+                cfg.bed_min[2] + cfg.build_volume[2],
+            ]
+        });
         Checker {
             cfg,
             parser,
@@ -1120,9 +1128,14 @@ impl<'a> Checker<'a> {
                     // Not printing, but into the piece just printed: a
                     // crash like any other (an end code's `G1 Z+30` read
                     // as Z30 from above the rim).
-                    Finding::NozzleCollision | Finding::CarriageCollision => {
+                    Finding::NozzleCollision | Finding::CarriageCollision
+                        if !self.replayer.homing_lines.contains(&line) =>
+                    {
                         self.r.findings[kind].add(line, v);
                         format!("drives the nozzle into the printed piece (line {line})")
+                    }
+                    Finding::NozzleCollision | Finding::CarriageCollision => {
+                        "homing through the clay after the print (where the endstops are is the printer's), not judged".into()
                     }
                     _ => "moves after the print, not judged".into(),
                 });

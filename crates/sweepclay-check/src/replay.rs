@@ -85,6 +85,12 @@ pub struct Replayer {
     segments: Vec<Move>,
     /// The first line the replay cannot follow as firmware would, and why.
     pub cannot_judge: Option<(usize, String)>,
+    /// Where `G28` takes a delta printer (its towers home up: the centre,
+    /// at the top of the build volume); `None` homes to 0 as a Cartesian
+    /// printer's endstops do.
+    pub delta_home: Option<[f64; 3]>,
+    /// The lines of the first 64 `G28` moves.
+    pub homing_lines: Vec<usize>,
 }
 
 /// Longest segment an arc is split into (mm): Marlin's
@@ -105,6 +111,8 @@ impl Default for Replayer {
             plane: 17,
             segments: Vec::new(),
             cannot_judge: None,
+            delta_home: None,
+            homing_lines: Vec::new(),
         }
     }
 }
@@ -296,10 +304,18 @@ impl Replayer {
             ('G', 28.0) => {
                 let any = ['X', 'Y', 'Z'].iter().any(|k| l.get(*k).is_some());
                 let mut to = self.pos;
-                for (a, k) in ['X', 'Y', 'Z'].into_iter().enumerate() {
-                    if !any || l.get(k).is_some() {
-                        to[a] = 0.0;
+                if let Some(home) = self.delta_home {
+                    // A delta homes all three towers at once.
+                    to = home;
+                } else {
+                    for (a, k) in ['X', 'Y', 'Z'].into_iter().enumerate() {
+                        if !any || l.get(k).is_some() {
+                            to[a] = 0.0;
+                        }
                     }
+                }
+                if self.homing_lines.len() < 64 {
+                    self.homing_lines.push(l.line);
                 }
                 let m = Move {
                     line: l.line,
