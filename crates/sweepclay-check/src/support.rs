@@ -770,8 +770,13 @@ impl Nearest<'_> {
                     !(best.is_some_and(|c| lb > c.d) || skip(b, lb))
                         || double.as_ref().is_some_and(|found| {
                             // A bead at the new bead's height, under its
-                            // middle, higher than any found so far.
-                            lb < 0.5 * cfg.width_min
+                            // middle, higher than any found so far; none
+                            // matters once one is found at the middle's
+                            // height (no gap is left), so clay stacked
+                            // at one height costs one find, not a walk of
+                            // the whole stack.
+                            found.is_none_or(|z| z < mid[2])
+                                && lb < 0.5 * cfg.width_min
                                 && f64::from(b.hi[2]) + slack
                                     > found.map_or(mid[2] - ml, |z| z.max(mid[2] - ml))
                                 && f64::from(b.lo[2]) - slack < mid[2] + ml
