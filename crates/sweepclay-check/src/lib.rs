@@ -52,7 +52,9 @@ pub use checker::{check, check_reader, CheckWriter};
 #[doc(hidden)]
 pub use checker::{check_exhaustive, check_pruned};
 pub use parse::Diagnostic;
-pub use report::{Count, Finding, Findings, Report, Segment, SupportStats, TURN_FACTOR};
+pub use report::{
+    Count, Finding, Findings, Report, Segment, SupportStats, OVERFLOW_SECTIONS, TURN_FACTOR,
+};
 
 /// One xorshift step: the unit tests' reproducible random numbers.
 #[cfg(test)]
