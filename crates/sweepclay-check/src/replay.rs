@@ -124,6 +124,35 @@ impl Replayer {
         self.segments.pop()
     }
 
+    /// Where a move's X Y Z take the nozzle (absolute or relative).
+    fn target(&self, l: &Line) -> [f64; 3] {
+        let mut to = self.pos;
+        for (a, k) in ['X', 'Y', 'Z'].into_iter().enumerate() {
+            if let Some(v) = l.get(k) {
+                to[a] = if self.abs_xyz {
+                    v * self.scale
+                } else {
+                    self.pos[a] + v * self.scale
+                };
+            }
+        }
+        to
+    }
+
+    /// A move's E change (absolute or relative E); its feedrate is kept.
+    fn take_e_and_feed(&mut self, l: &Line) -> f64 {
+        let mut de = 0.0;
+        if let Some(v) = l.get('E') {
+            let v = v * self.scale;
+            de = if self.abs_e { v - self.e } else { v };
+            self.e += de;
+        }
+        if let Some(f) = l.get('F') {
+            self.feed = f * self.scale;
+        }
+        de
+    }
+
     /// Notes the first line the replay cannot follow.
     fn cannot(&mut self, line: usize, why: String) {
         self.cannot_judge.get_or_insert((line, why));
@@ -144,16 +173,7 @@ impl Replayer {
             );
             return None;
         }
-        let mut to = self.pos;
-        for (a, k) in ['X', 'Y', 'Z'].into_iter().enumerate() {
-            if let Some(v) = l.get(k) {
-                to[a] = if self.abs_xyz {
-                    v * scale
-                } else {
-                    self.pos[a] + v * scale
-                };
-            }
-        }
+        let to = self.target(l);
         let (p1, q1, p2, q2) = (self.pos[0], self.pos[1], to[0], to[1]);
         let centre = match (l.get('I'), l.get('J'), l.get('R')) {
             (i, j, _) if i.is_some() || j.is_some() => {
@@ -200,15 +220,7 @@ impl Replayer {
         if travel == 0.0 && p1 == p2 && q1 == q2 {
             travel = std::f64::consts::TAU;
         }
-        let mut de = 0.0;
-        if let Some(v) = l.get('E') {
-            let v = v * scale;
-            de = if self.abs_e { v - self.e } else { v };
-            self.e += de;
-        }
-        if let Some(f) = l.get('F') {
-            self.feed = f * scale;
-        }
+        let de = self.take_e_and_feed(l);
         let length = (travel * radius).hypot(to[2] - self.pos[2]);
         if !length.is_finite() || radius > 1e6 {
             self.cannot(l.line, "an arc whose centre is not a number".into());
@@ -263,25 +275,8 @@ impl Replayer {
         let scale = self.scale;
         match (letter, l.code) {
             ('G', c) if c == 0.0 || c == 1.0 => {
-                let mut to = self.pos;
-                for (a, k) in ['X', 'Y', 'Z'].into_iter().enumerate() {
-                    if let Some(v) = l.get(k) {
-                        to[a] = if self.abs_xyz {
-                            v * scale
-                        } else {
-                            self.pos[a] + v * scale
-                        };
-                    }
-                }
-                let mut de = 0.0;
-                if let Some(v) = l.get('E') {
-                    let v = v * scale;
-                    de = if self.abs_e { v - self.e } else { v };
-                    self.e += de;
-                }
-                if let Some(f) = l.get('F') {
-                    self.feed = f * scale;
-                }
+                let to = self.target(l);
+                let de = self.take_e_and_feed(l);
                 let m = Move {
                     line: l.line,
                     from: self.pos,
