@@ -445,58 +445,6 @@ impl Design {
         }
         Ok(())
     }
-
-    /// The length of Ψ (mm) without resampling it: a spline flattened to
-    /// a few dozen points a span (its control polygon can be twice as
-    /// long as the curve), a polyline's own. NaN when a coordinate is not
-    /// a number.
-    pub fn trajectory_length(&self) -> f64 {
-        use crate::bspline::polyline_length as poly;
-        let t = &self.trajectory;
-        let pts = t.given_points();
-        match (&t.control_points, pts.len()) {
-            (Some(cp), m) if t.closed && m >= 3 => poly(&crate::curves::periodic_bspline(cp, 32)),
-            (Some(cp), m) if m >= 2 => crate::bspline::BSpline::clamped(cp.clone())
-                .map_or(poly(pts), |c| poly(&c.flatten(32))),
-            (None, m) if t.closed && m > 1 => poly(pts) + crate::bspline::dist(pts[m - 1], pts[0]),
-            _ => poly(pts),
-        }
-    }
-
-    /// A bound on the number of path points, from the curves without
-    /// sampling anything (a server refuses a design before it allocates
-    /// anything for it): columns (Ψ's length / spacing + 1) times the
-    /// samples a column can get — a wall's mean height over the layer
-    /// height (flat layers, the most the layering chooses), a vessel's
-    /// lowest (its spiral turns) — plus a vessel's floor rings, a pitch
-    /// apart over the control polygon's area. [`crate::estimated_samples`]
-    /// narrows it for walls. NaN when a coordinate is not a number
-    /// (slicing then names it).
-    pub fn samples_bound(&self) -> f64 {
-        let t = &self.trajectory;
-        let pts = t.given_points();
-        let p = &self.params;
-        let mut floor = 0.0;
-        if t.closed && pts.len() > 1 {
-            let area = 0.5 * crate::plane::signed_area2(pts).abs();
-            let pitch = p.width_min * (1.0 - FLOOR_OVERLAP);
-            let layers = p.floor_layers.unwrap_or(DEFAULT_FLOOR_LAYERS);
-            floor = 1.5 * area / (pitch * p.spacing) * f64::from(layers);
-        }
-        let top = |c: &CurveSpec| c.control_points.iter().map(|p| p[1]).fold(0.0, f64::max);
-        let (zs, zt) = (top(&self.profile_start), top(self.end_profile()));
-        let height = if t.closed {
-            zs.min(zt)
-        } else {
-            // The mean of λ(u) (0.5 for the default f(u) = u).
-            let f = crate::curves::Interpolation::new(self.interpolation.as_ref());
-            let mean = f.map_or(0.5, |f| {
-                (0..=64).map(|k| f.eval(k as f64 / 64.0)).sum::<f64>() / 65.0
-            });
-            (1.0 - mean) * zs + mean * zt
-        };
-        (self.trajectory_length() / p.spacing + 1.0) * (height / p.layer_height + 1.0) + floor
-    }
 }
 
 #[cfg(test)]
@@ -518,7 +466,7 @@ mod tests {
             let real = crate::slice(&d).unwrap().toolpath.points.len() as f64;
             let est = crate::estimated_samples(&d);
             assert!((est / real - 1.0).abs() < 0.2, "{name}: {est} vs {real}");
-            assert!(d.samples_bound() >= real, "{name}");
+            assert!(crate::samples_bound(&d) >= real, "{name}");
         }
         // A wall of about a million samples (once estimated at 2.2 M and
         // refused by the default cap of 1.5 M).

@@ -261,6 +261,62 @@ pub struct Sliced {
     pub stats: Stats,
 }
 
+/// The length of Ψ (mm) without resampling it: a spline flattened to
+/// a few dozen points a span (its control polygon can be twice as
+/// long as the curve), a polyline's own. NaN when a coordinate is not
+/// a number.
+pub fn trajectory_length(d: &Design) -> f64 {
+    use crate::bspline::polyline_length as poly;
+    let t = &d.trajectory;
+    let pts = t.given_points();
+    match (&t.control_points, pts.len()) {
+        (Some(cp), m) if t.closed && m >= 3 => poly(&crate::curves::periodic_bspline(cp, 32)),
+        (Some(cp), m) if m >= 2 => {
+            crate::bspline::BSpline::clamped(cp.clone()).map_or(poly(pts), |c| poly(&c.flatten(32)))
+        }
+        (None, m) if t.closed && m > 1 => poly(pts) + crate::bspline::dist(pts[m - 1], pts[0]),
+        _ => poly(pts),
+    }
+}
+
+/// A bound on the number of path points, from the curves without
+/// sampling anything (a server refuses a design before it allocates
+/// anything for it): columns (Ψ's length / spacing + 1) times the
+/// samples a column can get — a wall's mean height over the layer
+/// height (flat layers, the most the layering chooses), a vessel's
+/// lowest (its spiral turns) — plus a vessel's floor rings, a pitch
+/// apart over the control polygon's area. [`estimated_samples`]
+/// narrows it for walls. NaN when a coordinate is not a number
+/// (slicing then names it).
+pub fn samples_bound(d: &Design) -> f64 {
+    let t = &d.trajectory;
+    let pts = t.given_points();
+    let p = &d.params;
+    let mut floor = 0.0;
+    if t.closed && pts.len() > 1 {
+        let area = 0.5 * crate::plane::signed_area2(pts).abs();
+        let pitch = p.width_min * (1.0 - crate::design::FLOOR_OVERLAP);
+        let layers = p
+            .floor_layers
+            .unwrap_or(crate::design::DEFAULT_FLOOR_LAYERS);
+        floor = 1.5 * area / (pitch * p.spacing) * f64::from(layers);
+    }
+    let top =
+        |c: &crate::design::CurveSpec| c.control_points.iter().map(|p| p[1]).fold(0.0, f64::max);
+    let (zs, zt) = (top(&d.profile_start), top(d.end_profile()));
+    let height = if t.closed {
+        zs.min(zt)
+    } else {
+        // The mean of λ(u) (0.5 for the default f(u) = u).
+        let f = crate::curves::Interpolation::new(d.interpolation.as_ref());
+        let mean = f.map_or(0.5, |f| {
+            (0..=64).map(|k| f.eval(k as f64 / 64.0)).sum::<f64>() / 65.0
+        });
+        (1.0 - mean) * zs + mean * zt
+    };
+    (trajectory_length(d) / p.spacing + 1.0) * (height / p.layer_height + 1.0) + floor
+}
+
 /// Most columns the estimate samples a wall at (coarser than its spacing
 /// where it has more): enough to see its layering, far from its cost.
 const ESTIMATE_COLUMNS: f64 = 2000.0;
@@ -274,11 +330,11 @@ const ESTIMATE_SAMPLES: f64 = 200_000.0;
 /// slicing will choose it: tilted passes give every column the short
 /// end's count, flat ones each its own height's) times the columns at
 /// the design's spacing; for a vessel, or where that coarse sampling
-/// would be large or fails, [`Design::samples_bound`].
+/// would be large or fails, [`samples_bound`].
 pub fn estimated_samples(design: &Design) -> f64 {
     let d = design.printed();
-    let bound = d.samples_bound();
-    let length = d.trajectory_length();
+    let bound = samples_bound(&d);
+    let length = trajectory_length(&d);
     let columns = length / d.params.spacing + 1.0;
     let per_column = bound / columns;
     if d.trajectory.closed || !bound.is_finite() || !length.is_finite() {
