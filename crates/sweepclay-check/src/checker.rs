@@ -243,6 +243,8 @@ struct Turn {
     line: usize,
     clay: f64,
     rise: f64,
+    /// Path length of the steps (mm).
+    length: f64,
     before: f64,
 }
 
@@ -841,10 +843,12 @@ impl<'a> Checker<'a> {
                 line: m.line,
                 clay: 0.0,
                 rise: 0.0,
+                length: 0.0,
                 before: *last_width,
             });
             t.clay += volume;
             t.rise += rise;
+            t.length += len;
         } else if *deep {
             let mid = [
                 0.5 * (m.from[0] + m.to[0]),
@@ -1037,7 +1041,11 @@ impl<'a> Checker<'a> {
                 let need = std::f64::consts::PI / 8.0 * w * w * t.rise;
                 r.support.turn_clay_mm3[0] += t.clay;
                 r.support.turn_clay_mm3[1] += need;
-                if t.clay > TURN_FACTOR * need {
+                // Steep beads that carry the clay a millimetre of the bead
+                // after them (a climb along a sloping top edge) lay a bead,
+                // not a pile: only clay beyond both measures piles up.
+                let per_mm = volume / len.max(1e-9);
+                if t.clay > TURN_FACTOR * need && t.clay > TURN_FACTOR * per_mm * t.length {
                     pile = Some((t.line, t.clay / need));
                 }
             }
