@@ -1019,6 +1019,26 @@ fn an_end_code_that_drives_the_nozzle_into_the_piece_fails() {
     );
 }
 
+/// A zig-zag wall of 12 layers of `w` wide beads, `h` high, whose passes
+/// climb to the next layer back along the new pass at 1:2 (2 h along for
+/// h up), each climb laid as a bead `climb_w` wide.
+fn climbing_wall(w: f64, h: f64, climb_w: f64) -> G {
+    let mut g = G::new([50.0, 50.0, h]);
+    for k in 1..=12 {
+        let z = h * k as f64;
+        let (x0, x1, dir) = if k % 2 == 1 {
+            (50.0, 90.0, 1.0)
+        } else {
+            (90.0, 50.0, -1.0)
+        };
+        if k > 1 {
+            g.bead([x0 + dir * 2.0 * h, 50.0, z], climb_w, h);
+        }
+        g.run([x1, 50.0, z], w, h);
+    }
+    g
+}
+
 #[test]
 fn a_steep_bead_with_a_beads_clay_is_no_pile() {
     // A wall of 4.5 mm beads on 1.8 mm layers whose passes climb to the
@@ -1027,36 +1047,10 @@ fn a_steep_bead_with_a_beads_clay_is_no_pile() {
     // they made "more than twice the clay" (the half-disc a turn needs
     // is less than a bead's clay along a long slope).
     let (w, h) = (4.5, 1.8);
-    let mut g = G::new([50.0, 50.0, h]);
-    for k in 1..=12 {
-        let z = h * k as f64;
-        let (x0, x1, dir) = if k % 2 == 1 {
-            (50.0, 90.0, 1.0)
-        } else {
-            (90.0, 50.0, -1.0)
-        };
-        if k > 1 {
-            // The climb: back along the new pass while rising a layer.
-            g.bead([x0 + dir * 3.6, 50.0, z], w, h);
-        }
-        g.run([x1, 50.0, z], w, h);
-    }
-    let r = verdict(&g.out);
+    let r = verdict(&climbing_wall(w, h, w).out);
     assert_eq!(r.findings[Finding::TurnPile].count, 0, "{}", r.render());
     assert!(r.printable, "{}", r.render());
     // The same climbs carrying three times the clay do pile up.
-    let mut g = G::new([50.0, 50.0, h]);
-    for k in 1..=12 {
-        let z = h * k as f64;
-        let (x0, x1, dir) = if k % 2 == 1 {
-            (50.0, 90.0, 1.0)
-        } else {
-            (90.0, 50.0, -1.0)
-        };
-        if k > 1 {
-            g.bead([x0 + dir * 3.6, 50.0, z], 3.0 * w, h);
-        }
-        g.run([x1, 50.0, z], w, h);
-    }
+    let g = climbing_wall(w, h, 3.0 * w);
     assert!(verdict(&g.out).findings[Finding::TurnPile].count > 0);
 }

@@ -364,10 +364,7 @@ fn slice(a: SliceArgs) -> Result<i32> {
         point_lines,
     } = checked;
     drop((written, point_lines));
-    let reshaped = sliced
-        .corrected
-        .report
-        .reshaped(sliced.corrected.surface.params.max_correction_mm);
+    let reshaped = sliced.corrected.reshaped();
     let printer = &sliced.corrected.surface.printer;
     if let Some(p) = &a.preview {
         write_atomic(p, sweepclay_core::preview::svg(&sliced).as_bytes())?;

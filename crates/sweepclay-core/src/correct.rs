@@ -205,6 +205,15 @@ pub struct Corrected {
     pub report: CorrectionReport,
 }
 
+impl Corrected {
+    /// [`CorrectionReport::reshaped`] beyond the design's
+    /// `params.max_correction_mm`: the verdict's "printable, but
+    /// reshaped: …" words, if it gets them.
+    pub fn reshaped(&self) -> Option<String> {
+        self.report.reshaped(self.surface.params.max_correction_mm)
+    }
+}
+
 /// How the correction loop tightens the corrections where the pipeline's
 /// own check of the planned G-code failed (docs/ALGORITHMS.md §4, "The
 /// loop closes"). The default tightens nothing.

@@ -98,25 +98,21 @@ pub fn floor_plan(
     // out to a point: the last offset of a long polygon or lobed oval) is
     // laid once, as the line down its middle, instead of the ring and the
     // core inside it.
-    // A ring too fat somewhere for the widest bead down its middle stays
-    // (and is refused below).
     if let Some(k) = rings.iter().rposition(|r| !r.open) {
-        let fits = |pts: &[[f64; 2]]| {
-            midline(pts, beads.spacing)
-                .is_some_and(|(_, apart)| apart.iter().all(|t| t + beads.width <= beads.widest))
-        };
         if lies_on_itself(&rings[k].pts, pitch).is_some() {
-            if fits(&rings[k].pts) {
-                if let Some(line) = thin_ring_line(&rings[k].pts, beads) {
+            match midline(&rings[k].pts, beads.spacing) {
+                // Thin all along: laid once, down its middle.
+                Some(m) if m.1.iter().all(|t| t + beads.width <= beads.widest) => {
                     rings.truncate(k);
-                    rings.push(line);
+                    rings.push(line_of(m, beads));
                 }
-            } else {
                 // Fat in the middle: the ring stays, its tail's two sides
                 // laid narrower down to a U-turn of two pitches.
-                let r = &mut rings[k];
-                r.widths = narrowed_within(&r.pts, beads.width, 2.0 * pitch);
-                r.tail = true;
+                _ => {
+                    let r = &mut rings[k];
+                    r.widths = narrowed_within(&r.pts, beads.width, 2.0 * pitch);
+                    r.tail = true;
+                }
             }
         }
     }
@@ -415,18 +411,23 @@ pub struct FloorRing {
 /// floor's bead up to the widest, so that it meets the ring outside it
 /// with the stated overlap (docs/ALGORITHMS.md §8).
 fn thin_ring_line(ring: &[[f64; 2]], beads: FloorBeads) -> Option<FloorRing> {
-    let (pts, apart) = midline(ring, beads.spacing)?;
+    midline(ring, beads.spacing).map(|m| line_of(m, beads))
+}
+
+/// The open element of a [`midline`]: its points, each bead the sides'
+/// distance plus a bead wide, from the floor's bead up to the widest.
+fn line_of((pts, apart): (Vec<[f64; 2]>, Vec<f64>), beads: FloorBeads) -> FloorRing {
     let widths: Vec<f64> = apart
         .iter()
         .map(|t| (t + beads.width).clamp(beads.width, beads.widest.max(beads.width)))
         .collect();
     let wider = widths.iter().any(|&w| w > beads.width + 1e-9);
-    Some(FloorRing {
+    FloorRing {
         pts,
         open: true,
         widths: wider.then_some(widths),
         tail: false,
-    })
+    }
 }
 
 /// The line down the middle of a thin closed ring: between the point

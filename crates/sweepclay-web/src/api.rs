@@ -418,8 +418,7 @@ pub fn verified(design: &Design, cancel: &Cancel) -> Result<Verified, ApiError> 
     match slice_checked(design, 0.5, cancel, || Ok(Vec::new())) {
         Ok(c) => {
             let advice = c.advice();
-            let r = &c.sliced.corrected;
-            let reshaped = r.report.reshaped(r.surface.params.max_correction_mm);
+            let reshaped = c.sliced.corrected.reshaped();
             Ok(Verified {
                 gcode: String::from_utf8(c.out).expect("G-code is UTF-8"),
                 report: c.report,

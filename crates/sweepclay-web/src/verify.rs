@@ -372,10 +372,7 @@ pub fn verify_until(s: &Sliced, min_overlap: f64, cancel: &Cancel) -> io::Result
         report,
         locations,
         advice: Vec::new(),
-        reshaped: s
-            .corrected
-            .report
-            .reshaped(s.corrected.surface.params.max_correction_mm),
+        reshaped: s.corrected.reshaped(),
     })
 }
 

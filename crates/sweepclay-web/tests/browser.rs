@@ -206,13 +206,18 @@ async fn close_guide(c: &Client) {
 /// import's preview dialog; `shape` picks a shape (0: the first), then
 /// "Use this path" replaces the trajectory. Returns the dialog's count
 /// line.
-async fn import_file(c: &Client, file: &Path, shape: usize) -> String {
-    c.find(fantoccini::Locator::Id("import-file"))
+/// Chooses `file` in the page's file input `id`.
+async fn choose_file(c: &Client, id: &str, file: &Path) {
+    c.find(fantoccini::Locator::Id(id))
         .await
         .unwrap()
         .send_keys(file.to_str().unwrap())
         .await
         .unwrap();
+}
+
+async fn import_file(c: &Client, file: &Path, shape: usize) -> String {
+    choose_file(c, "import-file", file).await;
     wait_js(
         c,
         "return document.getElementById('import-dialog').open",
@@ -620,12 +625,7 @@ async fn draw_preview_and_download_verified_gcode() {
         "printer":"wasp-40100-clay"}"#,
     )
     .unwrap();
-    c.find(fantoccini::Locator::Id("open-file"))
-        .await
-        .unwrap()
-        .send_keys(flared.to_str().unwrap())
-        .await
-        .unwrap();
+    choose_file(&c, "open-file", &flared).await;
     let verdict = wait_js(
         &c,
         "const v = document.getElementById('verdict'); return window.sweepclay.design.name === 'flared pot' && !window.sweepclay.inFlight && !window.sweepclay.pending && v.classList.contains('warn') ? v.textContent : null",
