@@ -226,6 +226,27 @@ enum Rest {
     Air,
 }
 
+/// Consecutive beads overlapping the bead below by less than the least
+/// overlap, or resting over a layer gap ([`WEAK_KINDS`]). Shorter in all
+/// than half the narrowest bead, they are held up by the clay on either
+/// side (a slicer's seam bead a millimetre long, the end of a pass over
+/// the slope the pass below climbed); longer, each is a failure
+/// (docs/CHECKER.md, "Overlap", "Layer gaps").
+#[derive(Default)]
+struct Weak {
+    /// Their length in plan (mm).
+    length: f64,
+    /// The beads not yet recorded: line and value.
+    pending: Vec<(usize, f64)>,
+}
+
+/// The findings judged by stretches of [`Weak`] beads.
+const WEAK_KINDS: [Finding; 2] = [Finding::UnderMinOverlap, Finding::LayerGap];
+
+/// How much a ramp's gap or height may dip from one bead to the next
+/// (rounding in the file) and still rise (mm).
+const RAMP_SLACK_MM: f64 = 0.02;
+
 /// A stretch of consecutive beads laid on clay at their own height: their
 /// clay and the part of it that has no room (docs/CHECKER.md, "Clay on
 /// clay").
@@ -235,6 +256,14 @@ struct Stretch {
     length: f64,
     volume: f64,
     excess: f64,
+    /// The gap under its first and its last bead (mm).
+    first_gap: f64,
+    last_gap: f64,
+    /// Whether some bead of it lies lower than the one before, or on a
+    /// thinner gap: then it is no ramp.
+    falls: bool,
+    /// Height of its last bead's middle (mm).
+    last_z: f64,
 }
 
 /// Turnaround steps since the last bead: the first one's line, their
@@ -289,6 +318,9 @@ struct Checker<'a> {
     /// The last judged bead was a stub, and its overlap.
     prev_stub: bool,
     prev_overlap: f64,
+    /// Consecutive beads under the least overlap, and over a layer gap,
+    /// not yet recorded.
+    weak: [Weak; 2],
     beads: Vec<Bead>,
     /// `bent_before[k + 1]`: how many of beads `0..=k` are bent (a
     /// prefix count, so "any bent bead in this stretch?" is two loads).
@@ -355,6 +387,7 @@ impl<'a> Checker<'a> {
             stretch: Stretch::default(),
             prev_stub: false,
             prev_overlap: 0.0,
+            weak: Default::default(),
             beads: Vec::new(),
             bent_before: vec![0],
             grid: BeadGrid::new(cfg),
@@ -716,6 +749,17 @@ impl<'a> Checker<'a> {
         }
     }
 
+    /// Records the beads of a stretch under the least overlap, now that
+    /// it is long enough to fail ([`Weak`]).
+    fn flush_weak(&mut self, k: usize) {
+        let mut pending = std::mem::take(&mut self.weak[k].pending);
+        for &(line, v) in &pending {
+            self.record(WEAK_KINDS[k], line, v, false);
+        }
+        pending.clear();
+        self.weak[k].pending = pending;
+    }
+
     /// Ends a stretch of beads on clay at their own height: a failure if
     /// most of its clay had no room and it is longer than 2 w_max, or
     /// shorter — but at least 3/4 `w_min` long, more than a seam's last
@@ -724,12 +768,25 @@ impl<'a> Checker<'a> {
     /// one ring of a floor to the next laid as a full bead over both
     /// (docs/CHECKER.md, "Clay on clay"). A join carrying next to no clay
     /// across them is a smear, not a bead on a bead.
-    fn close_stretch(&mut self) {
+    ///
+    /// A *ramp* is neither: a stretch whose gap only grows, by at least
+    /// half the thinnest layer, and that the path leaves by a bead resting
+    /// on the clay below at least a thinnest layer up, a vase's first turn
+    /// rising from its flat loop, at any slope, width or lean (`climbs_out`:
+    /// the gap under the bead that ended the stretch, if it rests on clay).
+    fn close_stretch(&mut self, climbs_out: Option<f64>) {
         if self.stretch.length == 0.0 {
             return;
         }
         let st = std::mem::take(&mut self.stretch);
         let cfg = self.cfg;
+        let ramp = !st.falls
+            && st.last_gap - st.first_gap >= 0.5 * cfg.min_layer_mm
+            && climbs_out
+                .is_some_and(|g| g >= cfg.min_layer_mm && g <= st.last_gap + cfg.min_layer_mm);
+        if ramp {
+            return;
+        }
         let bead = cfg.width_min * cfg.min_layer_mm * st.length.max(cfg.width_min);
         let short = st.length >= 0.75 * cfg.width_min && st.excess > bead;
         if st.excess > 0.75 * st.volume && (st.length > 2.0 * cfg.width_max || short) {
@@ -759,8 +816,13 @@ impl<'a> Checker<'a> {
                 false,
             );
         }
-        // What it rests on, if its support was sought.
+        // For each of WEAK_KINDS, whether it was judged, and if so the
+        // bead's shortfall.
+        let mut weak_bead: [Option<Option<f64>>; 2] = [None; 2];
+        // What it rests on, if its support was sought, and the gap
+        // above what it rests on.
         let mut rest = None;
+        let mut rest_gap = f64::NAN;
         let Checker {
             r,
             beads,
@@ -791,7 +853,7 @@ impl<'a> Checker<'a> {
         // Its failures, recorded once the borrows below end (at most one
         // each of: no clay below, too little overlap, overhang, more clay
         // than fits).
-        let mut held = [(Finding::Unsupported, 0.0); 4];
+        let mut held = [(Finding::Unsupported, 0.0); 5];
         let mut n_held = 0;
         let mut hold = |kind, v| {
             held[n_held] = (kind, v);
@@ -867,6 +929,11 @@ impl<'a> Checker<'a> {
             // The shortcuts: along the pass below (`prev_support`), or on
             // the bare bed (a first layer: nothing below to follow).
             let near_bed = mid[2] <= cfg.first_layer_max_mm;
+            // The largest gap this bead's clay can stand in: as tall as
+            // it would then be wide, with the widths' tolerance.
+            let gap_limit = (section * (1.0 + WIDTH_TOLERANCE))
+                .sqrt()
+                .min(cfg.max_gap_mm);
             let fast = (*walk == Walk::Auto
                 && (prev_support.is_some() || near_bed)
                 && (recent.clear_of(m, mid, cfg.min_layer_mm, turn, xy)
@@ -901,7 +968,14 @@ impl<'a> Checker<'a> {
                 let room = len * gap * 2.0 * cfg.width_max;
                 if stretch.length == 0.0 {
                     stretch.first_line = m.line;
+                    stretch.first_gap = gap;
+                } else if gap < stretch.last_gap - RAMP_SLACK_MM
+                    || mid[2] < stretch.last_z - RAMP_SLACK_MM
+                {
+                    stretch.falls = true;
                 }
+                stretch.last_gap = gap;
+                stretch.last_z = mid[2];
                 stretch.length += len;
                 stretch.volume += volume;
                 stretch.excess += (volume - room).max(0.0);
@@ -936,6 +1010,20 @@ impl<'a> Checker<'a> {
                 Some(c) => {
                     let dz = mid[2] - c.z;
                     width = volume / (len * dz);
+                    // Taller than wide over the clay it rests on: the
+                    // bead does not stand (docs/CHECKER.md, "Layer gaps").
+                    // A stub (a blob joined to the bead before) and a
+                    // smear carry no bead of their own; a bead climbing
+                    // a thinnest layer or more climbs from the clay it
+                    // was just laid on (a finishing pass, a sloping edge).
+                    if xy >= 0.25 * cfg.width_min
+                        && rise < cfg.min_layer_mm
+                        && !crate::support::is_smear(width, cfg)
+                    {
+                        let over = dz > gap_limit
+                            && !crate::support::clay_within_gap(beads, grid, &q, gap_limit);
+                        weak_bead[1] = Some(over.then_some(dz));
+                    }
                     // A bead thinner than the one below it and wider (a
                     // vase's first turn rising from its flat loop), or
                     // wider than the widest bead, is pressed onto it and
@@ -959,6 +1047,7 @@ impl<'a> Checker<'a> {
                     (f64::NAN, f64::NAN, 0.0, 0.0)
                 }
             };
+            rest_gap = dz;
             // A bead into the bed has no layer height or width to speak of.
             if dz.is_finite() && low_z >= cfg.first_layer_min_mm {
                 height = dz;
@@ -1000,9 +1089,9 @@ impl<'a> Checker<'a> {
                     };
                     *prev_stub = stub;
                     *prev_overlap = overlap;
-                    if overlap < cfg.overlap_min - 1e-9 {
-                        hold(Finding::UnderMinOverlap, cfg.overlap_min - overlap);
-                    }
+                    weak_bead[0] = Some(
+                        (overlap < cfg.overlap_min - 1e-9).then_some(cfg.overlap_min - overlap),
+                    );
                     if overlap < cfg.overlap_target - 1e-6 {
                         r.support.under_target += 1;
                     }
@@ -1019,7 +1108,13 @@ impl<'a> Checker<'a> {
                             r.support.max_overhang_deg = Some((angle, m.line));
                         }
                         if angle > cfg.max_overhang_deg + cfg.overhang_tolerance_deg {
-                            hold(Finding::Overhang, angle);
+                            // Climbed to a bead beside it: judged by the
+                            // gentlest full-height bead under its middle.
+                            let lean = crate::support::gentlest_lean(beads, grid, &q, gap_limit);
+                            let angle = angle.min(lean.atan().to_degrees());
+                            if angle > cfg.max_overhang_deg + cfg.overhang_tolerance_deg {
+                                hold(Finding::Overhang, angle);
+                            }
                         }
                     }
                 }
@@ -1079,10 +1174,27 @@ impl<'a> Checker<'a> {
         bent_before.push(bent_before.last().copied().unwrap_or(0) + u32::from(bead.bent));
         beads.push(bead);
         if !on_clay && !step {
-            self.close_stretch();
+            let climbs_out = matches!(rest, Some(Rest::Bead(_))).then_some(rest_gap);
+            self.close_stretch(climbs_out);
         }
         for &(kind, v) in &held[..n_held] {
             self.record(kind, m.line, v, false);
+        }
+        for (k, judged) in weak_bead.into_iter().enumerate() {
+            match judged {
+                Some(Some(short)) => {
+                    self.weak[k].length += xy;
+                    self.weak[k].pending.push((m.line, short));
+                    if self.weak[k].length >= 0.5 * self.cfg.width_min {
+                        self.flush_weak(k);
+                    }
+                }
+                Some(None) => {
+                    self.weak[k].length = 0.0;
+                    self.weak[k].pending.clear();
+                }
+                None => {}
+            }
         }
         if let Some((line, ratio)) = pile {
             self.record(Finding::TurnPile, line, ratio, false);
@@ -1109,7 +1221,12 @@ impl<'a> Checker<'a> {
     }
 
     fn finish(mut self) -> Report {
-        self.close_stretch();
+        self.close_stretch(None);
+        for k in 0..WEAK_KINDS.len() {
+            if self.weak[k].length >= 0.5 * self.cfg.width_min {
+                self.flush_weak(k);
+            }
+        }
         if self.lead.print_run.is_none() {
             // Nothing rests on anything (a single layer): the print begins
             // at the first run that is not a purge in the air.

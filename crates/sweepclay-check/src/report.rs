@@ -64,6 +64,10 @@ pub enum Finding {
     CarriageCollision,
     /// A bead with no clay below it and not on the bed; its height (mm).
     Unsupported,
+    /// A bead resting on clay farther below it than the bead is wide: a
+    /// bead taller than wide does not stand, and clay two layers down is
+    /// no support (docs/CHECKER.md, "Layer gaps"); the worst gap (mm).
+    LayerGap,
     /// A stretch of beads laid on clay at their own height whose clay has
     /// no room to go; the clay that has none (mm³).
     DoubleDeposition,
@@ -99,7 +103,7 @@ pub const TURN_FACTOR: f64 = 2.0;
 
 impl Finding {
     /// Every kind, in the order reports list them.
-    pub const ALL: [Finding; 17] = [
+    pub const ALL: [Finding; 18] = [
         Finding::TravelMove,
         Finding::Retraction,
         Finding::Pause,
@@ -110,6 +114,7 @@ impl Finding {
         Finding::NozzleCollision,
         Finding::CarriageCollision,
         Finding::Unsupported,
+        Finding::LayerGap,
         Finding::DoubleDeposition,
         Finding::UnderMinOverlap,
         Finding::Overhang,
@@ -132,6 +137,7 @@ impl Finding {
             Finding::NozzleCollision => "nozzle collisions (mm)",
             Finding::CarriageCollision => "carriage collisions (mm)",
             Finding::Unsupported => "unsupported beads",
+            Finding::LayerGap => "layer gaps (mm)",
             Finding::DoubleDeposition => "clay on clay (mm³)",
             Finding::UnderMinOverlap => "overlap < minimum",
             Finding::Overhang => "overhang > limit (deg)",
@@ -155,6 +161,9 @@ impl Finding {
             Finding::NozzleCollision => "nozzle collision(s) with printed clay",
             Finding::CarriageCollision => "carriage collision(s) with printed clay",
             Finding::Unsupported => "bead(s) with no clay below",
+            Finding::LayerGap => {
+                "bead(s) resting on clay farther below than they are wide (clay two layers down is no support)"
+            }
             Finding::DoubleDeposition => "stretch(es) of beads laid on clay at their own height",
             Finding::UnderMinOverlap => "bead(s) overlapping the bead below by less than half",
             Finding::Overhang => "overhang(s) beyond the limit",
@@ -387,6 +396,7 @@ impl Report {
                 || !matches!(
                     f,
                     Finding::IntoBed
+                        | Finding::LayerGap
                         | Finding::FirstLayerHigh
                         | Finding::AmbiguousNumber
                         | Finding::UnreadableNumber

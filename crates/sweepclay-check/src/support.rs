@@ -496,6 +496,53 @@ fn nearer_below(beads: &[Bead], grid: &BeadGrid, q: &Query, best: &Candidate) ->
     )
 }
 
+/// The gentlest lean over any bead below that covers the new bead's
+/// middle within `max_gap`: the least offset / height ratio (height the
+/// larger of the gap and that bead's own). Asked only of a bead about to
+/// fail the overhang limit, whose support the walk of [`pick_support`]
+/// climbed to: a bead pressed on a thin top-edge bead beside it may still
+/// sit squarely on the full bead under its middle (docs/CHECKER.md,
+/// "Overhang").
+pub(crate) fn gentlest_lean(beads: &[Bead], grid: &BeadGrid, q: &Query, max_gap: f64) -> f64 {
+    let (mid, cfg) = (q.mid, q.cfg);
+    let mut best = f64::INFINITY;
+    let r = cfg.width_max;
+    grid.in_box(mid, r, mid[2] - max_gap, mid[2] - cfg.min_layer_mm, |run| {
+        for j in run.first..=run.last {
+            if let Class::Below(c) = q.classify(&beads[j as usize], j) {
+                let dz = mid[2] - c.z;
+                if c.covers && dz <= max_gap {
+                    best = best.min(c.d / dz.max(c.height));
+                }
+            }
+        }
+    });
+    best
+}
+
+/// Whether any clay laid before the new bead, however recently, lies
+/// under its middle between a thinnest layer and `gap` below it: a bead
+/// with such clay under it is no bead over a layer gap, whatever the
+/// support walk settled on (docs/CHECKER.md, "Layer gaps"). Asked only
+/// of a bead about to fail for its gap.
+pub(crate) fn clay_within_gap(beads: &[Bead], grid: &BeadGrid, q: &Query, gap: f64) -> bool {
+    let (mid, cfg) = (q.mid, q.cfg);
+    let (lo, hi) = (mid[2] - gap, mid[2] - cfg.min_layer_mm);
+    let mut found = false;
+    grid.in_box(mid, cfg.width_max, lo, hi, |run| {
+        found = found
+            || (run.first..=run.last).any(|j| {
+                let b = &beads[j as usize];
+                if b.step || b.s_end >= q.s_start - 1e-9 || is_smear(b.width(), cfg) {
+                    return false;
+                }
+                let (d, z, _) = b.closest(mid);
+                z >= lo && z <= hi && d <= b.width() / 2.0
+            });
+    });
+    found
+}
+
 /// Whether a bead lies at the new bead's own height under its middle
 /// ([`Class::Double`]): asked of the beads themselves where a cell too
 /// coarse to tell holds clay that high near it (beside the rings of a

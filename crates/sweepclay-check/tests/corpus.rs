@@ -108,7 +108,7 @@ fn each_hand_made_fault_fails_for_its_fault() {
         (
             "fault-bed-drag.gcode",
             "into the bed",
-            &["overlapping the bead below"][..],
+            &["overlapping the bead below", "farther below"][..],
         ),
         (
             "fault-overhang.gcode",

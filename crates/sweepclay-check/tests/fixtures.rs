@@ -640,7 +640,11 @@ fn a_first_bead_from_the_bed_fails_as_dragged() {
         g.run([b, 50.0, z], W, LAYER);
     }
     let r = verdict(&g.out);
-    fails_for(&r, "into the bed", &["overlapping the bead below"]);
+    fails_for(
+        &r,
+        "into the bed",
+        &["overlapping the bead below", "farther below"],
+    );
     // Beads into the bed have no layer height or width to report.
     let [(lo, _), _] = r.support.layer_height.unwrap();
     assert!(lo > 0.0, "{}", r.render());
@@ -1053,4 +1057,89 @@ fn a_steep_bead_with_a_beads_clay_is_no_pile() {
     // The same climbs carrying three times the clay do pile up.
     let g = climbing_wall(w, h, 3.0 * w);
     assert!(verdict(&g.out).findings[Finding::TurnPile].count > 0);
+}
+
+/// A zig-zag wall of 10 layers whose pass 6, between x = 60 and 80,
+/// swerves `off` mm sideways; pass 7 runs straight back over the swerve.
+fn swerving_wall(off: f64) -> G {
+    let mut g = G::new([50.0, 50.0, LAYER]);
+    for k in 1..=10 {
+        let z = LAYER * k as f64;
+        let (x0, x1) = if k % 2 == 1 {
+            (50.0, 90.0)
+        } else {
+            (90.0, 50.0)
+        };
+        if k > 1 {
+            g.bead([x0, 50.0, z], W, LAYER);
+        }
+        if k == 6 {
+            g.run([80.0, 50.0, z], W, LAYER);
+            g.bead([79.0, 50.0 + off, z], W, LAYER);
+            g.run([61.0, 50.0 + off, z], W, LAYER);
+            g.bead([60.0, 50.0, z], W, LAYER);
+        }
+        g.run([x1, 50.0, z], W, LAYER);
+    }
+    g
+}
+
+#[test]
+fn a_pass_over_clay_two_layers_down_fails_for_its_layer_gap() {
+    // Pass 6 swerves 6 mm off the wall (a bead with nothing below: its
+    // own failure); pass 7 runs straight back over the swerve, where the
+    // clay below it is pass 5's, two layers (2.4 mm) down: 3.2 mm beads
+    // carrying 1.2 mm layers of clay cannot stand 2.4 mm tall. It used to
+    // pass with a warning about thin beads.
+    let r = verdict(&swerving_wall(6.0).out);
+    fails_for(
+        &r,
+        "farther below than they are wide",
+        &["no clay below", "overlapping the bead below", "overhang"],
+    );
+    let gap = &r.findings[Finding::LayerGap];
+    assert!(gap.count >= 15, "{}", r.render());
+    let (worst, _) = gap.worst.unwrap();
+    assert!((worst - 2.0 * LAYER).abs() < 0.05, "{}", r.render());
+    // The same wall with the swerve half a bead wide: pass 6 still under
+    // pass 7 everywhere, no layer gap.
+    let r = verdict(&swerving_wall(1.0).out);
+    assert!(r.printable, "{}", r.render());
+    assert_eq!(r.findings[Finding::LayerGap].count, 0);
+}
+
+/// A spiral vase of radius 30 mm: a flat first loop 2.5 mm up, then
+/// `turns` turns rising `pitch` each, beads `w` wide carrying
+/// `pitch`-high layers.
+fn helix(pitch: f64, w: f64, turns: usize) -> G {
+    let first = 2.5;
+    let mut g = G::new([130.0, 100.0, first]);
+    let n = 90;
+    for i in 1..=n * (turns + 1) {
+        let a = std::f64::consts::TAU * i as f64 / n as f64;
+        let rise = (i.saturating_sub(n)) as f64 / n as f64;
+        g.bead(
+            [
+                100.0 + 30.0 * a.cos(),
+                100.0 + 30.0 * a.sin(),
+                first + pitch * rise,
+            ],
+            w,
+            pitch,
+        );
+    }
+    g
+}
+
+#[test]
+fn a_helix_of_layers_taller_than_its_beads_are_wide_fails() {
+    // 5 mm layers from 3 mm beads: each turn is a coil taller than wide
+    // on the turn below; it used to pass.
+    let r = verdict(&helix(5.0, 3.0, 8).out);
+    only(&r, "farther below than they are wide");
+    let (worst, _) = r.findings[Finding::LayerGap].worst.unwrap();
+    assert!(worst > 4.9, "{}", r.render());
+    // 2.5 mm layers of the same beads stand.
+    let r = verdict(&helix(2.5, 3.0, 8).out);
+    assert!(r.printable, "{}", r.render());
 }
