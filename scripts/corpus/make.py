@@ -3,7 +3,8 @@
 
 Small clay designs (a bulging vase and a ripple vase as STL meshes, an open
 wall) are sliced by the tools potters use today, with clay settings
-(1.25 mm layers, 3 mm beads):
+(1.25 mm layers, 3 mm beads; a leaning bowl with 1.8 mm layers and
+4.5 mm beads):
 
 - CuraEngine (Debian `cura-engine`, spiralize; its setting definitions come
   from Debian's `cura` package, unpacked, never installed),
@@ -95,11 +96,11 @@ def cura_definitions(tmp):
     return os.path.join(tmp, "cura", "usr", "share", "cura", "resources", "definitions")
 
 
-def cura_settings():
+def cura_settings(layer=LAYER, width=WIDTH):
     """CuraEngine's clay settings for a spiralized vase."""
     return [
-        "magic_spiralize=true", f"layer_height={LAYER}", f"layer_height_0={LAYER}",
-        f"line_width={WIDTH}", f"machine_nozzle_size={WIDTH}",
+        "magic_spiralize=true", f"layer_height={layer}", f"layer_height_0={layer}",
+        f"line_width={width}", f"machine_nozzle_size={width}",
         f"material_diameter={FEED_DIA}", "bottom_layers=0", "top_layers=0",
         "wall_line_count=1", "infill_sparse_density=0", "adhesion_type=skirt",
         "skirt_line_count=1", "skirt_gap=6", "speed_print=30", "speed_wall_0=30",
@@ -108,17 +109,17 @@ def cura_settings():
         "meshfix_maximum_resolution=1.5",
         # CuraEngine's command line takes the definitions' default values,
         # not their formulas: the settings derived from the above, stated.
-        f"wall_line_width_0={WIDTH}", f"wall_line_width_x={WIDTH}",
-        f"skirt_brim_line_width={WIDTH}", f"skin_line_width={WIDTH}",
-        f"infill_line_width={WIDTH}", "top_thickness=0", "bottom_thickness=0",
+        f"wall_line_width_0={width}", f"wall_line_width_x={width}",
+        f"skirt_brim_line_width={width}", f"skin_line_width={width}",
+        f"infill_line_width={width}", "top_thickness=0", "bottom_thickness=0",
         "top_bottom_thickness=0", "initial_bottom_layers=0", "infill_line_distance=0",
         "roofing_layer_count=0", "speed_layer_0=30", "speed_print_layer_0=30",
         "speed_travel=60", "retraction_hop_enabled=false",
     ]
 
 
-def cura(stl, out, defs):
-    clay = cura_settings()
+def cura(stl, out, defs, layer=LAYER, width=WIDTH):
+    clay = cura_settings(layer, width)
     cmd = ["CuraEngine", "slice", "-j", os.path.join(defs, "fdmprinter.def.json")]
     for s in clay:
         cmd += ["-s", s]
@@ -139,12 +140,12 @@ PRUSA_START = (
 )
 
 
-def prusa(tool, stl, out, tmp):
+def prusa(tool, stl, out, tmp, layer=LAYER, width=WIDTH):
     cmd = [
         tool, "--export-gcode" if tool == "prusa-slicer" else "--gcode-comments",
-        "--spiral-vase", "--perimeters", "1", "--layer-height", str(LAYER),
-        "--first-layer-height", str(LAYER), "--nozzle-diameter", str(WIDTH),
-        "--extrusion-width", str(WIDTH), "--first-layer-extrusion-width", str(WIDTH),
+        "--spiral-vase", "--perimeters", "1", "--layer-height", str(layer),
+        "--first-layer-height", str(layer), "--nozzle-diameter", str(width),
+        "--extrusion-width", str(width), "--first-layer-extrusion-width", str(width),
         "--filament-diameter", str(FEED_DIA), "--bottom-solid-layers", "0",
         "--top-solid-layers", "0", "--skirts", "0", "--fill-density", "0",
         "--center" if tool == "prusa-slicer" else "--print-center", "100,100", "--bed-shape", "0x0,200x0,200x200,0x200",
@@ -161,6 +162,28 @@ def prusa(tool, stl, out, tmp):
             f.write("start_gcode = G28 ; home\\nG1 Z5 F5000\\nG92 E0\\nG1 F200 E3 ; prime\\nG92 E0\n")
         cmd[1:1] = ["--load", ini]
     run(cmd)
+
+
+def bowl_r(z, t):
+    """The leaning bowl: 36 mm tall, radius 25 mm at the foot, its wall
+    leaning 35° out from the vertical."""
+    return 25 + z * math.tan(math.radians(35))
+
+
+BOWL_LAYER = 1.8  # mm: wide, thick clay lines, as potters print bowls
+BOWL_WIDTH = 4.5
+
+
+def lean_files(tmp, defs):
+    """Leaning vase starts: the 35° bowl with 4.5 mm lines on 1.8 mm
+    layers, spiralized by each slicer. Their first turn rises from the
+    flat first loop over a wall that leans out."""
+    bowl = os.path.join(tmp, "bowl.stl")
+    write_stl(bowl, bowl_r, 36, 20, 64)
+    lw = dict(layer=BOWL_LAYER, width=BOWL_WIDTH)
+    cura(bowl, os.path.join(OUT, "cura-bowl.gcode"), defs, **lw)
+    prusa("prusa-slicer", bowl, os.path.join(OUT, "prusa-bowl.gcode"), tmp, **lw)
+    prusa("slic3r", bowl, os.path.join(OUT, "slic3r-bowl.gcode"), tmp, **lw)
 
 
 def fullcontrol_files():
@@ -336,6 +359,7 @@ def main():
         defs = cura_definitions(tmp)
         cura(vase, os.path.join(OUT, "cura-vase.gcode"), defs)
         cura(ripple, os.path.join(OUT, "cura-ripple.gcode"), defs)
+        lean_files(tmp, defs)
         prusa("prusa-slicer", vase, os.path.join(OUT, "prusa-vase.gcode"), tmp)
         prusa("prusa-slicer", ripple, os.path.join(OUT, "prusa-ripple.gcode"), tmp)
         prusa("slic3r", vase, os.path.join(OUT, "slic3r-vase.gcode"), tmp)

@@ -243,6 +243,10 @@ struct Weak {
 /// The findings judged by stretches of [`Weak`] beads.
 const WEAK_KINDS: [Finding; 2] = [Finding::UnderMinOverlap, Finding::LayerGap];
 
+/// Widths are read only from gaps of at least this many thinnest layers
+/// (docs/CHECKER.md, "Numbers").
+const WIDTH_GAP_LAYERS: f64 = 2.0;
+
 /// How much a ramp's gap or height may dip from one bead to the next
 /// (rounding in the file) and still rise (mm).
 const RAMP_SLACK_MM: f64 = 0.02;
@@ -1053,9 +1057,17 @@ impl<'a> Checker<'a> {
                 height = dz;
                 layer_heights.push(dz);
                 minmax(&mut r.support.layer_height, dz, m.line);
-                minmax(&mut r.support.width, width, m.line);
+                // A gap under two thinnest layers (a vase ramp's first
+                // millimetres) gives a width no one could measure on the
+                // print (24 mm for 4.5 mm lines): left out of the figures.
+                let measurable = dz >= WIDTH_GAP_LAYERS * cfg.min_layer_mm;
+                if measurable {
+                    minmax(&mut r.support.width, width, m.line);
+                }
                 if width > cfg.width_max * (1.0 + WIDTH_TOLERANCE) {
-                    r.support.wide.add(m.line, width);
+                    if measurable {
+                        r.support.wide.add(m.line, width);
+                    }
                 } else if width < cfg.width_min * (1.0 - WIDTH_TOLERANCE) {
                     r.support.thin.add(m.line, cfg.width_min - width);
                 }

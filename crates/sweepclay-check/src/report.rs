@@ -328,7 +328,8 @@ pub struct Report {
     pub time_min: f64,
     /// Size of the extruded part (mm).
     pub size_mm: [f64; 3],
-    /// Estimated layer count: height over the median layer height.
+    /// Estimated layer count: height over the median layer height; 0 when
+    /// no bead rests on another (the report then says so).
     pub layers: usize,
     /// Set when the file holds a command the replay cannot follow as
     /// firmware would (an arc in another plane, with no centre, or with
@@ -484,8 +485,15 @@ impl Report {
             &mut s,
             "size",
             format!(
-                "{:.1} x {:.1} x {:.1} mm, ~{} layers",
-                self.size_mm[0], self.size_mm[1], self.size_mm[2], self.layers
+                "{:.1} x {:.1} x {:.1} mm, {}",
+                self.size_mm[0],
+                self.size_mm[1],
+                self.size_mm[2],
+                match self.layers {
+                    // No bead rests on another: no layer height to count by.
+                    0 => "layers not counted (no bead rests on another)".to_string(),
+                    n => format!("~{n} layers"),
+                }
             ),
         );
         row(

@@ -577,17 +577,15 @@ fn vase(turns: usize) -> G {
 #[test]
 fn a_seam_and_a_vase_ramp_at_full_flow_are_normal_printing() {
     // The flat loop's last bead ends on its first; the spiral's first turn
-    // rises from 0 to one layer over it at full flow (over-squished at
-    // first: a warning, not a failure).
+    // rises from 0 to one layer over it at full flow. Its first
+    // millimetres, on gaps under two thinnest layers, give no width a
+    // person could measure (up to 13 mm here): the figures leave them out.
     let r = verdict(&vase(12).out);
     assert!(r.printable, "{}", r.render());
     assert!(r.support.on_clay > 0, "{}", r.render());
-    assert!(r.support.wide.count > 0, "{}", r.render());
-    assert!(
-        r.warnings.iter().any(|w| w.contains("over-squished")),
-        "{:?}",
-        r.warnings
-    );
+    let [_, (widest, _)] = r.support.width.unwrap();
+    assert!(widest < 2.0 * W + 0.1, "{}", r.render());
+    assert_eq!(r.support.wide.count, 0, "{}", r.render());
 }
 
 #[test]
