@@ -694,7 +694,7 @@ mod tests {
         let c = correct(&sample_surface(&d).unwrap()).unwrap();
         assert!(c.report.support.is_empty(), "{:?}", c.report.summary());
         d.params.layer_height = 2.0;
-        d.params.max_layer_height = 4.0;
+        d.params.max_layer_height = 3.75;
         let c = correct(&sample_surface(&d).unwrap()).unwrap();
         let f = &c.report.support[0];
         assert!(

@@ -143,6 +143,11 @@ pub struct Params {
     pub max_correction_mm: f64,
 }
 
+/// The tallest layer a design may ask for, in narrowest bead widths: the
+/// checker's largest gap, a bead as tall as it is wide with the widths'
+/// 25 % tolerance (docs/CHECKER.md, "Layer gaps").
+pub const TALLEST_BEAD: f64 = 1.25;
+
 /// Floor layers of a vessel when `params.floor_layers` is omitted.
 pub const DEFAULT_FLOOR_LAYERS: u32 = 2;
 
@@ -209,6 +214,18 @@ impl Params {
             10_000.0,
         )?;
         range("params.width_max", self.width_max, self.width_min, 50.0)?;
+        // A bead taller than it is wide does not stand: the checker fails
+        // it as a layer gap (docs/CHECKER.md, "Layer gaps").
+        let tallest = TALLEST_BEAD * self.width_min;
+        if self.max_layer_height > tallest + 1e-9 {
+            return Err(Error::invalid(
+                "params.max_layer_height",
+                format!(
+                    "must be at most {TALLEST_BEAD} × width_min = {tallest:.3} mm: a bead taller than it is wide does not stand (got {}; raise width_min or lower max_layer_height)",
+                    self.max_layer_height
+                ),
+            ));
+        }
         range("params.overlap", self.overlap, 0.5, 0.95)?;
         range("params.max_overhang_deg", self.max_overhang_deg, 1.0, 80.0)?;
         range("params.feedrate", self.feedrate, 1.0, 100_000.0)?;

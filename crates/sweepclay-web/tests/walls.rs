@@ -125,7 +125,9 @@ proptest! {
             "sweepclay": 1, "name": "random wall",
             "profile_start": profile(pk, h, pa),
             "trajectory": trajectory(tk, size, ta, turns),
-            "params": { "layer_height": lh, "max_layer_height": 2.0 * lh, "width_min": w, "width_max": 2.0 * w },
+            // Layers no taller than a bead is wide: a taller bead does not
+            // stand, and such a design is refused by name (below).
+            "params": { "layer_height": lh, "max_layer_height": (2.0 * lh).min(1.25 * w), "width_min": w, "width_max": 2.0 * w },
             "printer": printer,
         });
         if let Some((ek, scale, ea)) = end {
