@@ -12,6 +12,15 @@ use crate::CheckConfig;
 pub(crate) const CELL_XY: f64 = 4.0;
 pub(crate) const CELL_Z: f64 = 2.0;
 
+/// Passes of the path through one cell that a question reads, newest
+/// first. A clay print lays a few in a 4 × 4 × 2 mm cell (beads of 1.5 mm
+/// and more, layers of 0.3 mm and more: a dozen); more is clay stacked
+/// at one place (the same ring laid hundreds of times), which fails
+/// as clay on clay from its second pass. Reading only the newest keeps
+/// every question's cost bounded, so such a file checks in linear time
+/// (docs/CHECKER.md, "Bounded cost").
+pub(crate) const MAX_CELL_RUNS: usize = 64;
+
 /// Cells are indexed over the build volume with a margin of this many
 /// cells a side; clay beyond is counted in the border cells, whose lists
 /// only grow by it (every reader tests each bead's geometry).
@@ -232,9 +241,14 @@ impl BeadGrid {
                 let column = &self.columns[y * self.dims[0] as usize + x];
                 for &head in column.get(zs[0]..zs[1] + 1).unwrap_or_default() {
                     let mut e = head;
+                    let mut n = 0;
                     while let Some(run) = self.links.get(e as usize) {
+                        if n == MAX_CELL_RUNS {
+                            break;
+                        }
                         f(run);
                         e = run.next;
+                        n += 1;
                     }
                 }
             }
