@@ -210,11 +210,24 @@ def fullcontrol_files():
                 steps.append(fc.Point(x=x, y=6 * math.sin(x / 8), z=z))
         return steps
 
+    def tall_steps():
+        # A helix of 5 mm layers in 3 mm beads: each turn a coil taller
+        # than it is wide on the turn below (fault-tall-layers).
+        steps = []
+        seg, pitch = 64, 5.0
+        for i in range(seg * 7 + 1):
+            t = 2 * math.pi * i / seg
+            z = 2.5 + pitch * max(0.0, (i - seg) / seg)
+            steps.append(fc.Point(x=22 * math.cos(t), y=22 * math.sin(t), z=z))
+        return steps
+
     settings = {"extrusion_width": WIDTH, "extrusion_height": LAYER, "print_speed": 1200}
-    for name, steps in [("fullcontrol-vase", vase_steps(vase_r, 50)),
-                        ("fullcontrol-wall", wall_steps())]:
+    tall = {"extrusion_width": WIDTH, "extrusion_height": 5.0, "print_speed": 1200}
+    for name, steps, init in [("fullcontrol-vase", vase_steps(vase_r, 50), settings),
+                              ("fullcontrol-wall", wall_steps(), settings),
+                              ("fault-tall-layers", tall_steps(), tall)]:
         text = fc.transform(steps, "gcode", fc.GcodeControls(printer_name="wasp2040clay",
-                                                               initialization_data=settings),
+                                                               initialization_data=init),
                             show_tips=False)
         with open(os.path.join(OUT, name + ".gcode"), "w") as f:
             f.write(text)
@@ -294,6 +307,12 @@ def edits():
     i = mid_index(p, 25.0)
     p[i:i] = ["G1 Z35 F3000 ; travel away", "G1 X150 Y150", "G1 X100 Y100", "G1 Z25.0"]
     save("travel", p)
+    # Relative E switched on half way through an absolute-E file (Prusa
+    # vase): each running total is read as one move's clay.
+    p = load("prusa-vase")
+    i = mid_index(p, 25.0)
+    p[i:i] = ["M83 ; relative extrusion from here"]
+    save("m83", p)
     # A pause in the middle (Cura vase).
     c = load("cura-vase")
     i = mid_index(c, 20.0)

@@ -898,8 +898,9 @@ impl<'a> Checker<'a> {
         // OVERFLOW_SECTIONS widest beads of half their width in height
         // (E switched to relative half way, a lost G92).
         let section = volume / len.max(1e-9);
-        if !step && section > crate::report::OVERFLOW_SECTIONS * 0.5 * cfg.width_max * cfg.width_max
-        {
+        let overflow = !step
+            && section > crate::report::OVERFLOW_SECTIONS * 0.5 * cfg.width_max * cfg.width_max;
+        if overflow {
             hold(Finding::ClayOverflow, section);
         }
         let mut on_clay = false;
@@ -1060,7 +1061,9 @@ impl<'a> Checker<'a> {
                 // A gap under two thinnest layers (a vase ramp's first
                 // millimetres) gives a width no one could measure on the
                 // print (24 mm for 4.5 mm lines): left out of the figures.
-                let measurable = dz >= WIDTH_GAP_LAYERS * cfg.min_layer_mm;
+                // Nor does clay that cannot fit under the nozzle (its
+                // own failure): a 23 m bead is no figure.
+                let measurable = dz >= WIDTH_GAP_LAYERS * cfg.min_layer_mm && !overflow;
                 if measurable {
                     minmax(&mut r.support.width, width, m.line);
                 }

@@ -17,7 +17,7 @@ fn corpus() -> PathBuf {
 
 /// The printer a file was made for, from the corpus's printer files.
 fn printer(file: &str) -> CheckConfig {
-    let name = if file.starts_with("fullcontrol") {
+    let name = if file.starts_with("fullcontrol") || file == "fault-tall-layers.gcode" {
         "wasp-2040.json"
     } else {
         "clay-200.json"
@@ -126,6 +126,14 @@ fn each_hand_made_fault_fails_for_its_fault() {
             &[][..],
         ),
         ("fault-turn-pile.gcode", "piles up at the turn", &[][..]),
+        // FullControl's helix of 5 mm layers in 3 mm beads.
+        (
+            "fault-tall-layers.gcode",
+            "farther below than they are wide",
+            &[][..],
+        ),
+        // `M83` half way through PrusaSlicer's absolute-E vase.
+        ("fault-m83.gcode", "more clay than fits", &[][..]),
     ] {
         println!("{file}");
         let r = report(file);
