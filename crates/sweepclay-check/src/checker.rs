@@ -1294,7 +1294,25 @@ impl<'a> Checker<'a> {
         if unreadable.count > 0 {
             r.findings[Finding::UnreadableNumber] = unreadable.clone();
         }
-        let (lo, hi) = (self.lo, self.hi);
+        // The size of the piece a person measures: the print's beads,
+        // not a purge line or skirt of the start code beside it.
+        let first = self
+            .lead
+            .print_run
+            .and_then(|k| self.lead.runs.get(k))
+            .map_or(0, |run| run.first_bead as usize);
+        let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
+        for b in self.beads.get(first..).unwrap_or_default() {
+            for p in [b.from(), b.to()] {
+                for a in 0..3 {
+                    lo[a] = lo[a].min(p[a]);
+                    hi[a] = hi[a].max(p[a]);
+                }
+            }
+        }
+        if hi[0] < lo[0] {
+            (lo, hi) = (self.lo, self.hi);
+        }
         if r.extruding_moves > 0 {
             r.size_mm = [hi[0] - lo[0], hi[1] - lo[1], hi[2].max(0.0)];
         }

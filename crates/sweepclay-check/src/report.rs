@@ -326,7 +326,8 @@ pub struct Report {
     pub volume_ml: f64,
     /// Time from the feedrates, all moves (min).
     pub time_min: f64,
-    /// Size of the extruded part (mm).
+    /// Size of the print (mm): its beads' centrelines from its first bead
+    /// on, start code beside it left out; z is the highest bead's.
     pub size_mm: [f64; 3],
     /// Estimated layer count: height over the median layer height; 0 when
     /// no bead rests on another (the report then says so).
