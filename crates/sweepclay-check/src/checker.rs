@@ -765,13 +765,13 @@ impl<'a> Checker<'a> {
     }
 
     /// Ends a stretch of beads on clay at their own height: a failure if
-    /// most of its clay had no room and it is longer than 2 w_max, or
-    /// shorter — but at least 3/4 `w_min` long, more than a seam's last
-    /// bead — laying a bead's clay (more than a `w_min`-wide bead of
-    /// `min_layer_mm` a millimetre, over at least `w_min`): the step from
-    /// one ring of a floor to the next laid as a full bead over both
-    /// (docs/CHECKER.md, "Clay on clay"). A join carrying next to no clay
-    /// across them is a smear, not a bead on a bead.
+    /// most of its clay had no room, it is at least 3/4 `w_min` long (more
+    /// than a seam's last bead) and its excess is a bead's clay (more
+    /// than a `w_min`-wide bead of `min_layer_mm` a millimetre, over at
+    /// least `w_min`): a pass laid again, or the step from one ring of a
+    /// floor to the next laid as a full bead over both (docs/CHECKER.md,
+    /// "Clay on clay"). A join carrying next to no clay across them, of
+    /// any length, is a smear, not a bead on a bead.
     ///
     /// A *ramp* is neither: a stretch whose gap only grows, by at least
     /// half the thinnest layer, and that the path leaves by a bead resting
@@ -791,9 +791,11 @@ impl<'a> Checker<'a> {
         if ramp {
             return;
         }
+        // Either way its excess must be a bead's clay: a join laid with
+        // next to no clay across a floor's rings, however long, is a
+        // smear, not a bead on a bead.
         let bead = cfg.width_min * cfg.min_layer_mm * st.length.max(cfg.width_min);
-        let short = st.length >= 0.75 * cfg.width_min && st.excess > bead;
-        if st.excess > 0.75 * st.volume && (st.length > 2.0 * cfg.width_max || short) {
+        if st.excess > 0.75 * st.volume && st.excess > bead && st.length >= 0.75 * cfg.width_min {
             self.record(Finding::DoubleDeposition, st.first_line, st.excess, false);
         }
     }

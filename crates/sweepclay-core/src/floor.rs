@@ -60,7 +60,10 @@ impl FloorBeads {
 /// would lay its beads on each other; it becomes the line down its middle
 /// instead, an open [`FloorRing`].
 pub fn floor_rings(outer: &[[f64; 2]], beads: FloorBeads) -> Vec<FloorRing> {
-    rings_of(outer, &inward_offsets(outer, beads.pitch()), beads)
+    match floor_plan(outer, beads) {
+        Ok(rings) => rings,
+        Err(_) => rings_of(outer, &inward_offsets(outer, beads.pitch()), beads, true),
+    }
 }
 
 /// Why a floor cannot be laid as one continuous path.
@@ -84,20 +87,67 @@ pub enum FloorRefusal {
 }
 
 /// [`floor_rings`] from one set of offsets, or why the floor is refused.
+///
+/// A floor whose offsets split at a waist into islands is laid ring by
+/// ring down to the waist, then island after island, each from its
+/// outside in (and its own core); the first ring of each island is
+/// reached by a join that may be long ([`FloorRing::island`]). An island
+/// that splits again is refused.
 pub fn floor_plan(
     outer: &[[f64; 2]],
     beads: FloorBeads,
 ) -> std::result::Result<Vec<FloorRing>, FloorRefusal> {
     let pitch = beads.pitch();
     let offsets = inward_offsets(outer, pitch);
-    if let Some((depth, count)) = split_of(&offsets, pitch) {
-        return Err(FloorRefusal::Islands { depth, count });
+    let mut rings = match split_of(&offsets, pitch) {
+        None => {
+            let mut rings = rings_of(outer, &offsets, beads, true);
+            end_in_tail(&mut rings, beads);
+            rings
+        }
+        Some((_, _)) => {
+            let s = offsets.iter().position(|c| c.len() > 1).unwrap_or(0);
+            let mut rings = rings_of(outer, &offsets[..s], beads, false);
+            for island in &offsets[s] {
+                let mut inner = vec![vec![island.clone()]];
+                inner.extend(offsets_from(island.clone(), pitch));
+                if let Some((depth, count)) = split_of(&inner, pitch) {
+                    return Err(FloorRefusal::Islands {
+                        depth: depth + pitch * s as f64,
+                        count,
+                    });
+                }
+                let mut part = rings_of(outer, &inner, beads, true);
+                end_in_tail(&mut part, beads);
+                if let Some(first) = part.first_mut() {
+                    first.island = true;
+                }
+                rings.extend(part);
+            }
+            rings
+        }
+    };
+    rings.retain(|r| r.pts.len() >= 2);
+    for (k, r) in rings.iter().enumerate().filter(|(_, r)| !r.open && !r.tail) {
+        if let Some(at) = lies_on_itself(&r.pts, pitch) {
+            // Depth counted in rings laid before it: an estimate past a
+            // split, where islands follow each other.
+            return Err(FloorRefusal::Tail {
+                depth: pitch * (k + 1) as f64,
+                at,
+            });
+        }
     }
-    let mut rings = rings_of(outer, &offsets, beads);
-    // The innermost ring of a region that ends in a tail (a lens drawn
-    // out to a point: the last offset of a long polygon or lobed oval) is
-    // laid once, as the line down its middle, instead of the ring and the
-    // core inside it.
+    Ok(rings)
+}
+
+/// The innermost ring of a region that ends in a tail (a lens drawn out
+/// to a point: the last offset of a long polygon or lobed oval) is laid
+/// once, as the line down its middle, instead of the ring and the core
+/// inside it; or, fat in the middle, stays a ring whose tail's two sides
+/// are laid narrower.
+fn end_in_tail(rings: &mut Vec<FloorRing>, beads: FloorBeads) {
+    let pitch = beads.pitch();
     if let Some(k) = rings.iter().rposition(|r| !r.open) {
         if lies_on_itself(&rings[k].pts, pitch).is_some() {
             match midline(&rings[k].pts, beads.spacing) {
@@ -116,22 +166,13 @@ pub fn floor_plan(
             }
         }
     }
-    for (k, r) in rings.iter().enumerate().filter(|(_, r)| !r.open && !r.tail) {
-        if let Some(at) = lies_on_itself(&r.pts, pitch) {
-            // One contour a depth: ring k is k + 1 pitches in.
-            return Err(FloorRefusal::Tail {
-                depth: pitch * (k + 1) as f64,
-                at,
-            });
-        }
-    }
-    Ok(rings)
 }
 
 fn rings_of(
     outer: &[[f64; 2]],
     offsets: &[Vec<Vec<[f64; 2]>>],
     beads: FloorBeads,
+    core: bool,
 ) -> Vec<FloorRing> {
     let (pitch, spacing) = (beads.pitch(), beads.spacing);
     let ccw = signed_area2(outer) > 0.0;
@@ -155,9 +196,13 @@ fn rings_of(
                     open: false,
                     widths,
                     tail: false,
+                    island: false,
                 });
             }
         }
+    }
+    if !core {
+        return rings;
     }
     // The hole the innermost ring (or the outline itself) leaves.
     let last = match rings.last() {
@@ -201,6 +246,7 @@ fn core_of(ring: &[[f64; 2]], beads: FloorBeads) -> Option<FloorRing> {
         open: true,
         widths: None,
         tail: false,
+        island: false,
     })
 }
 
@@ -322,8 +368,14 @@ fn inward_offsets(outer: &[[f64; 2]], pitch: f64) -> Vec<Vec<Vec<[f64; 2]>>> {
     if signed_area2(&first) < 0.0 {
         first.reverse();
     }
+    offsets_from(thinned(&first), pitch)
+}
+
+/// The inward offsets of a counter-clockwise contour by one pitch, two,
+/// … (see [`inward_offsets`]), the contour itself not among them.
+fn offsets_from(contour: Vec<[f64; 2]>, pitch: f64) -> Vec<Vec<Vec<[f64; 2]>>> {
     let mut out = Vec::new();
-    let mut current = vec![thinned(&first)];
+    let mut current = vec![contour];
     for _ in 0..MAX_FLOOR_RINGS {
         let next: Vec<Vec<[f64; 2]>> = current
             .iter()
@@ -403,6 +455,11 @@ pub struct FloorRing {
     /// The innermost ring of a region that ends in a tail, laid with its
     /// tail's two sides side by side (docs/ALGORITHMS.md §8).
     pub tail: bool,
+    /// The first element of an island (a floor whose offsets split at a
+    /// waist): the path reaches it by a join that may be long, across the
+    /// clay of the ring round the islands or of the island before
+    /// (docs/ALGORITHMS.md §8, "Islands").
+    pub island: bool,
 }
 
 /// The open element that lays a thin closed ring once: the line down
@@ -427,6 +484,7 @@ fn line_of((pts, apart): (Vec<[f64; 2]>, Vec<f64>), beads: FloorBeads) -> FloorR
         open: true,
         widths: wider.then_some(widths),
         tail: false,
+        island: false,
     }
 }
 
@@ -578,6 +636,11 @@ pub fn floor_entries(rings: &[FloorRing], start: [f64; 2], width: f64) -> (Vec<u
             } else {
                 pts.len() - 1
             }
+        } else if r.island {
+            // An island is entered on the side nearest its middle, where
+            // its inner rings lie a pitch apart (not at a tip pointing to
+            // the waist, which they recede from).
+            seam_at(pts, nearest(pts, centroid(pts)), width)
         } else {
             seam_at(pts, nearest(pts, at), width)
         };
@@ -585,7 +648,11 @@ pub fn floor_entries(rings: &[FloorRing], start: [f64; 2], width: f64) -> (Vec<u
         // pitch the rings lie apart (a ring far from the last entry is
         // reached across the clay of the ring before).
         let step = d2(at, pts[e]).sqrt();
-        longest = longest.max(if r.open { step } else { step * 2.0 / 3.0 });
+        // The join into the next island crosses the island before: long
+        // by design, laid with next to no clay.
+        if !r.island {
+            longest = longest.max(if r.open { step } else { step * 2.0 / 3.0 });
+        }
         entry.push(e);
         at = pts[e];
     }
@@ -744,6 +811,48 @@ mod tests {
         assert!(coverage(&outer, &rings, 1.5) > 0.99);
         // Without it, the middle is bare.
         assert!(coverage(&outer, &rings[..rings.len() - 1], 1.5) < coverage(&outer, &rings, 1.5));
+    }
+
+    /// A peanut: two lobes 64 mm across joined by a waist, 110 mm long.
+    fn peanut(n: usize) -> Vec<[f64; 2]> {
+        (0..n)
+            .map(|i| {
+                let a = std::f64::consts::TAU * i as f64 / n as f64;
+                let y = 32.0 * a.sin() * (0.35 + 0.65 * a.cos().abs());
+                [55.0 * a.cos(), y]
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_floor_that_splits_at_a_waist_is_laid_island_by_island() {
+        // Once refused ("the floor's rings would split into 2 separate
+        // islands"): the rings round both lobes down to the waist, then
+        // each island from its outside in, each entered by a join.
+        let outer = peanut(240);
+        let rings = floor_plan(&outer, BEADS).unwrap();
+        let islands: Vec<usize> = (0..rings.len()).filter(|&k| rings[k].island).collect();
+        assert_eq!(islands.len(), 2, "{:?}", islands);
+        // The islands lie either side of the waist, and every element of
+        // an island after its first lies inside it.
+        let mid = |k: usize| centroid(&rings[k].pts)[0];
+        assert!(mid(islands[0]) * mid(islands[1]) < 0.0);
+        for (n, &k) in islands.iter().enumerate() {
+            let end = islands.get(n + 1).copied().unwrap_or(rings.len());
+            for j in k + 1..end {
+                assert!(mid(j) * mid(k) > 0.0, "element {j} of island {n}");
+            }
+        }
+        // Entered at its middle side, each island's rings follow a pitch
+        // apart; only the joins into the islands are long.
+        let start = outer[0];
+        let (entries, longest) = floor_entries(&rings, start, BEADS.width);
+        assert!(longest <= 2.0 * BEADS.pitch(), "{longest}");
+        assert_eq!(entries.len(), rings.len());
+        let cov = coverage(&outer, &rings, 1.5);
+        assert!(cov > 0.95, "{cov}");
+        let d = closest_elements(&outer, &rings);
+        assert!(d > 0.75 * BEADS.pitch(), "{d}");
     }
 
     #[test]
