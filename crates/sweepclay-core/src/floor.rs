@@ -69,20 +69,13 @@ pub fn floor_rings(outer: &[[f64; 2]], beads: FloorBeads) -> Vec<FloorRing> {
 /// Why a floor cannot be laid as one continuous path.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum FloorRefusal {
-    /// Its offsets split into `count` islands `depth` mm inside the wall.
+    /// Its offsets split into islands, and one of them splits again into
+    /// `count` islands `depth` mm inside the wall.
     Islands {
-        /// Depth (mm) of the first split.
+        /// Depth (mm) of the second split.
         depth: f64,
         /// Islands at that depth.
         count: usize,
-    },
-    /// A ring `depth` mm inside the wall lies on itself at `at` (plan,
-    /// design coordinates): the region ends in a tail narrower than a bead.
-    Tail {
-        /// Depth (mm) of the ring.
-        depth: f64,
-        /// Where its two sides meet.
-        at: [f64; 2],
     },
 }
 
@@ -128,14 +121,13 @@ pub fn floor_plan(
         }
     };
     rings.retain(|r| r.pts.len() >= 2);
-    for (k, r) in rings.iter().enumerate().filter(|(_, r)| !r.open && !r.tail) {
-        if let Some(at) = lies_on_itself(&r.pts, pitch) {
-            // Depth counted in rings laid before it: an estimate past a
-            // split, where islands follow each other.
-            return Err(FloorRefusal::Tail {
-                depth: pitch * (k + 1) as f64,
-                at,
-            });
+    // A ring further out that runs into a tail (a deep lobe of a lobed
+    // oval) is laid as the innermost one that is fat in the middle: its
+    // tail's two sides narrower, down to a U-turn of two pitches.
+    for r in rings.iter_mut().filter(|r| !r.open && !r.tail) {
+        if lies_on_itself(&r.pts, pitch).is_some() {
+            r.widths = narrowed_within(&r.pts, beads.width, 2.0 * pitch);
+            r.tail = true;
         }
     }
     Ok(rings)
@@ -420,10 +412,9 @@ fn thinned(contour: &[[f64; 2]]) -> Vec<[f64; 2]> {
 const OFFSET_SAG_MM: f64 = 0.01;
 
 /// The first depth (mm inside `outer`) at which its inward offsets by
-/// multiples of `pitch` split into separate islands, if they do: one
-/// continuous path cannot go from one island to the next without crossing
-/// the clay between them, so such a floor is refused (docs/ALGORITHMS.md
-/// §8).
+/// multiples of `pitch` split into separate islands, if they do, and how
+/// many: from there the floor is laid island by island
+/// (docs/ALGORITHMS.md §8, "Islands").
 fn split_of(offsets: &[Vec<Vec<[f64; 2]>>], pitch: f64) -> Option<(f64, usize)> {
     offsets
         .iter()
@@ -926,13 +917,24 @@ mod tests {
     }
 
     #[test]
-    fn a_floor_ring_that_would_lie_on_itself_is_refused() {
-        match floor_plan(&lobed_oval(0.1164), BEADS) {
-            Err(FloorRefusal::Tail { depth, at }) => {
-                assert!(depth > 10.0 && at[0].abs() > 15.0, "{depth} {at:?}");
-            }
-            other => panic!("{other:?}"),
+    fn a_ring_further_out_that_runs_into_a_tail_is_laid_narrower_there() {
+        // A ring some way in runs out into a tail between two lobes (once
+        // refused: "the floor narrows to a sliver thinner than a bead"):
+        // it is laid as a fat innermost ring is, its tail's two sides
+        // narrower down to a U-turn, and the floor still covers.
+        let outer = lobed_oval(0.1164);
+        let rings = floor_plan(&outer, BEADS).unwrap();
+        let tails: Vec<&FloorRing> = rings.iter().filter(|r| r.tail).collect();
+        assert!(!tails.is_empty());
+        for r in &tails {
+            let w = r.widths.as_ref().expect("narrowed where the sides meet");
+            assert!(w.iter().any(|&w| w < BEADS.width - 1e-9));
+            assert!(w.iter().all(|&w| w <= BEADS.width + 1e-9));
         }
+        let cov = coverage(&outer, &rings, 1.5);
+        assert!(cov > 0.95, "{cov}");
+        let d = closest_elements(&outer, &rings);
+        assert!(d > 0.75 * BEADS.pitch(), "{d}");
         // Without the lobes the same oval ends in a line down its middle.
         let rings = floor_plan(&lobed_oval(0.0), BEADS).unwrap();
         assert!(rings.last().unwrap().open);

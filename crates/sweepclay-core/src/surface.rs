@@ -292,9 +292,8 @@ pub fn sample_surface(design: &Design) -> Result<Surface> {
 /// The columns a vessel's path may start each layer and turn at, best
 /// first: Ψ's start, or the one nearest the floor's innermost ring, where
 /// each ring is entered a short step from the one before
-/// (docs/ALGORITHMS.md §8). Refuses a floor that
-/// splits into islands, or whose innermost line is out of a short step's
-/// reach.
+/// (docs/ALGORITHMS.md §8). Refuses a floor whose islands split again,
+/// or whose innermost line is out of a short step's reach.
 fn floor_start(
     columns: &[Column],
     params: &Params,
@@ -322,15 +321,8 @@ fn floor_start(
         Err(FloorRefusal::Islands { depth, count: k }) => return Err(Error::invalid(
             "trajectory",
             format!(
-                "the floor's rings would split into {k} separate islands {depth:.1} mm inside the wall (a waist about {:.0} mm wide or narrower): one continuous path cannot go from one to the next without crossing clay; widen the waist, or print the vessel bottomless (params.floor_layers = 0)",
+                "the floor's rings split at a waist into islands, and one of them splits again into {k} islands {depth:.1} mm inside the wall (a second waist about {:.0} mm wide or narrower): the path goes from island to island only once; widen that waist, or print the vessel bottomless (params.floor_layers = 0)",
                 2.0 * depth
-            ),
-        )),
-        Err(FloorRefusal::Tail { depth, at }) => return Err(Error::invalid(
-            "trajectory",
-            format!(
-                "the floor narrows to a sliver thinner than a bead {depth:.1} mm inside the wall, near ({:.1}, {:.1}) mm: one continuous path would lay its clay twice there; round off or widen that end of the shape, or print the vessel bottomless (params.floor_layers = 0)",
-                at[0], at[1]
             ),
         )),
     };
