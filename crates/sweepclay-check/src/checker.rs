@@ -243,6 +243,10 @@ struct Weak {
 /// The findings judged by stretches of [`Weak`] beads.
 const WEAK_KINDS: [Finding; 2] = [Finding::UnderMinOverlap, Finding::LayerGap];
 
+/// A thin bead fails for its gap only beyond this many times the gap
+/// under the beads before it (docs/CHECKER.md, "Layer gaps").
+const DEEP_GAP: f64 = 1.5;
+
 /// Widths are read only from gaps of at least this many thinnest layers
 /// (docs/CHECKER.md, "Numbers").
 const WIDTH_GAP_LAYERS: f64 = 2.0;
@@ -325,6 +329,9 @@ struct Checker<'a> {
     /// Consecutive beads under the least overlap, and over a layer gap,
     /// not yet recorded.
     weak: [Weak; 2],
+    /// The gap under the beads judged for it so far, a running mean
+    /// (mm; 0 before the first): the layers the print lays.
+    typical_gap: f64,
     beads: Vec<Bead>,
     /// `bent_before[k + 1]`: how many of beads `0..=k` are bent (a
     /// prefix count, so "any bent bead in this stretch?" is two loads).
@@ -392,6 +399,7 @@ impl<'a> Checker<'a> {
             prev_stub: false,
             prev_overlap: 0.0,
             weak: Default::default(),
+            typical_gap: 0.0,
             beads: Vec::new(),
             bent_before: vec![0],
             grid: BeadGrid::new(cfg),
@@ -852,6 +860,7 @@ impl<'a> Checker<'a> {
             prev_overlap,
             lead,
             bent_before,
+            typical_gap,
             turn: pending_turn,
             last_width,
             ..
@@ -1023,12 +1032,25 @@ impl<'a> Checker<'a> {
                     // smear carry no bead of their own; a bead climbing
                     // a thinnest layer or more climbs from the clay it
                     // was just laid on (a finishing pass, a sloping edge).
+                    // A thin bead (a floor's narrowed tail between its
+                    // neighbours) fails only over a gap well beyond the
+                    // layers laid so far: clay two layers down.
                     if xy >= 0.25 * cfg.width_min
                         && rise < cfg.min_layer_mm
                         && !crate::support::is_smear(width, cfg)
                     {
+                        let thin = width < cfg.width_min * (1.0 - WIDTH_TOLERANCE);
+                        let deep = *typical_gap == 0.0 || dz > DEEP_GAP * *typical_gap;
                         let over = dz > gap_limit
+                            && (!thin || deep)
                             && !crate::support::clay_within_gap(beads, grid, &q, gap_limit);
+                        if !over {
+                            *typical_gap = if *typical_gap == 0.0 {
+                                dz
+                            } else {
+                                0.95 * *typical_gap + 0.05 * dz
+                            };
+                        }
                         weak_bead[1] = Some(over.then_some(dz));
                     }
                     // A bead thinner than the one below it and wider (a
