@@ -12,7 +12,8 @@
 //! `viewBox`, which fixes the scale. The y axis is flipped (SVG's points
 //! down) and the curve is centred on `o`.
 //!
-//! CSV: one `x, y` pair per line (comma, semicolon, tab or spaces), in mm;
+//! CSV: one `x, y` pair per line (comma, semicolon, tab or spaces; a
+//! decimal comma with `;` or tabs between fields), in mm;
 //! blank lines and `#` comments are skipped, and so are header lines
 //! before the data; the points are centred on `o`, as an SVG's are.
 
@@ -54,6 +55,39 @@ pub fn svg_path(text: &str) -> Result<ImportedPath> {
 /// Most shapes [`svg_shapes`] lists for the user to pick from.
 pub const MAX_SHAPES: usize = 20;
 
+/// Most XML nodes an imported SVG may hold (elements, text, attributes'
+/// nodes): a drawing has a few thousand; the cap bounds the parser's
+/// memory on a hostile file.
+pub const MAX_SVG_NODES: u32 = 200_000;
+
+/// An SVG document parsed as drawing programs write it: a `<!DOCTYPE>`
+/// (Adobe Illustrator's standard export declares the SVG 1.1 DTD) is
+/// read; entities declared in it are refused by name, since expanding
+/// them is no drawing's business.
+fn parse_svg(text: &str) -> Result<roxmltree::Document<'_>> {
+    let root_at = text.find("<svg").unwrap_or(text.len());
+    if text[..root_at].contains("<!ENTITY") {
+        return Err(Error::invalid(
+            "svg",
+            "its DOCTYPE declares entities (<!ENTITY …>), which are not expanded: export it without them (Illustrator: SVG 1.1, with \"Preserve Illustrator Editing Capabilities\" off)",
+        ));
+    }
+    let opt = roxmltree::ParsingOptions {
+        allow_dtd: true,
+        nodes_limit: MAX_SVG_NODES,
+        ..roxmltree::ParsingOptions::default()
+    };
+    roxmltree::Document::parse_with_options(text, opt).map_err(|e| match e {
+        roxmltree::Error::NodesLimitReached => Error::invalid(
+            "svg",
+            format!(
+                "more than {MAX_SVG_NODES} XML nodes (the cap of an import): simplify the drawing"
+            ),
+        ),
+        e => Error::invalid("svg", format!("not an SVG document: {e}")),
+    })
+}
+
 /// Every shape of an SVG document, in document order, each as trajectory
 /// points (mm, centred on `o`, y up), at most `max`: each `<polyline>`,
 /// `<polygon>`, `<line>`, `<circle>`, `<ellipse>` and `<rect>`, and each
@@ -61,8 +95,7 @@ pub const MAX_SHAPES: usize = 20;
 /// shape and its hole, or several strokes). Labelled by element, `id` and
 /// sub-path. An error when there is none.
 pub fn svg_shapes(text: &str, max: usize) -> Result<Vec<(String, ImportedPath)>> {
-    let doc = roxmltree::Document::parse(text)
-        .map_err(|e| Error::invalid("svg", format!("not an SVG document: {e}")))?;
+    let doc = parse_svg(text)?;
     let root = doc.root_element();
     if root.tag_name().name() != "svg" {
         return Err(Error::invalid(
@@ -223,6 +256,39 @@ pub fn csv_trajectory(text: &str) -> Result<Vec<[f64; 2]>> {
     csv_path(text).map(|p| p.points)
 }
 
+/// The fields of one CSV line. A line with `;` (a European spreadsheet's
+/// export, `45,000;0,000`) or a tab between its fields may write its
+/// numbers with a decimal comma; a line with neither is split at commas
+/// and spaces, and one that mixes a decimal comma with spaces
+/// (`45,5 0,2`: x 45.5 and y 0.2, or four numbers?) is refused by name
+/// rather than read as a zig-zag.
+fn csv_fields(line: &str, key: &str) -> Result<Vec<String>> {
+    let decimal_comma = |f: &str| f.trim().replace(',', ".");
+    if line.contains(';') || line.contains('\t') {
+        return Ok(line
+            .split([';', '\t'])
+            .map(decimal_comma)
+            .filter(|f| !f.is_empty())
+            .collect());
+    }
+    let b = line.as_bytes();
+    let mixed = (1..b.len().saturating_sub(1))
+        .any(|k| b[k] == b',' && b[k - 1].is_ascii_digit() && b[k + 1].is_ascii_digit())
+        && line.split(',').any(|part| part.trim().contains(' '));
+    if mixed {
+        return Err(Error::invalid(
+            key,
+            format!("`{line}` mixes a decimal comma with spaces between fields: separate x and y by `;` or a tab (`45,5; 0,2`), or write decimal points"),
+        ));
+    }
+    Ok(line
+        .split([',', ' '])
+        .map(str::trim)
+        .filter(|f| !f.is_empty())
+        .map(str::to_string)
+        .collect())
+}
+
 /// [`csv_trajectory`], closed when its last point meets its first.
 pub fn csv_path(text: &str) -> Result<ImportedPath> {
     let mut pts = Vec::new();
@@ -231,16 +297,12 @@ pub fn csv_path(text: &str) -> Result<ImportedPath> {
         if line.is_empty() {
             continue;
         }
-        let fields: Vec<&str> = line
-            .split([',', ';', '\t', ' '])
-            .map(str::trim)
-            .filter(|f| !f.is_empty())
-            .collect();
+        let key = format!("csv line {}", i + 1);
+        let fields = csv_fields(line, &key)?;
         let parsed: Vec<Option<f64>> = fields.iter().map(|f| f.parse().ok()).collect();
         if pts.is_empty() && parsed.iter().all(Option::is_none) {
             continue; // a header (or a title) before the data
         }
-        let key = format!("csv line {}", i + 1);
         if fields.len() < 2 {
             return Err(Error::invalid(
                 key,
@@ -515,6 +577,63 @@ mod tests {
     use super::*;
 
     use crate::bspline::polyline_length as length;
+
+    #[test]
+    fn a_european_csv_reads_its_decimal_commas() {
+        // A spreadsheet in a European locale writes `;` between fields and
+        // decimal commas: read as commas between fields it was a zig-zag.
+        let eu = "x;y\n0,000;0,000\n45,500;0,000\n45,500;20,250\n";
+        let p = csv_path(eu).unwrap();
+        let us = csv_path("x,y\n0,0\n45.5,0\n45.5,20.25\n").unwrap();
+        assert_eq!(p.points, us.points);
+        // Tabs between fields too.
+        let tab = csv_path("0,0\t0,0\n45,5\t0\n45,5\t20,25\n").unwrap();
+        assert_eq!(tab.points, us.points);
+        // A decimal comma with spaces between fields is refused by name.
+        let e = csv_path("0 0\n45,5 0,2\n").unwrap_err().to_string();
+        assert!(
+            e.contains("csv line 2") && e.contains("decimal comma"),
+            "{e}"
+        );
+        // Plain commas and spaces still read as before (three columns:
+        // the first two).
+        assert!(csv_path("1, 2, 3\n10, 2, 3\n10, 12, 3\n").is_ok());
+    }
+
+    #[test]
+    fn an_illustrator_export_with_its_doctype_is_read() {
+        // Adobe Illustrator's standard SVG export: an XML declaration,
+        // its generator comment and the SVG 1.1 DOCTYPE (refused once:
+        // "XML with DTD detected").
+        let svg = r#"<?xml version="1.0" encoding="utf-8"?>
+<!-- Generator: Adobe Illustrator 27.0.0, SVG Export Plug-In . SVG Version: 6.00 Build 0)  -->
+<!DOCTYPE svg PUBLIC "-//W3C//DTD SVG 1.1//EN" "http://www.w3.org/Graphics/SVG/1.1/DTD/svg11.dtd">
+<svg version="1.1" id="Layer_1" xmlns="http://www.w3.org/2000/svg" xmlns:xlink="http://www.w3.org/1999/xlink" x="0px" y="0px"
+	 width="283.5px" height="283.5px" viewBox="0 0 283.5 283.5" style="enable-background:new 0 0 283.5 283.5;" xml:space="preserve">
+<style type="text/css">
+	.st0{fill:none;stroke:#000000;stroke-miterlimit:10;}
+</style>
+<circle class="st0" cx="141.7" cy="141.7" r="113.4"/>
+</svg>
+"#;
+        let shapes = svg_shapes(svg, MAX_SHAPES).unwrap();
+        assert_eq!(shapes.len(), 1);
+        // r = 113.4 px = 30 mm: a circle 2π·30 mm round.
+        let p = &shapes[0].1;
+        assert!(p.closed);
+        let mut ring = p.points.clone();
+        ring.push(ring[0]);
+        assert!((length(&ring) - std::f64::consts::TAU * 30.0).abs() < 0.5);
+        // Entities in the DOCTYPE are refused by name.
+        let with_entities = svg.replace(
+            "svg11.dtd\">",
+            "svg11.dtd\" [<!ENTITY ns_svg \"http://www.w3.org/2000/svg\">]>",
+        );
+        let e = svg_shapes(&with_entities, MAX_SHAPES)
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("entities"), "{e}");
+    }
 
     #[test]
     fn svg_arc_in_mm_is_flattened_and_flipped() {
