@@ -356,15 +356,37 @@ impl Design {
     /// Parses a design file. Unknown keys, wrong types and a wrong format
     /// version are errors naming the line.
     pub fn from_json(text: &str) -> Result<Design> {
-        let d: Design = serde_json::from_str(text).map_err(|e| Error::Parse {
-            message: e
+        let de = &mut serde_json::Deserializer::from_str(text);
+        let d: Design = serde_path_to_error::deserialize(de).map_err(|e| {
+            let path = e.path().to_string();
+            let inner = e.into_inner();
+            let message = inner
                 .to_string()
                 .split(" at line ")
                 .next()
                 .unwrap_or("")
-                .to_string(),
-            line: e.line(),
-            column: e.column(),
+                .to_string();
+            // A value of the wrong type or range names its key, so the
+            // modeler can outline that field ("params.floor_layers:
+            // invalid value: integer `-1`, expected u32").
+            // An unknown key names itself, and is no field to outline.
+            let known = !message.starts_with("unknown field");
+            if inner.classify() == serde_json::error::Category::Data && path != "." && known {
+                Error::invalid(
+                    path,
+                    format!(
+                        "{message} (line {}, column {})",
+                        inner.line(),
+                        inner.column()
+                    ),
+                )
+            } else {
+                Error::Parse {
+                    message,
+                    line: inner.line(),
+                    column: inner.column(),
+                }
+            }
         })?;
         if d.sweepclay != FORMAT_VERSION {
             return Err(Error::invalid(
@@ -558,6 +580,25 @@ mod tests {
     fn round_trips_through_json() {
         let d = Design::from_json(MINIMAL).unwrap();
         assert_eq!(Design::from_json(&d.to_json()).unwrap(), d);
+    }
+
+    #[test]
+    fn a_value_of_the_wrong_type_names_its_key() {
+        // Floor layers −1 or 2.5 named only "line 1 column 377": the
+        // modeler could outline no field.
+        for bad in ["-1", "2.5", "\"two\""] {
+            let text = MINIMAL.replace(
+                "\"trajectory\": {",
+                &format!("\"params\": {{\"floor_layers\": {bad}}}, \"trajectory\": {{"),
+            );
+            match Design::from_json(&text).unwrap_err() {
+                Error::Invalid { key, reason } => {
+                    assert_eq!(key, "params.floor_layers", "{reason}");
+                    assert!(reason.contains("line"), "{reason}");
+                }
+                e => panic!("unexpected {e}"),
+            }
+        }
     }
 
     #[test]

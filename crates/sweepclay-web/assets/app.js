@@ -624,6 +624,16 @@ function plainWords(msg) {
   }).replace(/params\.(\w+)/g, (all, k) => (param(k) ? param(k).label : all));
 }
 
+/**
+ * A number as a potter types it: "1.5", or with a decimal comma "1,5";
+ * anything else (two separators, letters, "1,5,0") is NaN, never a
+ * silent 15.
+ */
+function parseDecimal(text) {
+  const t = String(text).trim().replace(/^(-?\d*),(\d+)$/, '$1.$2');
+  return /^-?(\d+\.?\d*|\.\d+)(e-?\d+)?$/i.test(t) ? Number(t) : NaN;
+}
+
 function showError(msg, key) {
   const s = $('status');
   document.querySelectorAll('#params input.bad').forEach((i) => i.classList.remove('bad'));
@@ -694,17 +704,20 @@ function buildParams() {
     const l = document.createElement('label');
     l.innerHTML = `<span>${label} <small>${unit}</small></span>`;
     const inp = document.createElement('input');
-    inp.type = 'number';
-    inp.step = step;
+    // Text, not a number field: a browser's number field reads "1,5" as
+    // 15 in some locales; a decimal comma is read here as a decimal.
+    inp.type = 'text';
+    inp.inputMode = 'decimal';
+    inp.dataset.step = step;
     inp.id = `p-${key}`;
     const def = state.meta.params[key] ?? (key === 'floor_layers' ? 2 : null);
     const shown = def == null ? '' : ` (default ${Number((def * factor).toFixed(4))}${unit ? ` ${unit}` : ''})`;
     inp.title = `${help}${shown}`;
     l.title = inp.title;
     inp.addEventListener('change', () => {
-      const v = parseFloat(inp.value);
+      const v = parseDecimal(inp.value);
       if (!Number.isFinite(v)) {
-        showError(`${label}: enter a number`, `params.${key}`);
+        showError(`${label}: "${inp.value}" is not a number (write 1.5 or 1,5)`, `params.${key}`);
         return;
       }
       edit((d) => { d.params = { ...(d.params || {}), [key]: v / factor }; }, true);

@@ -738,6 +738,18 @@ async fn truthful_state_imports_printers_and_phones() {
         [json!(true), json!(true), json!(false)],
         "{state}"
     );
+    // A decimal comma is a decimal, not 15; a number with two commas is
+    // refused by name.
+    set_value(&c, "p-layer_height", "1,5").await;
+    wait_js(
+        &c,
+        "return window.sweepclay.design.params.layer_height === 1.5",
+        "a layer height of 1,5 read as 1.5",
+    )
+    .await;
+    set_value(&c, "p-layer_height", "1,2,5").await;
+    let err = error_text(&c, "the error for 1,2,5").await;
+    assert!(err.as_str().unwrap().contains("not a number"), "{err}");
     set_value(&c, "p-layer_height", "1.25").await;
     wait_js(&c, PRINTABLE, "the verdict once the layer height is back").await;
     assert_eq!(
