@@ -69,10 +69,10 @@ pub fn floor_rings(outer: &[[f64; 2]], beads: FloorBeads) -> Vec<FloorRing> {
 /// Why a floor cannot be laid as one continuous path.
 #[derive(Clone, Copy, Debug, PartialEq)]
 pub enum FloorRefusal {
-    /// Its offsets split into islands, and one of them splits again into
-    /// `count` islands `depth` mm inside the wall.
+    /// Its islands split more than [`MAX_SPLITS`] times, the last into
+    /// `count` islands `depth` mm inside the island before.
     Islands {
-        /// Depth (mm) of the second split.
+        /// Depth (mm) of the last split, inside the island it splits.
         depth: f64,
         /// Islands at that depth.
         count: usize,
@@ -83,43 +83,17 @@ pub enum FloorRefusal {
 ///
 /// A floor whose offsets split at a waist into islands is laid ring by
 /// ring down to the waist, then island after island, each from its
-/// outside in (and its own core); the first ring of each island is
-/// reached by a join that may be long ([`FloorRing::island`]). An island
-/// that splits again is refused.
+/// outside in (and its own core), an island that splits again the same
+/// way; the first ring of each island is reached by a join that may be
+/// long ([`FloorRing::island`]). More than [`MAX_SPLITS`] splits deep is
+/// refused.
 pub fn floor_plan(
     outer: &[[f64; 2]],
     beads: FloorBeads,
 ) -> std::result::Result<Vec<FloorRing>, FloorRefusal> {
     let pitch = beads.pitch();
     let offsets = inward_offsets(outer, pitch);
-    let mut rings = match split_of(&offsets, pitch) {
-        None => {
-            let mut rings = rings_of(outer, &offsets, beads, true);
-            end_in_tail(&mut rings, beads);
-            rings
-        }
-        Some((_, _)) => {
-            let s = offsets.iter().position(|c| c.len() > 1).unwrap_or(0);
-            let mut rings = rings_of(outer, &offsets[..s], beads, false);
-            for island in &offsets[s] {
-                let mut inner = vec![vec![island.clone()]];
-                inner.extend(offsets_from(island.clone(), pitch));
-                if let Some((depth, count)) = split_of(&inner, pitch) {
-                    return Err(FloorRefusal::Islands {
-                        depth: depth + pitch * s as f64,
-                        count,
-                    });
-                }
-                let mut part = rings_of(outer, &inner, beads, true);
-                end_in_tail(&mut part, beads);
-                if let Some(first) = part.first_mut() {
-                    first.island = true;
-                }
-                rings.extend(part);
-            }
-            rings
-        }
-    };
+    let mut rings = region_rings(outer, &offsets, beads, 0)?;
     rings.retain(|r| r.pts.len() >= 2);
     // A ring further out that runs into a tail (a deep lobe of a lobed
     // oval) is laid as the innermost one that is fat in the middle: its
@@ -129,6 +103,46 @@ pub fn floor_plan(
             r.widths = narrowed_within(&r.pts, beads.width, 2.0 * pitch);
             r.tail = true;
         }
+    }
+    Ok(rings)
+}
+
+/// Most times a floor's islands may split again (a chain of lobes, each
+/// waist narrower than the last): bounds the offsetting work.
+pub const MAX_SPLITS: usize = 8;
+
+/// The elements of a region from its inward offsets, depth by depth:
+/// rings down to the depth where they split, then each island the same
+/// way (its first element entered by a join, [`FloorRing::island`]),
+/// down to [`MAX_SPLITS`] splits; a region that does not split ends in
+/// its core or tail.
+fn region_rings(
+    outer: &[[f64; 2]],
+    offsets: &[Vec<Vec<[f64; 2]>>],
+    beads: FloorBeads,
+    splits: usize,
+) -> std::result::Result<Vec<FloorRing>, FloorRefusal> {
+    let pitch = beads.pitch();
+    let Some(s) = offsets.iter().position(|c| c.len() > 1) else {
+        let mut rings = rings_of(outer, offsets, beads, true);
+        end_in_tail(&mut rings, beads);
+        return Ok(rings);
+    };
+    if splits >= MAX_SPLITS {
+        return Err(FloorRefusal::Islands {
+            depth: pitch * (s + 1) as f64,
+            count: offsets[s].len(),
+        });
+    }
+    let mut rings = rings_of(outer, &offsets[..s], beads, false);
+    for island in &offsets[s] {
+        let mut inner = vec![vec![island.clone()]];
+        inner.extend(offsets_from(island.clone(), pitch));
+        let mut part = region_rings(outer, &inner, beads, splits + 1)?;
+        if let Some(first) = part.first_mut() {
+            first.island = true;
+        }
+        rings.extend(part);
     }
     Ok(rings)
 }
@@ -410,18 +424,6 @@ fn thinned(contour: &[[f64; 2]]) -> Vec<[f64; 2]> {
 /// The farthest a thinned contour's chords may stray from the curve it
 /// stands for (mm): well inside the 0.05 mm the rings are held to.
 const OFFSET_SAG_MM: f64 = 0.01;
-
-/// The first depth (mm inside `outer`) at which its inward offsets by
-/// multiples of `pitch` split into separate islands, if they do, and how
-/// many: from there the floor is laid island by island
-/// (docs/ALGORITHMS.md §8, "Islands").
-fn split_of(offsets: &[Vec<Vec<[f64; 2]>>], pitch: f64) -> Option<(f64, usize)> {
-    offsets
-        .iter()
-        .enumerate()
-        .find(|(_, c)| c.len() > 1)
-        .map(|(d, c)| (pitch * (d + 1) as f64, c.len()))
-}
 
 /// Whether an offset contour encloses less than a pitch squared: a speck
 /// the squeeze of the beads round it fills (docs/ALGORITHMS.md §8).
@@ -840,6 +842,44 @@ mod tests {
         let (entries, longest) = floor_entries(&rings, start, BEADS.width);
         assert!(longest <= 2.0 * BEADS.pitch(), "{longest}");
         assert_eq!(entries.len(), rings.len());
+        let cov = coverage(&outer, &rings, 1.5);
+        assert!(cov > 0.95, "{cov}");
+        let d = closest_elements(&outer, &rings);
+        assert!(d > 0.75 * BEADS.pitch(), "{d}");
+    }
+
+    /// Three smooth lobes in a row, 64 mm across, 60 and 66 mm apart: the
+    /// waist between the first two about 41 mm across, the other 32 mm.
+    fn three_lobes() -> Vec<[f64; 2]> {
+        let centres = [-60.0, 0.0, 66.0];
+        let half = |x: f64| {
+            centres
+                .iter()
+                .map(|c: &f64| 32.0 * (-((x - c) / 28.0).powi(2)).exp())
+                .sum::<f64>()
+        };
+        let n = 240;
+        let (a, b) = (-110.0, 116.0);
+        let xs: Vec<f64> = (0..=n).map(|i| a + (b - a) * i as f64 / n as f64).collect();
+        let mut pts: Vec<[f64; 2]> = xs.iter().map(|&x| [x, -half(x)]).collect();
+        pts.extend(xs.iter().rev().skip(1).take(n - 1).map(|&x| [x, half(x)]));
+        pts
+    }
+
+    #[test]
+    fn islands_that_split_again_are_laid_island_in_island() {
+        // The narrower waist splits the floor first (one lobe, and two
+        // still joined); the wider one splits those two later. It was
+        // refused as islands that split again.
+        let outer = three_lobes();
+        let rings = floor_plan(&outer, BEADS).unwrap();
+        let islands = rings.iter().filter(|r| r.island).count();
+        assert!(islands >= 4, "{islands}");
+        // Started at the middle lobe's side (the tapered ends are no
+        // place to start a floor from: the pipeline picks a start column
+        // the same way, docs/ALGORITHMS.md §8).
+        let (_, longest) = floor_entries(&rings, outer[120], BEADS.width);
+        assert!(longest <= 2.0 * BEADS.pitch(), "{longest}");
         let cov = coverage(&outer, &rings, 1.5);
         assert!(cov > 0.95, "{cov}");
         let d = closest_elements(&outer, &rings);

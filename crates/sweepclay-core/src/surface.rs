@@ -292,8 +292,9 @@ pub fn sample_surface(design: &Design) -> Result<Surface> {
 /// The columns a vessel's path may start each layer and turn at, best
 /// first: Ψ's start, or the one nearest the floor's innermost ring, where
 /// each ring is entered a short step from the one before
-/// (docs/ALGORITHMS.md §8). Refuses a floor whose islands split again,
-/// or whose innermost line is out of a short step's reach.
+/// (docs/ALGORITHMS.md §8). Refuses a floor whose islands split more
+/// than `MAX_SPLITS` times, or whose innermost line is out of a short
+/// step's reach.
 fn floor_start(
     columns: &[Column],
     params: &Params,
@@ -321,7 +322,8 @@ fn floor_start(
         Err(FloorRefusal::Islands { depth, count: k }) => return Err(Error::invalid(
             "trajectory",
             format!(
-                "the floor's rings split at a waist into islands, and one of them splits again into {k} islands {depth:.1} mm inside the wall (a second waist about {:.0} mm wide or narrower): the path goes from island to island only once; widen that waist, or print the vessel bottomless (params.floor_layers = 0)",
+                "the floor's rings split at waists into islands more than {} times over, the last into {k} islands {depth:.1} mm inside the island before (a waist about {:.0} mm wide or narrower): widen the narrowest waists, or print the vessel bottomless (params.floor_layers = 0)",
+                crate::floor::MAX_SPLITS,
                 2.0 * depth
             ),
         )),
