@@ -88,13 +88,25 @@ fn parse_svg(text: &str) -> Result<roxmltree::Document<'_>> {
     })
 }
 
+/// One shape of an imported file: its label (element, `id`, sub-path)
+/// and its points.
+pub type Shape = (String, ImportedPath);
+
 /// Every shape of an SVG document, in document order, each as trajectory
 /// points (mm, centred on `o`, y up), at most `max`: each `<polyline>`,
 /// `<polygon>`, `<line>`, `<circle>`, `<ellipse>` and `<rect>`, and each
 /// sub-path of each `<path>` (a drawing program's one path often holds a
 /// shape and its hole, or several strokes). Labelled by element, `id` and
 /// sub-path. An error when there is none.
-pub fn svg_shapes(text: &str, max: usize) -> Result<Vec<(String, ImportedPath)>> {
+pub fn svg_shapes(text: &str, max: usize) -> Result<Vec<Shape>> {
+    svg_shapes_skipping(text, max).map(|(shapes, _)| shapes)
+}
+
+/// [`svg_shapes`], keeping the good shapes of a file with a bad one: each
+/// shape that cannot be read (a path with a broken `d`, a degenerate
+/// circle) is left out and named with its reason in the second list. An
+/// error only when no shape can be read: the first shape's reason.
+pub fn svg_shapes_skipping(text: &str, max: usize) -> Result<(Vec<Shape>, Vec<String>)> {
     let doc = parse_svg(text)?;
     let root = doc.root_element();
     if root.tag_name().name() != "svg" {
@@ -108,6 +120,7 @@ pub fn svg_shapes(text: &str, max: usize) -> Result<Vec<(String, ImportedPath)>>
     }
     let mm_per_unit = unit_scale(&root)?;
     let mut out = Vec::new();
+    let mut skipped: Vec<(String, Error)> = Vec::new();
     let nodes = root
         .descendants()
         .filter(|n| n.is_element())
@@ -124,29 +137,50 @@ pub fn svg_shapes(text: &str, max: usize) -> Result<Vec<(String, ImportedPath)>>
             Some(id) => format!("<{tag}> {id}"),
             None => format!("<{tag}>"),
         };
-        let parts = shape_of(node, mm_per_unit)?;
+        let parts = match shape_of(node, mm_per_unit) {
+            Ok(parts) => parts,
+            Err(e) => {
+                skipped.push((name, e));
+                continue;
+            }
+        };
         let many = parts.len() > 1;
         for (k, (pts, closed)) in parts.into_iter().enumerate() {
             if out.len() >= max {
-                return Ok(out);
+                return Ok((out, skipped_notes(skipped)));
             }
             let label = if many {
                 format!("{name}, sub-path {}", k + 1)
             } else {
                 name.clone()
             };
-            let mut path = finish_path(pts, closed, &format!("svg <{tag}>"))?;
-            centre(&mut path.points);
-            out.push((label, path));
+            match finish_path(pts, closed, &format!("svg <{tag}>")) {
+                Ok(mut path) => {
+                    centre(&mut path.points);
+                    out.push((label, path));
+                }
+                Err(e) => skipped.push((label, e)),
+            }
         }
     }
     if out.is_empty() {
-        return Err(Error::invalid(
-            "svg",
-            "no <path>, <polyline>, <polygon>, <line>, <circle>, <ellipse> or <rect> element to import",
-        ));
+        return Err(match skipped.into_iter().next() {
+            Some((_, e)) => e,
+            None => Error::invalid(
+                "svg",
+                "no <path>, <polyline>, <polygon>, <line>, <circle>, <ellipse> or <rect> element to import",
+            ),
+        });
     }
-    Ok(out)
+    Ok((out, skipped_notes(skipped)))
+}
+
+/// The shapes an import left out, each with its reason.
+fn skipped_notes(skipped: Vec<(String, Error)>) -> Vec<String> {
+    skipped
+        .into_iter()
+        .map(|(label, e)| format!("{label} left out: {e}"))
+        .collect()
 }
 
 /// One element's shapes in mm (y up, not yet centred): a `<path>`'s
@@ -577,6 +611,26 @@ mod tests {
     use super::*;
 
     use crate::bspline::polyline_length as length;
+
+    #[test]
+    fn one_bad_shape_leaves_the_good_ones() {
+        // A drawing with a broken path among good shapes: the good ones
+        // are kept and the bad one named (the whole file was refused).
+        let svg = r#"<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm" viewBox="0 0 100 100">
+            <path id="broken" d="M 10 10 L 20"/>
+            <circle id="good" cx="50" cy="50" r="20"/></svg>"#;
+        let (shapes, skipped) = svg_shapes_skipping(svg, MAX_SHAPES).unwrap();
+        assert_eq!(shapes.len(), 1);
+        assert_eq!(shapes[0].0, "<circle> good");
+        assert_eq!(skipped.len(), 1);
+        assert!(
+            skipped[0].starts_with("<path> broken left out"),
+            "{skipped:?}"
+        );
+        // Only bad shapes: the first one's reason.
+        let bad = r#"<svg xmlns="http://www.w3.org/2000/svg"><path d="M 10 10 L 20"/></svg>"#;
+        assert!(svg_shapes(bad, MAX_SHAPES).is_err());
+    }
 
     #[test]
     fn a_european_csv_reads_its_decimal_commas() {

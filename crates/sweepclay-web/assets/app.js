@@ -890,7 +890,10 @@ function openImport(name, body) {
     pick.appendChild(o);
   });
   $('im-pick-row').hidden = shapes.length < 2;
-  $('im-simplify').checked = shapes[0].points.length > 150;
+  // Dense shapes become editable points by default: the picked one's
+  // density decides, not the first's.
+  const denseDefault = () => { $('im-simplify').checked = shapes[Number(pick.value) || 0].points.length > 150; };
+  denseDefault();
   const chosen = () => {
     const sh = shapes[Number(pick.value) || 0];
     const tol = parseFloat($('im-tol').value);
@@ -900,10 +903,11 @@ function openImport(name, body) {
   const draw = () => {
     const { sh, pts, tol } = chosen();
     $('im-count').textContent = $('im-simplify').checked ? `${sh.points.length} → ${pts.length} points (within ${tol} mm)` : `${sh.points.length} points`;
-    $('im-what').textContent = `${name}: ${shapes.length} shape${shapes.length > 1 ? 's' : ''}; the path is replaced only when you press “Use this path”.`;
+    const left = (body.skipped || []).length ? ` ${body.skipped.join('; ')}.` : '';
+    $('im-what').textContent = `${name}: ${shapes.length} shape${shapes.length > 1 ? 's' : ''}; the path is replaced only when you press “Use this path”.${left}`;
     drawImport($('im-preview'), sh.points, pts, sh.closed);
   };
-  pick.onchange = draw;
+  pick.onchange = () => { denseDefault(); draw(); };
   $('im-simplify').onchange = draw;
   $('im-tol').oninput = draw;
   draw();
@@ -952,7 +956,10 @@ function useImport(name, body) {
     if (body.offset === 'normal') d.trajectory.offset = 'normal';
     setClosed(d, body.closed);
   }, true);
+  // The note of the last import, or none: an earlier import's stays no
+  // longer.
   if (body.note) showNote(`${name}: ${body.note}`);
+  else $('status').querySelector('.note')?.remove();
   editors[2].fitted = false;
   editors[2].fit();
   editors[2].refresh();

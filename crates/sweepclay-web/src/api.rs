@@ -489,6 +489,9 @@ pub struct Imported {
     /// Every shape of the file to pick from (an SVG's elements and
     /// sub-paths, the first being the one above), each with its own label.
     pub shapes: Vec<ImportedShape>,
+    /// The shapes left out, each with its reason ("<path> p3 left out:
+    /// …"): one bad shape no longer refuses the whole file.
+    pub skipped: Vec<String>,
 }
 
 /// One shape of an imported file.
@@ -541,18 +544,28 @@ fn imported_points(path: sweepclay_core::import::ImportedPath) -> ImportedPoints
 
 /// Imports a trajectory; `format` is `svg` or `csv`.
 pub fn import(format: &str, text: &str) -> Result<Imported, ApiError> {
-    let shapes: Vec<ImportedShape> = match format {
-        "svg" => sweepclay_core::import::svg_shapes(text, sweepclay_core::import::MAX_SHAPES)?
-            .into_iter()
-            .map(|(label, path)| ImportedShape {
-                label,
-                path: imported_points(path),
-            })
-            .collect(),
-        "csv" => vec![ImportedShape {
-            label: "CSV points".into(),
-            path: imported_points(sweepclay_core::import::csv_path(text)?),
-        }],
+    let (shapes, skipped): (Vec<ImportedShape>, Vec<String>) = match format {
+        "svg" => {
+            let (shapes, skipped) = sweepclay_core::import::svg_shapes_skipping(
+                text,
+                sweepclay_core::import::MAX_SHAPES,
+            )?;
+            let shapes = shapes
+                .into_iter()
+                .map(|(label, path)| ImportedShape {
+                    label,
+                    path: imported_points(path),
+                })
+                .collect();
+            (shapes, skipped)
+        }
+        "csv" => (
+            vec![ImportedShape {
+                label: "CSV points".into(),
+                path: imported_points(sweepclay_core::import::csv_path(text)?),
+            }],
+            Vec::new(),
+        ),
         other => {
             return Err(ApiError::new(
                 400,
@@ -564,6 +577,7 @@ pub fn import(format: &str, text: &str) -> Result<Imported, ApiError> {
     Ok(Imported {
         first: shapes[0].path.clone(),
         shapes,
+        skipped,
     })
 }
 
