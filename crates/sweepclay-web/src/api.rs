@@ -489,8 +489,8 @@ pub struct Imported {
     /// Every shape of the file to pick from (an SVG's elements and
     /// sub-paths, the first being the one above), each with its own label.
     pub shapes: Vec<ImportedShape>,
-    /// The shapes left out, each with its reason ("<path> p3 left out:
-    /// …"): one bad shape no longer refuses the whole file.
+    /// The shapes left out, each with its reason (`"<path> p3 left out:
+    /// …"`): one bad shape no longer refuses the whole file.
     pub skipped: Vec<String>,
 }
 
