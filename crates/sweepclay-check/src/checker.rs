@@ -5,7 +5,7 @@
 use crate::bead::Bead;
 use crate::blocks::Blocks;
 use crate::collide;
-use crate::geom::{larger, len2, minmax, overlap_fraction, smaller};
+use crate::geom::{larger, len2, minmax, overlap_fraction};
 use crate::grid::{settle, BeadGrid};
 use crate::parse::{Diagnostic, Line, LineParser};
 use crate::replay::{Event, Move, Replayer};
@@ -342,8 +342,6 @@ struct Checker<'a> {
     scratch: Scratch,
     s: f64,
     top_z: f64,
-    lo: [f64; 3],
-    hi: [f64; 3],
     layer_heights: Vec<f64>,
     /// Clay tops of the beads laid more than 2 w_max of path back, in
     /// finer cells, for the support's fast path (`follow_support`).
@@ -407,8 +405,6 @@ impl<'a> Checker<'a> {
             scratch: Scratch::default(),
             s: 0.0,
             top_z: f64::MIN,
-            lo: [f64::MAX; 3],
-            hi: [f64::MIN; 3],
             layer_heights: Vec::new(),
             support_tops: TopGrid::layered(
                 [cfg.build_volume[0], cfg.build_volume[1]],
@@ -761,9 +757,12 @@ impl<'a> Checker<'a> {
         }
     }
 
-    /// Records the beads of a stretch under the least overlap, now that
-    /// it is long enough to fail ([`Weak`]).
+    /// Records the beads of a stretch of [`Weak`] beads of kind `k`, if it
+    /// is long enough to fail: half the narrowest bead.
     fn flush_weak(&mut self, k: usize) {
+        if self.weak[k].length < 0.5 * self.cfg.width_min {
+            return;
+        }
         let mut pending = std::mem::take(&mut self.weak[k].pending);
         for &(line, v) in &pending {
             self.record(WEAK_KINDS[k], line, v, false);
@@ -844,8 +843,6 @@ impl<'a> Checker<'a> {
             blocks,
             scratch,
             top_z,
-            lo,
-            hi,
             layer_heights,
             support_tops,
             support_settled,
@@ -876,12 +873,6 @@ impl<'a> Checker<'a> {
         };
         r.path_length_mm += len;
         r.volume_ml += volume / 1000.0;
-        for p in [m.from, m.to] {
-            for a in 0..3 {
-                lo[a] = smaller(lo[a], p[a]);
-                hi[a] = larger(hi[a], p[a]);
-            }
-        }
         let rise = (m.to[2] - m.from[2]).abs();
         // The plan vector and length, once for every use below.
         let d = [m.to[0] - m.from[0], m.to[1] - m.from[1]];
@@ -1224,9 +1215,7 @@ impl<'a> Checker<'a> {
                 Some(Some(short)) => {
                     self.weak[k].length += xy;
                     self.weak[k].pending.push((m.line, short));
-                    if self.weak[k].length >= 0.5 * self.cfg.width_min {
-                        self.flush_weak(k);
-                    }
+                    self.flush_weak(k);
                 }
                 Some(None) => {
                     self.weak[k].length = 0.0;
@@ -1262,9 +1251,7 @@ impl<'a> Checker<'a> {
     fn finish(mut self) -> Report {
         self.close_stretch(None);
         for k in 0..WEAK_KINDS.len() {
-            if self.weak[k].length >= 0.5 * self.cfg.width_min {
-                self.flush_weak(k);
-            }
+            self.flush_weak(k);
         }
         if self.lead.print_run.is_none() {
             // Nothing rests on anything (a single layer): the print begins
@@ -1333,9 +1320,6 @@ impl<'a> Checker<'a> {
                     hi[a] = hi[a].max(p[a]);
                 }
             }
-        }
-        if hi[0] < lo[0] {
-            (lo, hi) = (self.lo, self.hi);
         }
         if r.extruding_moves > 0 {
             r.size_mm = [hi[0] - lo[0], hi[1] - lo[1], hi[2].max(0.0)];

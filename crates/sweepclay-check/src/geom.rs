@@ -35,17 +35,6 @@ pub(crate) fn larger<T: PartialOrd>(a: T, b: T) -> T {
     }
 }
 
-/// `a.min(b)` for an `a` that is not NaN (a running minimum): see
-/// [`larger`].
-#[inline(always)]
-pub(crate) fn smaller<T: PartialOrd>(a: T, b: T) -> T {
-    if b < a {
-        b
-    } else {
-        a
-    }
-}
-
 /// Plan distance from `p` to a rectangle `[x0, y0, x1, y1]` (0 inside; 0
 /// for a NaN `p`).
 #[inline]

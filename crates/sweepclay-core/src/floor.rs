@@ -135,9 +135,7 @@ fn region_rings(
         });
     }
     let mut rings = rings_of(outer, &offsets[..s], beads, false);
-    for island in &offsets[s] {
-        let mut inner = vec![vec![island.clone()]];
-        inner.extend(offsets_from(island.clone(), pitch));
+    for inner in by_island(&offsets[s..]) {
         let mut part = region_rings(outer, &inner, beads, splits + 1)?;
         if let Some(first) = part.first_mut() {
             first.island = true;
@@ -145,6 +143,31 @@ fn region_rings(
         rings.extend(part);
     }
     Ok(rings)
+}
+
+/// The offsets from a split on, island by island: each island's contour,
+/// then the deeper contours that lie inside it (a contour lies wholly
+/// inside the one it was offset from, so one of its points tells).
+fn by_island(offsets: &[Vec<Vec<[f64; 2]>>]) -> Vec<Vec<Vec<Vec<[f64; 2]>>>> {
+    use geo::Contains;
+    let islands: Vec<geo::Polygon<f64>> = offsets[0].iter().map(|c| polygon(c)).collect();
+    let mut parts: Vec<Vec<Vec<Vec<[f64; 2]>>>> =
+        offsets[0].iter().map(|c| vec![vec![c.clone()]]).collect();
+    for depth in &offsets[1..] {
+        let mut next = vec![Vec::new(); parts.len()];
+        for c in depth {
+            let p = geo::Point::new(c[0][0], c[0][1]);
+            if let Some(i) = islands.iter().position(|isl| isl.contains(&p)) {
+                next[i].push(c.clone());
+            }
+        }
+        for (part, cs) in parts.iter_mut().zip(next) {
+            if !cs.is_empty() {
+                part.push(cs);
+            }
+        }
+    }
+    parts
 }
 
 /// The innermost ring of a region that ends in a tail (a lens drawn out
@@ -374,14 +397,8 @@ fn inward_offsets(outer: &[[f64; 2]], pitch: f64) -> Vec<Vec<Vec<[f64; 2]>>> {
     if signed_area2(&first) < 0.0 {
         first.reverse();
     }
-    offsets_from(thinned(&first), pitch)
-}
-
-/// The inward offsets of a counter-clockwise contour by one pitch, two,
-/// … (see [`inward_offsets`]), the contour itself not among them.
-fn offsets_from(contour: Vec<[f64; 2]>, pitch: f64) -> Vec<Vec<Vec<[f64; 2]>>> {
     let mut out = Vec::new();
-    let mut current = vec![contour];
+    let mut current = vec![thinned(&first)];
     for _ in 0..MAX_FLOOR_RINGS {
         let next: Vec<Vec<[f64; 2]>> = current
             .iter()
