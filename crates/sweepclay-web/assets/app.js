@@ -6,6 +6,8 @@
 import { CurveEditor, fmt, segDist } from './editor.js';
 import { View3D } from './view3d.js';
 import { sample, samplePeriodic } from './bspline.js';
+import { afterPaint, frameStats, onFrame } from './frame.js';
+import { decode, normals, zip } from './mesh.js';
 
 const $ = (id) => document.getElementById(id);
 const STORE = 'sweepclay.design.v1';
@@ -13,6 +15,8 @@ const STORE = 'sweepclay.design.v1';
 // inside the browser's few megabytes of storage).
 const HISTORY = 'sweepclay.history.v1';
 const KEPT_STEPS = 60;
+// This tab's own history (a second tab keeps its own; docs/MODELER.md).
+const TAB_HISTORY = 'sweepclay.tab-history.v1';
 const PRINTERS = 'sweepclay.printers.v1';
 const GUIDE_SEEN = 'sweepclay.guide.v1';
 
@@ -43,13 +47,19 @@ const state = {
   pending: null,
   lastEdit: null,
   roundTrips: [],
+  // Pointer event → the painted frame with the edited curve (ms).
+  editTimes: [],
   verdictTimes: [],
+  // Each design sent to slice is numbered: an answer for an older one
+  // never sets the verdict (docs/MODELER.md).
+  seq: 0,
   verifyTimer: 0,
   verifySeq: 0,
   sliced: null,
 };
 // For tests and the curious: the last round trips (edit → preview drawn), ms.
 window.sweepclay = state;
+state.frames = frameStats;
 window.sweepclayErrors = [];
 window.addEventListener('error', (e) => window.sweepclayErrors.push(String(e.message)));
 window.addEventListener('unhandledrejection', (e) => window.sweepclayErrors.push(String(e.reason)));
@@ -77,8 +87,6 @@ function interpolationPoints(d) {
 
 /** Replaces the design; `record` adds an undo step. */
 function setDesign(d, { record = true, fit = false } = {}) {
-  // A pot with one profile (docs/FORMATS.md): the editors show both.
-  if (!d.profile_end) d.profile_end = JSON.parse(JSON.stringify(d.profile_start));
   state.design = d;
   if (record) {
     state.history = state.history.slice(0, state.at + 1);
@@ -86,35 +94,96 @@ function setDesign(d, { record = true, fit = false } = {}) {
     if (state.history.length > 200) state.history.shift();
     state.at = state.history.length - 1;
   }
-  try {
-    localStorage.setItem(STORE, JSON.stringify(d));
-    const kept = state.history.slice(-KEPT_STEPS);
-    const at = state.at - (state.history.length - kept.length);
-    localStorage.setItem(HISTORY, JSON.stringify({ history: kept, at }));
-  } catch (e) {
-    /* private mode or full: no autosave */
-  }
+  saveSoon();
   for (const ed of editors) {
     if (fit) ed.fitted = false;
     if (fit) ed.fit();
     ed.refresh();
   }
   fillParams();
+  showPotMode();
   $('offset').value = d.trajectory.offset === 'normal' ? 'normal' : 'radial';
   $('closed').checked = !!d.trajectory.closed;
   updateUndo();
   requestSlice(fit);
 }
 
-function edit(mutate, final) {
+/**
+ * Changes the design; `since` is the input event's own time (its
+ * `timeStamp`), from which the speed budget counts (docs/MODELER.md).
+ */
+/**
+ * Keeps the design and its history in the browser, a moment after the
+ * last change: a drag's moves never wait for storage.
+ */
+function saveSoon() {
+  clearTimeout(state.saveTimer);
+  state.unsaved = true;
+  state.saveTimer = setTimeout(saveNow, 300);
+}
+
+function saveNow() {
+  clearTimeout(state.saveTimer);
+  if (!state.design || !state.unsaved) return;
+  state.unsaved = false;
+  try {
+    localStorage.setItem(STORE, JSON.stringify(state.design));
+    const kept = state.history.slice(-KEPT_STEPS);
+    const at = state.at - (state.history.length - kept.length);
+    const h = JSON.stringify({ history: kept, at });
+    localStorage.setItem(HISTORY, h);
+    sessionStorage.setItem(TAB_HISTORY, h);
+  } catch (e) {
+    /* private mode or full: no autosave */
+  }
+}
+
+// Another tab saved its design: this tab keeps its own, says so, and
+// offers the other one (an undoable step), never losing either.
+window.addEventListener('storage', (e) => {
+  if (e.key !== STORE || !e.newValue || !state.design) return;
+  if (e.newValue === JSON.stringify(state.design)) return;
+  let other;
+  try {
+    other = JSON.parse(e.newValue);
+  } catch (err) {
+    return;
+  }
+  const s = $('status');
+  s.querySelector('.note')?.remove();
+  const div = document.createElement('div');
+  div.className = 'note';
+  div.id = 'other-tab';
+  div.append(`Another tab saved a different design${other.name ? ` ("${other.name}")` : ''}; this tab keeps yours and its undo history. `);
+  const b = document.createElement('button');
+  b.id = 'open-other-tab';
+  b.textContent = 'Open that design here';
+  b.addEventListener('click', () => {
+    div.remove();
+    setDesign(other, { fit: true });
+  });
+  div.append(b);
+  s.appendChild(div);
+});
+window.addEventListener('pagehide', saveNow);
+
+function edit(mutate, final, since) {
   state.restored = false;
   const d = clone(state.design);
   // A parameter's own change sets it again just after this.
   state.lastParam = null;
   mutate(d);
-  state.lastEdit = state.lastEdit ?? performance.now();
+  const t = since ?? performance.now();
+  state.lastEdit = Math.min(state.lastEdit ?? t, t);
   state.lastEditAt = performance.now();
   setDesign(d, { record: final });
+  // From the event to the painted frame that shows the edited curve.
+  if (since != null) {
+    afterPaint((now) => {
+      state.editTimes.push(now - since);
+      if (state.editTimes.length > 400) state.editTimes.shift();
+    });
+  }
 }
 
 function updateUndo() {
@@ -139,12 +208,18 @@ function redo() {
 const curve = (pts) => (pts.length >= 2 ? sample(pts, 160) : pts);
 const MIN_DZ = 0.5;
 
+/** A profile's points; a pot's end profile is its start one (docs/FORMATS.md). */
+function profilePoints(d, key) {
+  return (d[key] || d.profile_start).control_points;
+}
+
 function profileEditor(id, key, otherKey) {
   return new CurveEditor($(id), {
-    get: () => (state.design ? state.design[key].control_points : []),
-    set: (pts, final) => edit((d) => { d[key].control_points = pts; }, final),
+    get: () => (state.design ? profilePoints(state.design, key) : []),
+    set: (pts, final, since) => edit((d) => { d[key] = { control_points: pts }; }, final, since),
     curve,
-    ghost: () => (state.design ? state.design[otherKey].control_points : null),
+    // A pot has no other profile to show faintly.
+    ghost: () => (state.design?.profile_end ? profilePoints(state.design, otherKey) : null),
     printed: () => state.printed?.[key] ?? null,
     ground: true,
     snap: 1,
@@ -170,10 +245,10 @@ const editors = [
   new CurveEditor($('ed-traj'), {
     get: () => (state.design ? trajectoryPoints(state.design) : []),
     printed: () => state.printed?.trajectory ?? null,
-    set: (pts, final) => edit((d) => {
+    set: (pts, final, since) => edit((d) => {
       if (d.trajectory.points) d.trajectory.points = pts;
       else d.trajectory.control_points = pts;
-    }, final),
+    }, final, since),
     curve: (pts) => {
       const t = state.design?.trajectory;
       // A closed trajectory wraps round: the polygon closes, the
@@ -189,7 +264,7 @@ const editors = [
   }),
   new CurveEditor($('ed-interp'), {
     get: () => (state.design ? interpolationPoints(state.design) : [[0, 0], [1, 1]]),
-    set: (pts, final) => edit((d) => { d.interpolation = { control_points: pts }; }, final),
+    set: (pts, final, since) => edit((d) => { d.interpolation = { control_points: pts }; }, final, since),
     curve: (pts) => {
       const d = state.design;
       if (d?.trajectory.closed && !d.interpolation) {
@@ -297,11 +372,208 @@ $('offset').addEventListener('change', (e) => edit((d) => {
   else delete d.trajectory.offset;
 }, true));
 
+
+// ---------------------------------------------------------------- pots
+
+/**
+ * Pot mode (docs/MODELER.md): a design without an end profile has one
+ * profile for the whole wall. Its end-profile editor and the
+ * interpolation give way to the widths-at-heights table.
+ */
+function showPotMode() {
+  const d = state.design;
+  const pot = !d.profile_end;
+  $('one-profile').checked = pot;
+  $('end-figure').hidden = pot;
+  $('ed-interp').closest('figure').hidden = pot;
+  $('pot-panel').hidden = !pot;
+  const caption = pot ? 'side profile' : 'start side profile';
+  if ($('start-caption').textContent !== caption) $('start-caption').textContent = caption;
+  if (pot) fillPot();
+}
+
+$('one-profile').addEventListener('change', (e) => edit((d) => {
+  if (e.target.checked) {
+    delete d.profile_end;
+    delete d.interpolation;
+  } else {
+    d.profile_end = clone(d.profile_start);
+  }
+}, true));
+
+/** The x-extent of the path seen from above (mm): a round pot's base diameter. */
+function baseWidth(d) {
+  const t = d.trajectory;
+  const pts = t.points || t.control_points;
+  const path = t.closed ? (t.points ? pts : samplePeriodic(pts)) : t.points ? pts : sample(pts, 160);
+  const xs = path.map((p) => p[0]);
+  return Math.max(...xs) - Math.min(...xs);
+}
+
+/** The table's rows: each profile point as a height and a width across. */
+function fillPot() {
+  const d = state.design;
+  const pts = d.profile_start.control_points;
+  const w0 = baseWidth(d);
+  const p = { ...state.meta.params, ...(d.params || {}) };
+  // Rebuilt only when it shows something else: a drag repaints no table.
+  const look = JSON.stringify([pts, w0, p.layer_height]);
+  if (look === state.potLook) return;
+  state.potLook = look;
+  const body = $('pot-rows').tBodies[0];
+  const focused = document.activeElement?.closest?.('#pot-rows') ? document.activeElement.id : null;
+  body.innerHTML = '';
+  pts.forEach(([x, z], i) => {
+    const tr = document.createElement('tr');
+    const cell = (id, v, title, disabled) => {
+      const td = document.createElement('td');
+      const inp = document.createElement('input');
+      inp.type = 'text';
+      inp.inputMode = 'decimal';
+      inp.id = id;
+      inp.value = fmtMm(v);
+      inp.title = title;
+      inp.disabled = !!disabled;
+      td.appendChild(inp);
+      tr.appendChild(td);
+      return inp;
+    };
+    const zi = cell(`pot-z${i}`, z, i === 0 ? 'the base stands on the bed' : 'height of this point above the bed (mm)', i === 0);
+    const wi = cell(`pot-w${i}`, w0 + 2 * (x - pts[0][0]), i === 0 ? 'the width of the base across (mm): the path seen from above scales with it' : 'the width across at this height (mm)');
+    zi.addEventListener('change', () => potEdit(i, 'z', zi));
+    wi.addEventListener('change', () => potEdit(i, 'w', wi));
+    const td = document.createElement('td');
+    if (i > 0 && pts.length > 2) {
+      const del = document.createElement('button');
+      del.type = 'button';
+      del.textContent = '×';
+      del.id = `pot-del${i}`;
+      del.title = 'Remove this height';
+      del.addEventListener('click', () => edit((dd) => { dd.profile_start.control_points.splice(i, 1); }, true));
+      td.appendChild(del);
+    }
+    tr.appendChild(td);
+    body.appendChild(tr);
+  });
+  if (focused && $(focused)) $(focused).focus();
+  if (document.activeElement !== $('pot-height')) $('pot-height').value = fmtMm(pts[pts.length - 1][1]);
+  if (document.activeElement !== $('pot-layer')) $('pot-layer').value = fmtMm(p.layer_height);
+}
+
+const fmtMm = (v) => String(Number(v.toFixed(2)));
+
+/** A potter's number typed into the table, or a message beside it. */
+function potNumber(inp, what) {
+  const v = parseDecimal(inp.value);
+  if (!Number.isFinite(v)) {
+    potError(inp, `${what}: "${inp.value}" is not a number (write 1.5 or 1,5)`);
+    return null;
+  }
+  return v;
+}
+
+function potError(inp, msg) {
+  $('pot-error').textContent = msg;
+  inp.classList.add('bad');
+}
+
+/** Row `i`'s height or width typed in, within the profile's rules. */
+function potEdit(i, what, inp) {
+  $('pot-error').textContent = '';
+  const v = potNumber(inp, what === 'z' ? 'height' : 'width');
+  if (v == null) return;
+  const d = state.design;
+  const pts = d.profile_start.control_points;
+  if (what === 'z') {
+    const lo = pts[i - 1][1] + MIN_DZ;
+    const hi = i + 1 < pts.length ? pts[i + 1][1] - MIN_DZ : Infinity;
+    if (!(v >= lo && v <= hi)) {
+      potError(inp, `height ${fmtMm(v)} mm: must lie between the heights below and above it (${fmtMm(lo)} to ${Number.isFinite(hi) ? `${fmtMm(hi)} mm` : 'any'})`);
+      return;
+    }
+    edit((dd) => { dd.profile_start.control_points[i][1] = v; }, true);
+    return;
+  }
+  if (!(v > 0)) {
+    potError(inp, `width ${fmtMm(v)} mm: must be more than 0`);
+    return;
+  }
+  const w0 = baseWidth(d);
+  if (i === 0) {
+    // The base's width scales the path about o; the heights' widths keep
+    // their distance from the base's.
+    const k = v / w0;
+    const others = pts.map(([x]) => w0 + 2 * (x - pts[0][0]));
+    edit((dd) => {
+      const t = dd.trajectory;
+      const key = t.points ? 'points' : 'control_points';
+      t[key] = t[key].map(([x, y]) => [+(x * k).toFixed(3), +(y * k).toFixed(3)]);
+      const p0 = dd.profile_start.control_points;
+      for (let j = 1; j < p0.length; j++) p0[j][0] = +(p0[0][0] + (others[j] - v) / 2).toFixed(3);
+    }, true);
+    return;
+  }
+  edit((dd) => { dd.profile_start.control_points[i][0] = +(pts[0][0] + (v - w0) / 2).toFixed(3); }, true);
+}
+
+$('pot-add').addEventListener('click', () => edit((d) => {
+  const p = d.profile_start.control_points;
+  const n = p.length;
+  const [a, b] = [p[n - 2], p[n - 1]];
+  p.splice(n - 1, 0, [(a[0] + b[0]) / 2, (a[1] + b[1]) / 2]);
+}, true));
+
+$('pot-height').addEventListener('change', () => {
+  const inp = $('pot-height');
+  $('pot-error').textContent = '';
+  const h = potNumber(inp, 'height');
+  if (h == null) return;
+  const pts = state.design.profile_start.control_points;
+  const top = pts[pts.length - 1][1];
+  if (!(h >= MIN_DZ * (pts.length - 1))) {
+    potError(inp, `height ${fmtMm(h)} mm: too low for ${pts.length} heights`);
+    return;
+  }
+  edit((d) => {
+    for (const p of d.profile_start.control_points) p[1] = +((p[1] * h) / top).toFixed(3);
+  }, true);
+});
+
+$('pot-layer').addEventListener('change', () => {
+  const inp = $('pot-layer');
+  $('pot-error').textContent = '';
+  const v = potNumber(inp, 'layer height');
+  if (v == null) return;
+  edit((d) => { d.params = { ...(d.params || {}), layer_height: v }; }, true);
+  state.lastParam = 'layer_height';
+});
+
+/** A round pot a quarter as wide as the printer's bed: one profile, a floor. */
+function newPot() {
+  const printer = state.design?.printer ?? 'generic';
+  const d = {
+    sweepclay: 1,
+    name: 'new pot',
+    profile_start: { control_points: [[0, 0], [8, 30], [10, 60], [4, 90]] },
+    trajectory: { control_points: [], closed: true },
+    printer,
+  };
+  d.trajectory.control_points = defaultLoop(d);
+  const pr = typeof printer === 'object' ? printer : state.meta.presets.find((p) => p.name === printer);
+  // Tall enough to be a pot, never taller than the printer.
+  const zmax = pr?.build_volume?.[2] ?? 200;
+  const k = Math.min(1, (0.6 * zmax) / 90);
+  for (const p of d.profile_start.control_points) p[1] = +(p[1] * k).toFixed(2);
+  if (state.design?.params) d.params = { ...state.design.params };
+  setDesign(d, { fit: true });
+}
+$('new-pot').addEventListener('click', newPot);
+
 // ---------------------------------------------------------------- slicing
 
 let view = null;
 try {
-  view = new View3D($('view3d'));
+  view = new View3D($('view3d'), $('view-overlay'));
 } catch (e) {
   showError(String(e.message || e));
 }
@@ -337,7 +609,7 @@ function curveLines(d) {
   };
   for (const [key, k] of [['profile_start', 0], ['profile_end', t.closed ? 0 : path.length - 1]]) {
     const [p, dir] = frame(k);
-    const prof = sample(d[key].control_points, 80);
+    const prof = sample(profilePoints(d, key), 80);
     for (let i = 0; i + 1 < prof.length; i++) {
       for (const [x, z] of [prof[i], prof[i + 1]]) out.push([p[0] + x * dir[0], p[1] + x * dir[1], z]);
     }
@@ -346,11 +618,15 @@ function curveLines(d) {
 }
 
 function requestSlice(fit) {
-  if (view && state.design) view.showCurves(curveLines(state.design), state.lastEdit);
+  if (view && state.design) {
+    const d = state.design;
+    view.showCurves(() => curveLines(d), state.lastEdit);
+  }
   // The round trip counts from the oldest edit not yet shown: one merged
   // into a waiting request keeps that request's start.
   const edit = state.pending?.edit ?? state.lastEdit;
-  state.pending = { design: JSON.stringify(state.design), edit, fit: fit || state.pending?.fit };
+  state.seq++;
+  state.pending = { design: JSON.stringify(state.design), edit, fit: fit || state.pending?.fit, seq: state.seq };
   state.lastEdit = null;
   // A verdict belongs to one design: the last one no longer applies.
   cancelVerify();
@@ -381,85 +657,109 @@ function setStale(on) {
   $('stale-note').hidden = !on;
 }
 
-async function sendSlice() {
+// The slice is fetched and read in a worker (slice-worker.js): the page's
+// main thread stays free for input. Without workers, it is done here.
+let worker = null;
+const waiting = new Map();
+try {
+  worker = new Worker('/assets/slice-worker.js', { type: 'module' });
+  worker.onmessage = (e) => {
+    const w = waiting.get(e.data.id);
+    waiting.delete(e.data.id);
+    if (w) w(e.data);
+  };
+} catch (e) {
+  worker = null;
+}
+let workerIds = 0;
+
+/** Slices a design (JSON text): `{ ok, body, timing }`, or `{ failed }` when the server did not answer. */
+async function sliceDesign(design) {
+  if (worker) {
+    const id = ++workerIds;
+    return new Promise((resolve) => {
+      waiting.set(id, resolve);
+      worker.postMessage({ id, design });
+    });
+  }
+  const t0 = performance.now();
+  try {
+    const r = await postDesign('/api/slice?format=binary', design);
+    const headers = performance.now() - t0;
+    if (!r.ok) return { ok: false, body: await r.json() };
+    const body = decode(await r.arrayBuffer());
+    const request = performance.now() - t0;
+    body.surface.triangles = zip(body.surface.positions, body.surface.columns);
+    body.surface.normals = normals(body.surface.positions, body.surface.triangles);
+    return { ok: true, body, timing: { headers_ms: headers, request_ms: request, worker_ms: performance.now() - t0 } };
+  } catch (e) {
+    return { ok: false, failed: String(e.message || e) };
+  }
+}
+
+function sendSlice() {
   const job = state.pending;
   state.pending = null;
   if (!job) return;
   state.inFlight = true;
-  const t0 = performance.now();
   setBusy(true);
-  try {
-    const r = await postDesign('/api/slice?format=binary', job.design);
-    const th = performance.now();
-    const body = r.ok ? decode(await r.arrayBuffer()) : await r.json();
-    if (!r.ok) {
-      // A newer design already waiting answers for itself.
-      if (!state.pending) sliceFailed(body.error, body.key);
-    } else {
-      showError(null);
-      setStale(false);
-      state.restored = false;
-      const t1 = performance.now();
-      render(body, job.fit);
-      if (body.fit_error) {
-        // Shown as it is, with what lies outside the printer in red; it
-        // cannot be printed, so there is no check to wait for.
-        showError(body.fit_error.error, body.fit_error.key);
-        cancelVerify();
-        setVerdict({ printable: false, failures: [plainWords(body.fit_error.error)], locations: [] });
-      }
-      const now = performance.now();
-      const since = job.edit ?? t0;
-      state.roundTrips.push({
-        ms: now - since,
-        request_ms: t1 - t0,
-        headers_ms: th - t0,
-        render_ms: now - t1,
-        server_ms: body.slice_ms,
-        samples: body.stats.sample_points,
+  const t0 = performance.now();
+  sliceDesign(job.design)
+    // The answer is shown at the next frame, never inside a handler.
+    .then((res) => new Promise((resolve) => {
+      onFrame('slice', () => {
+        try {
+          showSlice(job, res, t0);
+        } finally {
+          resolve();
+        }
       });
-      if (state.roundTrips.length > 100) state.roundTrips.shift();
-      showTiming();
-      // A newer design waiting has the verdict to come, not this one.
-      if (!state.pending && !body.fit_error) scheduleVerify(job.design);
-    }
-  } catch (e) {
-    sliceFailed(`the server did not answer: ${e.message || e}`);
-  } finally {
-    state.inFlight = false;
-    setBusy(false);
-    if (state.pending) sendSlice();
-  }
+    }))
+    .finally(() => {
+      state.inFlight = false;
+      if (state.pending) sendSlice();
+      else setBusy(false);
+    });
 }
 
-/** Reads the binary slice answer (SliceView::to_binary): typed arrays, no parsing. */
-function decode(buf) {
-  const dv = new DataView(buf);
-  const magic = String.fromCharCode(...new Uint8Array(buf, 0, 4));
-  if (magic !== 'SWCL') throw new Error('unexpected answer from /api/slice');
-  const jsonLen = dv.getUint32(4, true);
-  const head = JSON.parse(new TextDecoder().decode(new Uint8Array(buf, 8, jsonLen)));
-  let o = 8 + jsonLen;
-  const next = (Type) => {
-    const n = dv.getUint32(o, true);
-    const a = new Type(buf, o + 4, n);
-    o += 4 + 4 * n;
-    return a;
-  };
-  const positions = next(Float32Array);
-  const columns = next(Uint32Array);
-  const moved = next(Uint32Array);
-  const order = next(Uint32Array);
-  const width = next(Float32Array);
-  const pass = next(Uint32Array);
-  const top = next(Uint32Array);
-  const beads = {
-    overlap: next(Float32Array),
-    overhang_deg: next(Float32Array),
-    layer_height: next(Float32Array),
-    clearance: next(Float32Array),
-  };
-  return { ...head, surface: { positions, columns, moved, curves: head.curves }, path: { order, width, pass, top, beads } };
+/** Shows a slice's answer: the preview, or the error; the verdict only for the newest design. */
+function showSlice(job, res, t0) {
+  // Whether this is the design now in the editors: an older one's
+  // answer may draw, but never sets the verdict or the error.
+  const current = job.seq === state.seq;
+  if (!res.ok) {
+    if (current) sliceFailed(res.failed ? `the server did not answer: ${res.failed}` : res.body.error, res.body?.key);
+    return;
+  }
+  const body = res.body;
+  showError(null);
+  setStale(false);
+  state.restored = false;
+  const t1 = performance.now();
+  render(body, job.fit);
+  if (body.fit_error && current) {
+    // Shown as it is, with what lies outside the printer marked; it
+    // cannot be printed, so there is no check to wait for.
+    showError(body.fit_error.error, body.fit_error.key);
+    cancelVerify();
+    setVerdict({ printable: false, failures: [plainWords(body.fit_error.error)], locations: [] });
+  }
+  const since = job.edit ?? t0;
+  const drawn = performance.now();
+  afterPaint((now) => {
+    state.roundTrips.push({
+      ms: now - since,
+      request_ms: res.timing.request_ms,
+      headers_ms: res.timing.headers_ms,
+      worker_ms: res.timing.worker_ms,
+      render_ms: drawn - t1,
+      server_ms: body.slice_ms,
+      samples: body.stats.sample_points,
+    });
+    if (state.roundTrips.length > 100) state.roundTrips.shift();
+    showTiming();
+  });
+  if (current && !body.fit_error) scheduleVerify(job.design);
 }
 
 function render(data, fit) {
@@ -487,7 +787,13 @@ function render(data, fit) {
     ['clay', `${s.volume_ml.toFixed(1)} ml, ${s.clay_g.toFixed(0)} g`],
     ['printing time', `${s.time_min.toFixed(1)} min`],
   ];
-  $('stats').innerHTML = rows.map(([k, v]) => `<tr><td>${k}</td><td data-stat="${k}">${v}</td></tr>`).join('');
+  // Rewritten only when they say something new: a drag's slices mostly
+  // change a few numbers.
+  const html = rows.map(([k, v]) => `<tr><td>${k}</td><td data-stat="${k}">${v}</td></tr>`).join('');
+  if (html !== state.statsHtml) {
+    state.statsHtml = html;
+    $('stats').innerHTML = html;
+  }
   list($('corrections'), data.corrections);
   list($('warnings'), data.warnings);
   showPrinted(data.printed || {});
@@ -505,7 +811,8 @@ function showPrinted(printed) {
     // A loop's printed outline closes on itself, as its editor draws it.
     trajectory: t && state.design?.trajectory?.closed ? [...t, t[0]] : t,
   };
-  editors.forEach((e) => e.draw());
+  // Only an editor whose printed curve changed is drawn again.
+  editors.forEach((e) => e.refresh());
 }
 
 function showTiming() {
@@ -517,6 +824,9 @@ function showTiming() {
 }
 
 function list(ul, items) {
+  const said = JSON.stringify(items);
+  if (ul.dataset.said === said) return;
+  ul.dataset.said = said;
   ul.innerHTML = '';
   for (const t of items) {
     const li = document.createElement('li');
@@ -552,6 +862,9 @@ const VERIFY_DELAY_MS = 60;
 
 function setVerdict(v) {
   const el = $('verdict');
+  // A drag asks for 'checking' every frame: the page is not touched again.
+  if (v === 'checking' && el.dataset.state === 'checking') return;
+  el.dataset.state = v === 'checking' ? 'checking' : '';
   el.className = '';
   if (v === null) {
     el.textContent = '— no verdict: the design does not slice';
@@ -609,12 +922,12 @@ function plainWords(msg) {
     const [, printer, axis, a, b, lo, hi] = fit;
     const over = Math.max(Number(lo) - Number(a), Number(b) - Number(hi));
     const word = { x: 'wide', y: 'deep', z: 'tall' }[axis];
-    return `${over.toFixed(1)} mm too ${word} for ${printer}: along ${axis} it spans ${Number(a).toFixed(1)} to ${Number(b).toFixed(1)} mm, the printer ${Number(lo).toFixed(1)} to ${Number(hi).toFixed(1)} mm (the part outside is red in the 3D view)`;
+    return `${over.toFixed(1)} mm too ${word} for ${printer}: along ${axis} it spans ${Number(a).toFixed(1)} to ${Number(b).toFixed(1)} mm, the printer ${Number(lo).toFixed(1)} to ${Number(hi).toFixed(1)} mm (the part outside is violet in the 3D view)`;
   }
   const round = /the design does not fit printer `([^`]+)`: it reaches (\S+) mm from the bed's centre but the round bed is (\S+) mm across/.exec(msg);
   if (round) {
     const [, printer, reach, dia] = round;
-    return `${(Number(reach) - Number(dia) / 2).toFixed(1)} mm past the edge of ${printer}'s round bed (${dia} mm across; the part outside is red in the 3D view)`;
+    return `${(Number(reach) - Number(dia) / 2).toFixed(1)} mm past the edge of ${printer}'s round bed (${dia} mm across; the part outside is violet in the 3D view)`;
   }
   return msg.replace(/params\.(\w+): must be between (\S+) and (\S+) \(got ([^)]+)\)/, (all, k, a, b, v) => {
     const p = param(k);
@@ -637,6 +950,8 @@ function parseDecimal(text) {
 function showError(msg, key) {
   const s = $('status');
   document.querySelectorAll('#params input.bad').forEach((i) => i.classList.remove('bad'));
+  document.querySelectorAll('#params .field-error').forEach((p) => p.remove());
+  $('side-error').textContent = '';
   if (!msg) {
     s.querySelector('.error')?.remove();
     // A good slice: the next error is nobody's earlier change.
@@ -673,7 +988,19 @@ function showError(msg, key) {
     div.append(out);
   }
   s.appendChild(div);
-  if (blamed && $(`p-${blamed}`)) $(`p-${blamed}`).classList.add('bad');
+  // Beside the field too: on a phone the 3D panel with the status line is
+  // hidden while the settings are shown (docs/MODELER.md).
+  const field = blamed && $(`p-${blamed}`);
+  if (field) {
+    field.classList.add('bad');
+    const p = document.createElement('p');
+    p.className = 'field-error';
+    p.id = `err-${blamed}`;
+    p.textContent = text;
+    field.closest('label').after(p);
+  } else {
+    $('side-error').textContent = text;
+  }
 }
 
 // ---------------------------------------------------------------- parameters
@@ -736,7 +1063,8 @@ function fillParams() {
   for (const [key, , , , , factor] of PARAMS) {
     const inp = $(`p-${key}`);
     // A percentage to two decimals (2/3 is 66.67 %).
-    if (document.activeElement !== inp) inp.value = Number((Number(p[key]) * factor).toFixed(factor === 1 ? 4 : 2));
+    const v = String(Number((Number(p[key]) * factor).toFixed(factor === 1 ? 4 : 2)));
+    if (document.activeElement !== inp && inp.value !== v) inp.value = v;
   }
   // Only a vessel has a floor.
   $('p-floor_layers').disabled = !d.trajectory.closed;
@@ -967,18 +1295,21 @@ function useImport(name, body) {
 
 // ---------------------------------------------------------------- guide, printer, tabs
 
+/**
+ * Shows the guide; once shown it is seen: it opens by itself on the
+ * first visit only (its close event is not relied on: a page closed
+ * with the guide open would show it again, in every new tab).
+ */
 function showGuide() {
   const g = $('guide');
   if (!g.open) g.showModal();
-}
-$('guide-open').addEventListener('click', showGuide);
-$('guide').addEventListener('close', () => {
   try {
     localStorage.setItem(GUIDE_SEEN, '1');
   } catch (e) {
     /* no storage: the guide comes back next time */
   }
-});
+}
+$('guide-open').addEventListener('click', showGuide);
 
 /** Printers the user made, kept in this browser: [{ printer, nozzle_height }]. */
 function keptPrinters() {
@@ -1001,6 +1332,7 @@ function openPrinter() {
   for (const [id, key, n] of PRINTER_FIELDS) {
     for (let k = 0; k < n; k++) $(`${id}${k}`).value = (base[key] || [0, 0, 0])[k];
   }
+  $('pr-dia').value = base.bed_diameter || '';
   $('pr-e').value = base.e_per_mm3;
   $('pr-r').value = base.nozzle_radius;
   $('pr-h').value = { ...state.meta.params, ...(d.params || {}) }.nozzle_height;
@@ -1017,6 +1349,10 @@ $('printer-form').addEventListener('submit', (e) => {
   // bed) stays as the printer it started from had it.
   const printer = { ...state.printerBase, name: $('pr-name').value.trim() };
   for (const [id, key, n] of PRINTER_FIELDS) printer[key] = Array.from({ length: n }, (_, k) => parseFloat($(`${id}${k}`).value));
+  // A round bed (a delta, a WASP): its diameter; empty for a rectangle.
+  const dia = $('pr-dia').value.trim();
+  if (dia) printer.bed_diameter = parseFloat(dia);
+  else delete printer.bed_diameter;
   printer.e_per_mm3 = parseFloat($('pr-e').value);
   printer.nozzle_radius = parseFloat($('pr-r').value);
   printer.start_gcode = $('pr-start').value;
@@ -1026,6 +1362,7 @@ $('printer-form').addEventListener('submit', (e) => {
     [!printer.name, 'give the printer a name'],
     [!printer.build_volume.every((v) => v > 0), 'the build volume must be positive on every axis'],
     [![...printer.bed_min, ...printer.origin].every(Number.isFinite), 'bed_min and the origin must be numbers'],
+    [dia && !(printer.bed_diameter > 0), 'the bed diameter must be a positive number of mm, or empty for a rectangular bed'],
     [!(printer.e_per_mm3 > 0), 'E per mm³ must be positive'],
     [!(printer.nozzle_radius >= 0), 'the nozzle body radius must be a number of mm'],
     [!(h > 0), 'the nozzle body height must be positive'],
@@ -1048,6 +1385,19 @@ $('printer-form').addEventListener('submit', (e) => {
     d.params = { ...(d.params || {}), nozzle_height: h };
   }, true);
 });
+
+/**
+ * An example for the printer chosen now: the example's shape, the user's
+ * printer (and, for a printer of their own, its extruder body height).
+ */
+function withMyPrinter(d) {
+  const mine = state.design?.printer;
+  if (!mine) return d;
+  d.printer = clone(mine);
+  const h = state.design.params?.nozzle_height;
+  if (typeof mine === 'object' && h != null) d.params = { ...(d.params || {}), nozzle_height: h };
+  return d;
+}
 
 function fillPrinterOptions() {
   const sel = $('p-printer');
@@ -1084,7 +1434,7 @@ $('redo').addEventListener('click', redo);
 $('new').addEventListener('click', () => setDesign(clone(NEW_DESIGN), { fit: true }));
 $('example').addEventListener('change', (e) => {
   const ex = state.meta.examples.find((x) => x.name === e.target.value);
-  if (ex) setDesign(clone(ex.design), { fit: true });
+  if (ex) setDesign(withMyPrinter(clone(ex.design)), { fit: true });
   e.target.value = '';
 });
 $('colour-by').addEventListener('change', (e) => {
@@ -1149,7 +1499,9 @@ async function start() {
   let d = null;
   try {
     d = JSON.parse(localStorage.getItem(STORE));
-    const h = JSON.parse(localStorage.getItem(HISTORY));
+    // This tab's own history first (a reload); a new tab starts from the
+    // last one saved in any tab.
+    const h = JSON.parse(sessionStorage.getItem(TAB_HISTORY) || localStorage.getItem(HISTORY));
     if (h && Array.isArray(h.history) && h.history.length && h.at >= 0 && h.at < h.history.length) {
       state.history = h.history;
       state.at = h.at;

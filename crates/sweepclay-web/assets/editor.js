@@ -4,7 +4,12 @@
 // options: how to draw the curve, which moves are allowed, what happens on
 // a change.
 
-const HIT_PX = 9;
+import { noteInput, onFrame } from './frame.js';
+
+// How near a point the pointer must come to take it (px): a mouse is
+// precise; a fingertip covers about 10 mm, so a touch reaches further.
+const HIT_PX = { mouse: 9, pen: 14, touch: 24 };
+let editorCount = 0;
 
 export class CurveEditor {
   /**
@@ -37,6 +42,10 @@ export class CurveEditor {
     this.snapOn = true;
     this.fitted = false;
     this.points = [];
+    this.key = `editor-${editorCount++}`;
+    // The last pointer's kind: a touch reaches further, and two taps are
+    // never a double-click (docs/MODELER.md).
+    this.pointerType = 'mouse';
     canvas.addEventListener('pointerdown', (e) => this.down(e));
     canvas.addEventListener('pointermove', (e) => this.move(e));
     canvas.addEventListener('pointerup', (e) => this.up(e));
@@ -71,7 +80,13 @@ export class CurveEditor {
   refresh() {
     this.points = this.o.get().map((p) => p.slice());
     if (this.selected >= this.points.length) this.selected = -1;
-    this.draw();
+    // An editor whose curves did not change is not drawn again: a drag in
+    // one editor repaints that one (and the other profile's ghost).
+    const look = JSON.stringify([this.points, this.o.ghost?.(), this.o.printed?.(), this.selected, this.o.curve(this.points).length]);
+    if (look !== this.look || !this.fitted) {
+      this.look = look;
+      onFrame(`${this.key}-draw`, () => this.draw());
+    }
     this.told();
   }
 
@@ -161,7 +176,7 @@ export class CurveEditor {
 
   hit(px, py) {
     let best = -1;
-    let bd = HIT_PX;
+    let bd = HIT_PX[this.pointerType] ?? HIT_PX.mouse;
     this.points.forEach((p, i) => {
       const [sx, sy] = this.toScreen(p);
       const d = Math.hypot(sx - px, sy - py);
@@ -180,6 +195,7 @@ export class CurveEditor {
   }
 
   down(e) {
+    this.pointerType = e.pointerType || 'mouse';
     this.canvas.focus();
     const [px, py] = this.local(e);
     this.canvas.setPointerCapture(e.pointerId);
@@ -201,7 +217,7 @@ export class CurveEditor {
 
   nearCentre(px, py) {
     const [sx, sy] = this.toScreen([0, 0]);
-    return Math.hypot(sx - px, sy - py) <= HIT_PX + 3;
+    return Math.hypot(sx - px, sy - py) <= (HIT_PX[this.pointerType] ?? HIT_PX.mouse) + 3;
   }
 
   move(e) {
@@ -213,10 +229,27 @@ export class CurveEditor {
       d = null;
     }
     if (!d) {
-      const over = this.hit(px, py) >= 0 || (this.o.centre && this.nearCentre(px, py));
-      this.canvas.style.cursor = over ? 'grab' : this.o.fixed ? 'crosshair' : 'move';
+      if (e.pointerType === 'mouse') {
+        const over = this.hit(px, py) >= 0 || (this.o.centre && this.nearCentre(px, py));
+        this.canvas.style.cursor = over ? 'grab' : this.o.fixed ? 'crosshair' : 'move';
+      }
       return;
     }
+    // Only the latest position counts, once a frame; the time is the
+    // oldest event's, so the wait in the queue counts (docs/MODELER.md).
+    this.latest = [px, py];
+    noteInput(e);
+    this.since = this.since ?? e.timeStamp;
+    onFrame(this.key, () => this.apply());
+  }
+
+  /** Moves what is dragged to the latest pointer position. */
+  apply() {
+    const d = this.drag;
+    const at = this.latest;
+    this.latest = null;
+    if (!d || !at) return;
+    const [px, py] = at;
     if (d.kind === 'pan') {
       this.ox = d.ox + px - d.px;
       this.oy = d.oy + py - d.py;
@@ -247,6 +280,8 @@ export class CurveEditor {
   }
 
   up(e) {
+    // A position not yet applied is applied before the gesture ends.
+    if (this.latest) this.apply();
     const d = this.drag;
     this.drag = null;
     if (this.canvas.hasPointerCapture(e.pointerId)) this.canvas.releasePointerCapture(e.pointerId);
@@ -257,6 +292,9 @@ export class CurveEditor {
   }
 
   dbl(e) {
+    // On a touch screen two quick taps on two points are not a request
+    // to delete the second: the buttons below add and delete there.
+    if (this.pointerType !== 'mouse') return;
     const [px, py] = this.local(e);
     const i = this.hit(px, py);
     if (i >= 0) {
@@ -279,7 +317,9 @@ export class CurveEditor {
 
   /** Hands a copy of the points to the model; `final` ends a gesture. */
   changed(final) {
-    this.o.set(this.points.map((q) => q.slice()), final);
+    const since = this.since;
+    this.since = null;
+    this.o.set(this.points.map((q) => q.slice()), final, since);
   }
 
   remove(i) {
@@ -304,7 +344,7 @@ export class CurveEditor {
   }
 
   draw() {
-    const c = this.canvas.getContext('2d');
+    const c = this.ctx();
     if (!this.w) return;
     const dpr = this.canvas.width / this.w;
     c.setTransform(dpr, 0, 0, dpr, 0, 0);
@@ -360,6 +400,16 @@ export class CurveEditor {
       const text = this.o.label ? this.o.label(p) : `${fmt(p[0])}, ${fmt(p[1])}`;
       c.fillText(text, Math.min(x + 8, this.w - 90), Math.max(y - 8, 12));
     }
+  }
+
+  /**
+   * The drawing context, kept in memory rather than on the GPU: small
+   * canvases redrawn every frame cost far less so where the GPU is
+   * software (docs/MODELER.md, measured there).
+   */
+  ctx() {
+    this.context = this.context || this.canvas.getContext('2d', { willReadFrequently: true });
+    return this.context;
   }
 
   drawGrid(c) {

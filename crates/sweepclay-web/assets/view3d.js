@@ -30,8 +30,10 @@ void main() { o = vec4(v_col, 1.0); }`;
 
 const CLAY = [0.83, 0.62, 0.48];
 const MOVED = [1.0, 0.5, 0.0];
-const OUTSIDE = [0.85, 0.05, 0.05];
+// Outside the printer is violet: red is kept for a bead at a limit.
+const OUTSIDE = [0.56, 0.27, 0.88];
 const WORST = [0.55, 0.0, 0.35];
+const CURVES = [0.1, 0.2, 0.75];
 
 /** Red → yellow → green for a margin m ∈ [0, 1] (0: at the limit). */
 export function margin(m) {
@@ -58,6 +60,9 @@ export function margins(beads, i, p, all = {}) {
   all.layer = Math.min(1, Math.max(0, lh));
   all.clearance = Math.min(1, Math.max(0, cl));
   all.stability = Math.min(all.overlap, all.overhang, all.layer, all.clearance);
+  // What a change of the design can improve: a thin layer is a spiral's
+  // start or a rim's taper, made so on purpose, and never the worst bead.
+  all.fixable = Math.min(all.overlap, all.overhang, all.clearance, h > p.max_layer_height * 1.05 ? all.layer : 1);
   return all;
 }
 
@@ -75,10 +80,21 @@ function hsl(h, s, l) {
   return [f(0), f(8), f(4)];
 }
 
+import { afterPaint, onFrame } from './frame.js';
+import { zip, normals } from './mesh.js';
+
 export class View3D {
-  constructor(canvas) {
+  /**
+   * @param {HTMLCanvasElement} canvas the WebGL view
+   * @param {HTMLCanvasElement} [overlay] a 2D canvas over it for the
+   *   edited curves, so that a drag never redraws the 3D scene
+   */
+  constructor(canvas, overlay) {
     this.canvas = canvas;
-    const gl = canvas.getContext('webgl2', { antialias: true });
+    this.overlay = overlay || null;
+    // Smoothed edges cost a software GPU (SwiftShader, llvmpipe) most of
+    // a frame: there they are off (docs/MODELER.md).
+    const gl = canvas.getContext('webgl2', { antialias: !softwareGL() });
     if (!gl) throw new Error('this browser has no WebGL 2: the 3D preview is off');
     this.gl = gl;
     this.lit = program(gl, VS_LIT, FS_LIT);
@@ -108,28 +124,16 @@ export class View3D {
 
   /** New slicing result; `params` gives the width range for colours. */
   update(data, params, fit) {
-    const gl = this.gl;
     this.data = data;
+    this.lines = null;
     this.replace('curves', null);
     this.params = params;
-    const P = new Float32Array(data.surface.positions);
+    const P = data.surface.positions;
     const n = P.length / 3;
-    // Smooth normals from the triangles.
-    const N = new Float32Array(P.length);
-    const T = zip(P, data.surface.columns);
-    for (let t = 0; t < T.length; t += 3) {
-      const [a, b, c] = [T[t] * 3, T[t + 1] * 3, T[t + 2] * 3];
-      const u = [P[b] - P[a], P[b + 1] - P[a + 1], P[b + 2] - P[a + 2]];
-      const v = [P[c] - P[a], P[c + 1] - P[a + 1], P[c + 2] - P[a + 2]];
-      const x = u[1] * v[2] - u[2] * v[1];
-      const y = u[2] * v[0] - u[0] * v[2];
-      const z = u[0] * v[1] - u[1] * v[0];
-      for (const i of [a, b, c]) {
-        N[i] += x;
-        N[i + 1] += y;
-        N[i + 2] += z;
-      }
-    }
+    // The triangles and their smooth normals come made (the slice worker,
+    // off the main thread); made here only for a caller that has none.
+    const T = data.surface.triangles || zip(P, data.surface.columns);
+    const N = data.surface.normals || normals(P, T);
     const C = new Float32Array(P.length);
     for (let i = 0; i < n; i++) C.set(CLAY, 3 * i);
     for (const i of data.surface.moved) C.set(MOVED, 3 * i);
@@ -187,13 +191,16 @@ export class View3D {
       this.volume = null;
     }
     this.replace('bed', this.mesh(this.flat, { pos: new Float32Array(g), col: new Float32Array(gc) }));
+    const old = this.box;
     this.box = [[x0, y0, 0], [x1, y1, hi[2]]];
-    // Coloured once the build volume is known (what lies outside is red).
+    const grew = !old || this.box[0].some((v, k) => v < old[0][k]) || this.box[1].some((v, k) => v > old[1][k]);
+    // Coloured once the build volume is known (what lies outside is violet).
     this.recolour();
-    if (fit) this.fit();
-    // Drawn now, not at the next frame, so the caller can time the update.
-    this.draw();
-    gl.finish();
+    // A print that grew out of sight (a top pulled up past the view) is
+    // framed again: nothing of it may be off-screen.
+    if (fit || (grew && !this.inView())) this.fit();
+    // Drawn with the next frame: never waiting here for the GPU.
+    this.redraw();
   }
 
   /**
@@ -202,11 +209,71 @@ export class View3D {
    * budget's immediate preview (docs/MODELER.md).
    */
   showCurves(lines, since) {
-    const P = new Float32Array(lines.length * 3);
-    lines.forEach((p, i) => P.set(p, 3 * i));
-    this.replace('curves', this.mesh(this.flat, { pos: P, col: new Float32Array(P.length).fill(0).map((_, i) => [0.1, 0.2, 0.75][i % 3]) }));
-    this.curvesSince = since ?? null;
-    this.redraw();
+    // Made into GPU buffers at the frame, never in an input handler: a
+    // drag's many moves make one buffer a frame (docs/MODELER.md).
+    this.curvesSince = this.curvesSince ?? since ?? null;
+    onFrame('view3d-curves', () => {
+      this.lines = typeof lines === 'function' ? lines() : lines;
+      if (this.overlay) {
+        this.drawOverlay();
+        this.timeCurves();
+        return;
+      }
+      const L = this.lines;
+      const P = new Float32Array(L.length * 3);
+      L.forEach((p, i) => P.set(p, 3 * i));
+      const C = new Float32Array(P.length);
+      for (let i = 0; i < C.length; i += 3) C.set(CURVES, i);
+      this.replace('curves', this.mesh(this.flat, { pos: P, col: C }));
+      this.redraw();
+    });
+  }
+
+  /**
+   * The edited curves on the 2D canvas over the view, projected as the
+   * 3D view is seen: drawn by the CPU in a fraction of a 3D frame.
+   */
+  drawOverlay() {
+    const o = this.overlay;
+    const dpr = window.devicePixelRatio || 1;
+    const w = Math.max(1, Math.round(o.clientWidth * dpr));
+    const h = Math.max(1, Math.round(o.clientHeight * dpr));
+    if (o.width !== w || o.height !== h) {
+      o.width = w;
+      o.height = h;
+    }
+    const c = o.getContext('2d', { willReadFrequently: true });
+    c.clearRect(0, 0, w, h);
+    const L = this.lines;
+    if (!L || !L.length || !this.data) return;
+    const m = this.matrix(w / h);
+    const at = (p) => {
+      const x = m[0] * p[0] + m[4] * p[1] + m[8] * p[2] + m[12];
+      const y = m[1] * p[0] + m[5] * p[1] + m[9] * p[2] + m[13];
+      const q = m[3] * p[0] + m[7] * p[1] + m[11] * p[2] + m[15];
+      return q > 1e-6 ? [((x / q + 1) / 2) * w, ((1 - y / q) / 2) * h] : null;
+    };
+    c.strokeStyle = 'rgb(26, 51, 191)';
+    c.lineWidth = 1.5 * dpr;
+    c.beginPath();
+    for (let i = 0; i + 1 < L.length; i += 2) {
+      const [a, b] = [at(L[i]), at(L[i + 1])];
+      if (!a || !b) continue;
+      c.moveTo(a[0], a[1]);
+      c.lineTo(b[0], b[1]);
+    }
+    c.stroke();
+  }
+
+  /** From the edit to the painted frame with its curves (the speed budget). */
+  timeCurves() {
+    if (this.curvesSince == null) return;
+    const since = this.curvesSince;
+    this.curvesSince = null;
+    afterPaint((t) => {
+      this.curveTimes.push(t - since);
+      if (this.curveTimes.length > 200) this.curveTimes.shift();
+    });
   }
 
   /** Beads drawn as boxes of their width and height, or as a line. */
@@ -244,8 +311,8 @@ export class View3D {
     for (let i = 0; i < n; i++) {
       let c;
       const m = beads ? margins(beads, i, p, scratch) : null;
-      if (m && m.stability < worstM) {
-        worstM = m.stability;
+      if (m && m.fixable < worstM) {
+        worstM = m.fixable;
         worst = i;
       }
       if (this.colourBy === 'pass') c = ramp((d.path.pass[i] - 1) / Math.max(1, K - 1));
@@ -309,27 +376,73 @@ export class View3D {
     return this.mesh(this.lit, { pos: pos.subarray(0, 3 * v), nrm: nrm.subarray(0, 3 * v), col: col.subarray(0, 3 * v) });
   }
 
-  /** What the worst bead lacks, in words, for the legend. */
+  /**
+   * What the worst bead a change can improve lacks, in words, and what to
+   * change (docs/MODELER.md): for the legend.
+   */
   worstWords() {
     const w = this.worst;
     if (!w) return '';
     const b = this.data.path.beads;
+    const p = this.params;
     const i = w.i;
-    const z = this.pathPositions[3 * i + 2].toFixed(1);
-    const [k] = Object.entries(w.m).filter(([key]) => key !== 'stability').sort((x, y) => x[1] - y[1])[0];
+    const zi = this.pathPositions[3 * i + 2];
+    const z = zi.toFixed(1);
+    const m = w.m;
+    const k = ['overlap', 'overhang', 'clearance', 'layer'].sort((x, y) => m[x] - m[y])[0];
     const what = {
       overlap: `overlap ${(100 * b.overlap[i]).toFixed(0)} %`,
-      overhang: `overhang ${b.overhang_deg[i].toFixed(0)}°`,
+      overhang: `overhang ${b.overhang_deg[i].toFixed(0)}° of ${p.max_overhang_deg}°`,
       layer: `layer ${b.layer_height[i].toFixed(2)} mm`,
       clearance: `body clearance ${b.clearance[i].toFixed(1)} mm`,
     }[k];
-    return `least room: ${what} at z ${z} mm (◆)`;
+    let advice = '';
+    // Advice only where the room is short (under a quarter).
+    if (m[k] < 0.25) {
+      if (k === 'overhang' || k === 'overlap') {
+        const by = this.pullIn(i);
+        advice = by ? `: pull the wall in by about ${by} mm near z ${z} mm` : `: lean the wall less near z ${z} mm`;
+      } else if (k === 'clearance') {
+        advice = `: the wall leans in over clay there; lean it in less near z ${z} mm, or set a taller extruder body height if yours is`;
+      } else {
+        advice = `: bring the two profiles' heights closer, or allow a thicker max layer height`;
+      }
+    }
+    return `least room: ${what} at z ${z} mm (◆)${advice}`;
+  }
+
+  /**
+   * How far (mm, to half a mm) the wall must come in around bead `i` for
+   * its overhang to keep a quarter of the limit as room: the excess lean
+   * over the band of steep beads at its height, taken as a wedge.
+   */
+  pullIn(i) {
+    const b = this.data.path.beads;
+    const p = this.params;
+    const PP = this.pathPositions;
+    const target = 0.75 * p.max_overhang_deg;
+    const lean = b.overhang_deg[i];
+    if (!(lean > target)) return 0;
+    const gap = 3 * p.max_layer_height;
+    const zs = [];
+    for (let j = 0; j < b.overhang_deg.length; j++) if (b.overhang_deg[j] > target) zs.push(PP[3 * j + 2]);
+    zs.sort((x, y) => x - y);
+    const z = PP[3 * i + 2];
+    let k = zs.findIndex((v) => v >= z - 1e-6);
+    if (k < 0) k = zs.length - 1;
+    let [lo, hi] = [k, k];
+    while (lo > 0 && zs[lo] - zs[lo - 1] < gap) lo--;
+    while (hi + 1 < zs.length && zs[hi + 1] - zs[hi] < gap) hi++;
+    const band = Math.max(zs[hi] - zs[lo], b.layer_height[i]);
+    const rad = Math.PI / 180;
+    const mm = (band * (Math.tan(lean * rad) - Math.tan(target * rad))) / 2;
+    return Math.max(0.5, Math.round(mm * 2) / 2);
   }
 
   legend() {
     const p = this.params;
     if (!p || !this.data) return '';
-    const out = this.outsideCount ? ` · <b style="color:#d00">${this.outsideCount} points outside the printer</b>` : '';
+    const out = this.outsideCount ? ` · <b style="color:#8f45e0">■ ${this.outsideCount} points outside the printer</b>` : '';
     const worst = this.data.path.beads ? ` · ${this.worstWords()}` : '';
     const m = `<i style="background:${grad(margin)}"></i>`;
     if (this.colourBy === 'stability') return `at a limit ${m} plenty of room${worst}${out}`;
@@ -383,21 +496,40 @@ export class View3D {
     return { vao, bufs, count, indexed: !!index };
   }
 
+  /** Whether every corner of the print's box is on the canvas. */
+  inView() {
+    if (!this.box) return true;
+    const c = this.canvas;
+    const m = this.matrix(Math.max(1, c.clientWidth) / Math.max(1, c.clientHeight));
+    const [lo, hi] = this.box;
+    for (const x of [lo[0], hi[0]]) {
+      for (const y of [lo[1], hi[1]]) {
+        for (const z of [lo[2], hi[2]]) {
+          const w = m[3] * x + m[7] * y + m[11] * z + m[15];
+          if (w <= 1e-6) return false;
+          const px = (m[0] * x + m[4] * y + m[8] * z + m[12]) / w;
+          const py = (m[1] * x + m[5] * y + m[9] * z + m[13]) / w;
+          if (Math.abs(px) > 1 || Math.abs(py) > 1) return false;
+        }
+      }
+    }
+    return true;
+  }
+
   fit() {
     if (!this.box) return;
     const [lo, hi] = this.box;
     this.target = [(lo[0] + hi[0]) / 2, (lo[1] + hi[1]) / 2, hi[2] / 2];
     const r = Math.hypot(hi[0] - lo[0], hi[1] - lo[1], hi[2]) / 2;
-    this.dist = r / Math.tan((Math.PI / 8)) * 1.1;
+    // A tall narrow canvas (a phone) sees less across than up and down.
+    const c = this.canvas;
+    const aspect = Math.min(1, Math.max(1, c.clientWidth) / Math.max(1, c.clientHeight));
+    this.dist = (r / (Math.tan(Math.PI / 8) * aspect)) * 1.1;
     this.redraw();
   }
 
   redraw() {
-    if (this.frame) return;
-    this.frame = requestAnimationFrame(() => {
-      this.frame = 0;
-      this.draw();
-    });
+    onFrame('view3d-draw', () => this.draw());
   }
 
   draw() {
@@ -444,11 +576,8 @@ export class View3D {
       gl.depthMask(true);
       gl.disable(gl.BLEND);
     }
-    if (this.curves && this.curvesSince != null) {
-      this.curveTimes.push(performance.now() - this.curvesSince);
-      if (this.curveTimes.length > 200) this.curveTimes.shift();
-      this.curvesSince = null;
-    }
+    if (this.overlay) this.drawOverlay();
+    else if (this.curves) this.timeCurves();
   }
 
   /** Times from edits to their curves on screen (ms), newest last. */
@@ -521,30 +650,17 @@ export class View3D {
   }
 }
 
-/**
- * Triangles between adjacent transition curves, always advancing along the
- * curve whose next sample is lower (as mesh::surface_triangles in Rust).
- * `cols` is [first, count, first, count, …].
- */
-export function zip(P, cols) {
-  let total = 0;
-  for (let c = 0; c + 3 < cols.length; c += 2) total += cols[c + 1] + cols[c + 3] - 2;
-  const T = new Uint32Array(3 * total);
-  let t = 0;
-  for (let c = 0; c + 3 < cols.length; c += 2) {
-    let i = cols[c];
-    let j = cols[c + 2];
-    const ae = i + cols[c + 1];
-    const be = j + cols[c + 3];
-    while (i + 1 < ae || j + 1 < be) {
-      const advanceA = i + 1 >= ae ? false : j + 1 >= be ? true : P[3 * i + 5] <= P[3 * j + 5];
-      T[t++] = i;
-      T[t++] = j;
-      if (advanceA) T[t++] = ++i;
-      else T[t++] = ++j;
-    }
+/** Whether WebGL here is drawn by the CPU (no GPU, or a blocked one). */
+function softwareGL() {
+  try {
+    const gl = document.createElement('canvas').getContext('webgl2');
+    const info = gl && gl.getExtension('WEBGL_debug_renderer_info');
+    const name = info ? gl.getParameter(info.UNMASKED_RENDERER_WEBGL) : '';
+    gl?.getExtension('WEBGL_lose_context')?.loseContext();
+    return /swiftshader|llvmpipe|software|softpipe/i.test(name);
+  } catch (e) {
+    return false;
   }
-  return T;
 }
 
 function grad(f0 = ramp) {

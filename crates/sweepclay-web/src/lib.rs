@@ -82,6 +82,21 @@ pub const ASSETS: &[(&str, &str, &str)] = &[
         "text/javascript; charset=utf-8",
         include_str!("../assets/bspline.js"),
     ),
+    (
+        "frame.js",
+        "text/javascript; charset=utf-8",
+        include_str!("../assets/frame.js"),
+    ),
+    (
+        "mesh.js",
+        "text/javascript; charset=utf-8",
+        include_str!("../assets/mesh.js"),
+    ),
+    (
+        "slice-worker.js",
+        "text/javascript; charset=utf-8",
+        include_str!("../assets/slice-worker.js"),
+    ),
 ];
 
 impl IntoResponse for ApiError {
