@@ -105,7 +105,7 @@ function setDesign(d, { record = true, fit = false } = {}) {
   $('offset').value = d.trajectory.offset === 'normal' ? 'normal' : 'radial';
   $('closed').checked = !!d.trajectory.closed;
   updateUndo();
-  requestSlice(fit);
+  requestSlice(fit, record);
 }
 
 /**
@@ -617,7 +617,7 @@ function curveLines(d) {
   return out;
 }
 
-function requestSlice(fit) {
+function requestSlice(fit, final) {
   if (view && state.design) {
     const d = state.design;
     view.showCurves(() => curveLines(d), state.lastEdit);
@@ -631,6 +631,9 @@ function requestSlice(fit) {
   // A verdict belongs to one design: the last one no longer applies.
   cancelVerify();
   setVerdict('checking');
+  // The end of a gesture (a drag let go, a value typed) is checked at
+  // once, beside its slice: a drag's moves wait for their previews.
+  if (final) scheduleVerify(state.pending.design, state.seq);
   if (!state.inFlight) sendSlice();
 }
 
@@ -646,6 +649,7 @@ function sliceFailed(msg, key) {
 function cancelVerify() {
   clearTimeout(state.verifyTimer);
   state.verifySeq++;
+  state.verifyFor = null;
 }
 
 /**
@@ -759,7 +763,7 @@ function showSlice(job, res, t0) {
     if (state.roundTrips.length > 100) state.roundTrips.shift();
     showTiming();
   });
-  if (current && !body.fit_error) scheduleVerify(job.design);
+  if (current && !body.fit_error && state.verifyFor !== job.seq) scheduleVerify(job.design, job.seq);
 }
 
 function render(data, fit) {
@@ -835,8 +839,9 @@ function list(ul, items) {
   }
 }
 
-function scheduleVerify(design) {
+function scheduleVerify(design, forSeq) {
   cancelVerify();
+  state.verifyFor = forSeq;
   const seq = state.verifySeq;
   setVerdict('checking');
   state.verifyTimer = setTimeout(async () => {
