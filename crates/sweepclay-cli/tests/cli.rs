@@ -592,3 +592,80 @@ fn designs_too_large_or_far_outside_the_printer_are_refused_before_slicing() {
         .code(2)
         .stderr(predicate::str::contains("does not fit"));
 }
+
+#[test]
+fn presets_from_published_definitions_print_lift_clear_and_keep_their_mode() {
+    let tmp = tempfile::tempdir().unwrap();
+    examples(tmp.path());
+    // Every preset is listed with its source.
+    sweepclay(tmp.path())
+        .arg("printers")
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("eazao-m600"))
+        .stdout(predicate::str::contains(
+            "source: Cura resources/definitions/eazao_zero.def.json",
+        ));
+    // An Eazao Potter prints the vase; the G-code lifts 10 mm before the
+    // end code, and the checker passes it.
+    sweepclay(tmp.path())
+        .args([
+            "slice",
+            "ex/vase.json",
+            "--printer",
+            "eazao-potter",
+            "-o",
+            "potter.gcode",
+        ])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("check              printable"));
+    let g = std::fs::read_to_string(tmp.path().join("potter.gcode")).unwrap();
+    let tail: Vec<&str> = g.lines().rev().take(4).collect();
+    assert_eq!(
+        tail,
+        [
+            "M84 ; steppers off",
+            "G90 ; absolute",
+            "G1 Z10 F300 ; lift clear of the piece",
+            "G91 ; relative"
+        ]
+    );
+    assert!(g.contains("M163 S0 P0.85"), "the definition's start code");
+    // A start code that says M83 with absolute E is refused before
+    // slicing, naming the fix; with relative E it prints in M83.
+    let printer = |relative: bool| {
+        format!(
+            r#"{{"name": "mine", "relative_e": {relative}, "start_gcode": "G28\nM83 ; relative E\n"}}"#
+        )
+    };
+    std::fs::write(tmp.path().join("m83.json"), printer(false)).unwrap();
+    sweepclay(tmp.path())
+        .args([
+            "slice",
+            "ex/t1.json",
+            "--printer",
+            "m83.json",
+            "-o",
+            "m83.gcode",
+        ])
+        .assert()
+        .failure()
+        .stderr(predicate::str::contains("start_gcode"))
+        .stderr(predicate::str::contains("\"relative_e\": true"));
+    assert!(!tmp.path().join("m83.gcode").exists());
+    std::fs::write(tmp.path().join("m83.json"), printer(true)).unwrap();
+    sweepclay(tmp.path())
+        .args([
+            "slice",
+            "ex/t1.json",
+            "--printer",
+            "m83.json",
+            "-o",
+            "m83.gcode",
+        ])
+        .assert()
+        .success();
+    let g = std::fs::read_to_string(tmp.path().join("m83.gcode")).unwrap();
+    assert!(g.contains("M83 ; relative extrusion") && !g.contains("M82"));
+}

@@ -28,6 +28,9 @@ impl<W: Write> Write for Lines<'_, W> {
     }
 }
 
+/// How far the nozzle rises from the last bead before the end code (mm).
+pub const END_LIFT_MM: f64 = 10.0;
+
 /// Writes the G-code of a sliced design. Returns, for each toolpath point,
 /// the 1-based line of the move that ends at it (the `G0` for the first),
 /// so a line of the file maps back to a point of the design.
@@ -142,6 +145,15 @@ pub fn emit<W: Write>(s: &Sliced, out: &mut W) -> io::Result<Vec<usize>> {
     } else {
         emit_typed_moves(out.inner, points.len(), pos, &s.extrusion, &format, &types)?
     };
+    // Clear of the piece before anything else the end code does: the
+    // nozzle would rest in the rim's clay (docs/FORMATS.md).
+    writeln!(out, "G91 ; relative")?;
+    writeln!(
+        out,
+        "G1 Z{END_LIFT_MM} F{:.0} ; lift clear of the piece",
+        pr.travel_feedrate.min(pr.max_speed_mm_s[2] * 60.0)
+    )?;
+    writeln!(out, "G90 ; absolute")?;
     out.write_all(pr.end_gcode.as_bytes())?;
     if !pr.end_gcode.is_empty() && !pr.end_gcode.ends_with('\n') {
         writeln!(out)?;

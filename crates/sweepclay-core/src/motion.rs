@@ -166,6 +166,41 @@ mod tests {
     }
 
     #[test]
+    fn each_preset_family_plans_with_its_own_limits() {
+        use crate::printer::Printer;
+        // 100 mm at 40 mm/s along x. Marlin's defaults (generic, CERAMBOT,
+        // WASP: none published): a = 3000, 0.27 mm each way, 2.5133 s.
+        // Eazao (Cura's definitions): a = 300, 2.67 mm each way, 2.6333 s.
+        let line = [Move {
+            to: [100.0, 0.0, 0.0],
+            feed: 40.0,
+            volume: 0.0,
+        }];
+        for (name, a) in [
+            ("generic", 3000.0),
+            ("cerambot-plus", 3000.0),
+            ("wasp-2040-clay", 3000.0),
+            ("eazao-zero", 300.0),
+            ("eazao-potter", 300.0),
+            ("eazao-m500", 300.0),
+            ("eazao-m600", 300.0),
+        ] {
+            let lim = Limits::of(&Printer::preset(name).unwrap());
+            assert_eq!(lim.acceleration, a, "{name}");
+            let t = print_time([0.0; 3], line, &lim);
+            let want = trapezoid(100.0, 0.0, 0.0, 40.0, a);
+            assert!((t - want).abs() < 1e-12, "{name}: {t} against {want}");
+            let closed = 2.0 * 40.0 / a + (100.0 - 40.0 * 40.0 / a) / 40.0;
+            assert!((t - closed).abs() < 1e-9, "{name}: {t} against {closed}");
+        }
+        // Eazao's z axis: 5 mm/s at most, 50 mm/s².
+        let lim = Limits::of(&Printer::preset("eazao-zero").unwrap());
+        assert_eq!(lim.max_speed, [100.0, 100.0, 5.0]);
+        assert_eq!(lim.max_acceleration, [500.0, 500.0, 50.0]);
+        assert!((lim.junction_deviation - 0.4 * 100.0 / 300.0).abs() < 1e-12);
+    }
+
+    #[test]
     fn a_straight_line_is_one_trapezoid() {
         // 100 mm at 20 mm/s, a = 100: 0.2 s up and 0.2 s down over 2 mm
         // each, 96 mm cruising at 20 mm/s (4.8 s): 5.2 s.

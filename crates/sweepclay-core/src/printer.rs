@@ -99,8 +99,83 @@ pub const PRESETS: &[&str] = &[
     "cerambot-mini",
     "wasp-2040-clay",
     "wasp-40100-clay",
+    "eazao-zero",
+    "eazao-potter",
+    "eazao-m500",
+    "eazao-m600",
     "generic",
 ];
+
+/// Where each preset's values come from (docs/FORMATS.md has the table
+/// with the commits read): a published definition, or a maker's page.
+pub fn preset_source(name: &str) -> Option<&'static str> {
+    Some(match name {
+        "generic" => "sweepclay's defaults (Marlin's motion limits)",
+        "cerambot-plus" | "cerambot-mini" => "the paper, Fig. 10 (build volume only)",
+        "wasp-2040-clay" | "wasp-40100-clay" => "3dwasp.com technical data (printing volume only)",
+        "eazao-zero" => "Cura resources/definitions/eazao_zero.def.json",
+        "eazao-potter" => "Cura resources/definitions/eazao_potter.def.json",
+        "eazao-m500" => "Cura resources/definitions/eazao_m500.def.json",
+        "eazao-m600" => "Cura resources/definitions/eazao_m600.def.json",
+        _ => return None,
+    })
+}
+
+/// The extrusion mode a start code leaves: `Some(true)` for relative
+/// (`M83`), `Some(false)` for absolute (`M82`), the last one said, comments
+/// and case aside; `None` when it says neither.
+pub fn extrusion_mode(start: &str) -> Option<bool> {
+    let mut mode = None;
+    for line in start.lines() {
+        let code = line
+            .split(';')
+            .next()
+            .unwrap_or("")
+            .trim()
+            .to_ascii_uppercase();
+        match code.split_whitespace().next() {
+            Some("M83") => mode = Some(true),
+            Some("M82") => mode = Some(false),
+            _ => {}
+        }
+    }
+    mode
+}
+
+/// E per mm³ of a machine whose firmware counts E as millimetres of
+/// filament of diameter `d` mm, as Cura writes it: 1 / (π d² / 4).
+/// The Eazao presets' end code: their definitions lift 10 mm, as every
+/// G-code now does before its end code, then free the steppers.
+const EAZAO_END: &str = "M84 ; steppers off\n";
+
+fn filament_e_per_mm3(d: f64) -> f64 {
+    1.0 / (std::f64::consts::PI * d * d / 4.0)
+}
+
+/// An Eazao machine as Ultimaker Cura's definition gives it (docs/
+/// FORMATS.md): a box of `size` mm with the origin at its corner, the
+/// design's o at the bed's middle, Cura's 1.75 mm filament-equivalent E,
+/// 300 mm/s² (`machine_acceleration`), axes to 500/500/50 mm/s² and
+/// 100/100/5 mm/s, and 10 mm/s of jerk as Marlin's junction deviation
+/// 0.4 · jerk² / acceleration. The body radius is not published: the
+/// generic 5 mm.
+fn eazao(name: &str, size: [f64; 3], travel_mm_s: f64, start: &str, end: &str) -> Printer {
+    let accel = 300.0;
+    Printer {
+        name: name.into(),
+        build_volume: size,
+        origin: [size[0] / 2.0, size[1] / 2.0],
+        e_per_mm3: filament_e_per_mm3(1.75),
+        travel_feedrate: travel_mm_s * 60.0,
+        acceleration_mm_s2: accel,
+        max_speed_mm_s: [100.0, 100.0, 5.0],
+        max_acceleration_mm_s2: [500.0, 500.0, 50.0],
+        junction_deviation_mm: 0.4 * 10.0 * 10.0 / accel,
+        start_gcode: start.into(),
+        end_gcode: end.into(),
+        ..Printer::default()
+    }
+}
 
 impl Printer {
     /// A built-in preset by name.
@@ -145,6 +220,38 @@ impl Printer {
                 origin: [0.0, 0.0],
                 ..base
             }),
+            // Start code as the definitions give it. Their end code lifts
+            // 10 mm by resetting z (`G92 Z0`, then `G1 Z10`) and homes x
+            // (and y) over the piece: the writer's own 10 mm lift takes
+            // its place, then the steppers are freed (docs/FORMATS.md).
+            "eazao-zero" => Some(eazao(
+                name,
+                [150.0, 150.0, 240.0],
+                25.0,
+                "G21\nG90 ;absolute positioning\nM82 ;set extruder to absolute mode\nG28 ;Home\nG1 Z15.0 F1500 ;move the platform down 15mm\nG92 E0\nG1 F1500 E2\nG92 E0\nM302\nM163 S0 P0.8 ;Set Mix Factor\nM163 S1 P0.2 ;Set Mix Factor\nM164 S0\n",
+                EAZAO_END,
+            )),
+            "eazao-potter" => Some(eazao(
+                name,
+                [167.0, 167.0, 280.0],
+                25.0,
+                "G21 ;set units to millimeters\nG90 ;absolute positioning\nM82 ;set extruder to absolute mode\nG28 ;Home\nG1 Z25.0 F1500 ;move the platform down 25mm\nG92 E0 ;extruder reset\nG1 F1500 E2\nG92 E0\nM302\nM163 S0 P0.85 ;Set Mix Factor\nM163 S1 P0.15 ;Set Mix Factor\nM164 S0\n",
+                EAZAO_END,
+            )),
+            "eazao-m500" => Some(eazao(
+                name,
+                [320.0, 320.0, 520.0],
+                20.0,
+                "G21 ;set units to millimeters\nG90 ;absolute positioning\nM82 ;set extruder to absolute mode\nG28 ;Home\nG1 Z25.0 F1500\nG92 E0 ;extruder reset\nG1 F300 E5\nG92 E0\nM302\nM163 S0 P0.85 ;Set Mix Factor\nM163 S1 P0.15 ;Set Mix Factor\nM164 S0\n",
+                EAZAO_END,
+            )),
+            "eazao-m600" => Some(eazao(
+                name,
+                [420.0, 420.0, 620.0],
+                20.0,
+                "G21 ;set units to millimeters\nG90 ;absolute positioning\nM82 ;set extruder to absolute mode\nG28 ;Home\nG1 Z25.0 F1500\nG92 E0 ;extruder reset\nG1 F300 E5\nG92 E0\nM302\nM163 S0 P0.87 ;Set Mix Factor\nM163 S1 P0.13 ;Set Mix Factor\nM164 S0\n",
+                EAZAO_END,
+            )),
             _ => None,
         }
     }
@@ -212,6 +319,19 @@ impl Printer {
         }
         if let Some(c) = self.cartridge_ml {
             positive(&format!("{key}.cartridge_ml"), c)?;
+        }
+        if let Some(m) = extrusion_mode(&self.start_gcode) {
+            if m != self.relative_e {
+                let (says, wants) = if m { ("M83", "true") } else { ("M82", "false") };
+                return Err(Error::invalid(
+                    format!("{key}.start_gcode"),
+                    format!(
+                        "sets {} extrusion ({says}) but {key}.relative_e is {}: the G-code's own mode would cancel it; set \"relative_e\": {wants} or take {says} out of the start code",
+                        if m { "relative" } else { "absolute" },
+                        !wants.parse::<bool>().unwrap_or(false),
+                    ),
+                ));
+            }
         }
         if !self.nozzle_radius.is_finite() || self.nozzle_radius < 0.0 {
             return Err(Error::invalid(
@@ -304,8 +424,36 @@ mod tests {
             [120.0, 135.0, 100.0]
         );
         for name in PRESETS {
+            assert!(preset_source(name).is_some(), "{name} has no source");
             Printer::preset(name).unwrap().validate("printer").unwrap();
         }
+    }
+
+    #[test]
+    fn a_start_code_that_contradicts_the_extrusion_mode_is_refused() {
+        assert_eq!(extrusion_mode("G28\nM83 ; relative\n"), Some(true));
+        assert_eq!(extrusion_mode("m83\nM82\n"), Some(false));
+        assert_eq!(extrusion_mode("G28 ; M83 in a comment\n"), None);
+        let p = Printer {
+            start_gcode: "G28\nM83\n".into(),
+            ..Printer::default()
+        };
+        let e = p.validate("printer").unwrap_err().to_string();
+        assert!(
+            e.contains("printer.start_gcode") && e.contains("\"relative_e\": true"),
+            "{e}"
+        );
+        let p = Printer {
+            relative_e: true,
+            ..p
+        };
+        p.validate("printer").unwrap();
+        let p = Printer {
+            start_gcode: "M82\n".into(),
+            ..p
+        };
+        let e = p.validate("printer").unwrap_err().to_string();
+        assert!(e.contains("\"relative_e\": false"), "{e}");
     }
 
     #[test]

@@ -1341,6 +1341,7 @@ function openPrinter() {
   $('pr-e').value = base.e_per_mm3;
   $('pr-r').value = base.nozzle_radius;
   $('pr-h').value = { ...state.meta.params, ...(d.params || {}) }.nozzle_height;
+  $('pr-rel').checked = !!base.relative_e;
   $('pr-start').value = base.start_gcode || '';
   $('pr-end').value = base.end_gcode || '';
   $('pr-error').textContent = '';
@@ -1360,7 +1361,9 @@ $('printer-form').addEventListener('submit', (e) => {
   else delete printer.bed_diameter;
   printer.e_per_mm3 = parseFloat($('pr-e').value);
   printer.nozzle_radius = parseFloat($('pr-r').value);
+  printer.relative_e = $('pr-rel').checked;
   printer.start_gcode = $('pr-start').value;
+  const said = extrusionMode(printer.start_gcode);
   printer.end_gcode = $('pr-end').value;
   const h = parseFloat($('pr-h').value);
   const bad = [
@@ -1371,6 +1374,7 @@ $('printer-form').addEventListener('submit', (e) => {
     [!(printer.e_per_mm3 > 0), 'E per mm³ must be positive'],
     [!(printer.nozzle_radius >= 0), 'the nozzle body radius must be a number of mm'],
     [!(h > 0), 'the nozzle body height must be positive'],
+    [said != null && said !== printer.relative_e, said ? 'the start code sets relative extrusion (M83) but "relative extrusion" is off: the G-code\'s own M82 would cancel it; tick it or take M83 out' : 'the start code sets absolute extrusion (M82) but "relative extrusion" is on: untick it or take M82 out'],
   ].find(([b]) => b);
   if (bad) {
     e.preventDefault();
@@ -1402,6 +1406,20 @@ function withMyPrinter(d) {
   const h = state.design.params?.nozzle_height;
   if (typeof mine === 'object' && h != null) d.params = { ...(d.params || {}), nozzle_height: h };
   return d;
+}
+
+/**
+ * The extrusion mode a start code leaves (true: M83, false: M82, null:
+ * neither), as the pipeline reads it (docs/FORMATS.md).
+ */
+function extrusionMode(text) {
+  let mode = null;
+  for (const line of String(text).split('\n')) {
+    const code = line.split(';')[0].trim().toUpperCase().split(/\s+/)[0];
+    if (code === 'M83') mode = true;
+    else if (code === 'M82') mode = false;
+  }
+  return mode;
 }
 
 function fillPrinterOptions() {

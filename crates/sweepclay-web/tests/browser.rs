@@ -1532,9 +1532,15 @@ async fn tabs_views_and_printers_keep_the_truth() {
     close_guide(&c).await;
 
     wait_js(&c, PRINTABLE, "the vase").await;
-    let legend = js(&c, "return document.getElementById('legend').textContent").await;
+    // The verdict may come before the preview's frame: the legend is
+    // waited for.
+    let legend = wait_js(
+        &c,
+        &format!("return {IDLE} && document.getElementById('legend').textContent.includes('least room') ? document.getElementById('legend').textContent : null"),
+        "the vase's legend",
+    )
+    .await;
     let legend = legend.as_str().unwrap();
-    assert!(legend.contains("least room"), "{legend}");
     assert!(
         !legend.contains("layer 0.0"),
         "the spiral's start marked: {legend}"
@@ -1637,6 +1643,29 @@ async fn tabs_views_and_printers_keep_the_truth() {
         &c,
         "return window.sweepclay.design.printer?.bed_diameter === 250",
         "the round bed",
+    )
+    .await;
+    // A start code saying M83 while relative extrusion is off is refused
+    // in the dialog, naming the switch; with the switch on it prints.
+    click(&c, "printer-edit").await;
+    set_value(&c, "pr-start", "G28\nM83 ; relative E\n").await;
+    click(&c, "pr-save").await;
+    let said = wait_js(
+        &c,
+        "return document.getElementById('pr-error').textContent || null",
+        "the start code's contradiction",
+    )
+    .await;
+    assert!(said.as_str().unwrap().contains("M83"), "{said}");
+    set_checked(&c, "pr-rel").await;
+    click(&c, "pr-save").await;
+    wait_js(
+        &c,
+        &format!(
+            "return window.sweepclay.design.printer?.relative_e === true && {IDLE} && {}",
+            &PRINTABLE[7..]
+        ),
+        "the printer with relative E",
     )
     .await;
     set_value(&c, "p-printer", "cerambot-mini").await;
