@@ -201,12 +201,18 @@ impl Printer {
             // Clay, Ø 200 × 400 mm (www.3dwasp.com, DeltaWASP 2040 Clay,
             // technical data); a delta with its origin at the bed's
             // centre.
+            // FullControl's profile of the machine (wasp2040clay.py, docs/
+            // FORMATS.md): relative E, E as mm of a 3.1 mm feed measured
+            // against printed volumes, travel at 4000 mm/min.
             "wasp-2040-clay" => Some(Printer {
                 name: name.into(),
                 build_volume: [200.0, 200.0, 400.0],
                 bed_min: [-100.0, -100.0, 0.0],
                 bed_diameter: Some(200.0),
                 origin: [0.0, 0.0],
+                relative_e: true,
+                e_per_mm3: filament_e_per_mm3(3.1),
+                travel_feedrate: 4000.0,
                 ..base
             }),
             // WASP's published printing volume of the DeltaWASP 40100
