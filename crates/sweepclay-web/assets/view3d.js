@@ -235,13 +235,7 @@ export class View3D {
    */
   drawOverlay() {
     const o = this.overlay;
-    const dpr = window.devicePixelRatio || 1;
-    const w = Math.max(1, Math.round(o.clientWidth * dpr));
-    const h = Math.max(1, Math.round(o.clientHeight * dpr));
-    if (o.width !== w || o.height !== h) {
-      o.width = w;
-      o.height = h;
-    }
+    const [w, h, dpr] = fitCanvas(o);
     const c = o.getContext('2d', { willReadFrequently: true });
     c.clearRect(0, 0, w, h);
     const L = this.lines;
@@ -534,14 +528,7 @@ export class View3D {
 
   draw() {
     const gl = this.gl;
-    const c = this.canvas;
-    const dpr = window.devicePixelRatio || 1;
-    const w = Math.max(1, Math.round(c.clientWidth * dpr));
-    const h = Math.max(1, Math.round(c.clientHeight * dpr));
-    if (c.width !== w || c.height !== h) {
-      c.width = w;
-      c.height = h;
-    }
+    const [w, h, dpr] = fitCanvas(this.canvas);
     gl.viewport(0, 0, w, h);
     gl.clearColor(0.957, 0.945, 0.925, 1);
     gl.clear(gl.COLOR_BUFFER_BIT | gl.DEPTH_BUFFER_BIT);
@@ -648,6 +635,18 @@ export class View3D {
   up(e) {
     this.pointers.delete(e.pointerId);
   }
+}
+
+/** Sizes a canvas's pixels to its box on screen: `[width, height, dpr]`. */
+function fitCanvas(c) {
+  const dpr = window.devicePixelRatio || 1;
+  const w = Math.max(1, Math.round(c.clientWidth * dpr));
+  const h = Math.max(1, Math.round(c.clientHeight * dpr));
+  if (c.width !== w || c.height !== h) {
+    c.width = w;
+    c.height = h;
+  }
+  return [w, h, dpr];
 }
 
 /** Whether WebGL here is drawn by the CPU (no GPU, or a blocked one). */

@@ -1113,13 +1113,16 @@ async fn truthful_state_imports_printers_and_phones() {
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 #[ignore = "a measurement: scripts/bench-modeler runs it"]
 async fn modeler_speed_budget() {
-    let tmp = tempfile::tempdir().unwrap();
-    let downloads = tmp.path().join("downloads");
-    std::fs::create_dir_all(&downloads).unwrap();
-    let Some((_driver, c)) = start_browser(&downloads, &tmp.path().join("profile")).await else {
+    let Some(Session {
+        tmp: _tmp,
+        downloads: _,
+        driver: _driver,
+        c,
+        base,
+    }) = Session::start().await
+    else {
         return;
     };
-    let base = server().await;
     let rounds: usize = std::env::var("SWEEPCLAY_BENCH_DRAGS")
         .ok()
         .and_then(|v| v.parse().ok())
@@ -1212,6 +1215,35 @@ async fn modeler_speed_budget() {
     c.close().await.unwrap();
 }
 
+/// A browser on a fresh profile, a server, and the downloads folder; the
+/// browser and the folder go when it is dropped.
+struct Session {
+    tmp: tempfile::TempDir,
+    downloads: PathBuf,
+    driver: Driver,
+    c: Client,
+    base: String,
+}
+
+impl Session {
+    /// `None` where there is no browser to run (the test then passes, as
+    /// the others do: `start_browser` says why).
+    async fn start() -> Option<Session> {
+        let tmp = tempfile::tempdir().unwrap();
+        let downloads = tmp.path().join("downloads");
+        std::fs::create_dir_all(&downloads).unwrap();
+        let (driver, c) = start_browser(&downloads, &tmp.path().join("profile")).await?;
+        let base = server().await;
+        Some(Session {
+            tmp,
+            downloads,
+            driver,
+            c,
+            base,
+        })
+    }
+}
+
 /// Taps the point `at` (page pixels) with a finger: down and up.
 async fn tap(c: &Client, at: (f64, f64)) {
     let t = TouchActions::new("finger".into())
@@ -1289,13 +1321,16 @@ const SMALL_CONTROLS: &str = "return [...document.querySelectorAll('button, sele
 /// the Settings tab, and a verdict never belongs to an older design).
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_pot_on_a_phone_by_touch() {
-    let tmp = tempfile::tempdir().unwrap();
-    let downloads = tmp.path().join("downloads");
-    std::fs::create_dir_all(&downloads).unwrap();
-    let Some((_driver, c)) = start_browser(&downloads, &tmp.path().join("profile")).await else {
+    let Some(Session {
+        tmp: _tmp,
+        downloads,
+        driver: _driver,
+        c,
+        base,
+    }) = Session::start().await
+    else {
         return;
     };
-    let base = server().await;
     c.set_window_size(390, 844).await.unwrap();
     c.goto(&base).await.unwrap();
     wait_js(
@@ -1518,13 +1553,16 @@ async fn a_pot_on_a_phone_by_touch() {
 /// change can improve, with the change.
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn tabs_views_and_printers_keep_the_truth() {
-    let tmp = tempfile::tempdir().unwrap();
-    let downloads = tmp.path().join("downloads");
-    std::fs::create_dir_all(&downloads).unwrap();
-    let Some((_driver, c)) = start_browser(&downloads, &tmp.path().join("profile")).await else {
+    let Some(Session {
+        tmp: _tmp,
+        downloads: _,
+        driver: _driver,
+        c,
+        base,
+    }) = Session::start().await
+    else {
         return;
     };
-    let base = server().await;
 
     // Worst bead on the vase: not the spiral's start, with advice where
     // room is short.
