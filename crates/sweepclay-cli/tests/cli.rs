@@ -639,33 +639,26 @@ fn presets_from_published_definitions_print_lift_clear_and_keep_their_mode() {
             r#"{{"name": "mine", "relative_e": {relative}, "start_gcode": "G28\nM83 ; relative E\n"}}"#
         )
     };
+    let slice = || {
+        sweepclay(tmp.path())
+            .args([
+                "slice",
+                "ex/t1.json",
+                "--printer",
+                "m83.json",
+                "-o",
+                "m83.gcode",
+            ])
+            .assert()
+    };
     std::fs::write(tmp.path().join("m83.json"), printer(false)).unwrap();
-    sweepclay(tmp.path())
-        .args([
-            "slice",
-            "ex/t1.json",
-            "--printer",
-            "m83.json",
-            "-o",
-            "m83.gcode",
-        ])
-        .assert()
+    slice()
         .failure()
         .stderr(predicate::str::contains("start_gcode"))
         .stderr(predicate::str::contains("\"relative_e\": true"));
     assert!(!tmp.path().join("m83.gcode").exists());
     std::fs::write(tmp.path().join("m83.json"), printer(true)).unwrap();
-    sweepclay(tmp.path())
-        .args([
-            "slice",
-            "ex/t1.json",
-            "--printer",
-            "m83.json",
-            "-o",
-            "m83.gcode",
-        ])
-        .assert()
-        .success();
+    slice().success();
     let g = std::fs::read_to_string(tmp.path().join("m83.gcode")).unwrap();
     assert!(g.contains("M83 ; relative extrusion") && !g.contains("M82"));
 }

@@ -326,15 +326,18 @@ impl Printer {
         if let Some(c) = self.cartridge_ml {
             positive(&format!("{key}.cartridge_ml"), c)?;
         }
-        if let Some(m) = extrusion_mode(&self.start_gcode) {
-            if m != self.relative_e {
-                let (says, wants) = if m { ("M83", "true") } else { ("M82", "false") };
+        if let Some(relative) = extrusion_mode(&self.start_gcode) {
+            if relative != self.relative_e {
+                let (kind, says) = if relative {
+                    ("relative", "M83")
+                } else {
+                    ("absolute", "M82")
+                };
                 return Err(Error::invalid(
                     format!("{key}.start_gcode"),
                     format!(
-                        "sets {} extrusion ({says}) but {key}.relative_e is {}: the G-code's own mode would cancel it; set \"relative_e\": {wants} or take {says} out of the start code",
-                        if m { "relative" } else { "absolute" },
-                        !wants.parse::<bool>().unwrap_or(false),
+                        "sets {kind} extrusion ({says}) but {key}.relative_e is {}: the G-code's own mode would cancel it; set \"relative_e\": {relative} or take {says} out of the start code",
+                        self.relative_e
                     ),
                 ));
             }

@@ -7,7 +7,7 @@ import { CurveEditor, fmt, segDist } from './editor.js';
 import { View3D } from './view3d.js';
 import { sample, samplePeriodic } from './bspline.js';
 import { afterPaint, frameStats, onFrame } from './frame.js';
-import { decode, normals, zip } from './mesh.js';
+import { fetchSlice } from './mesh.js';
 
 const $ = (id) => document.getElementById(id);
 const STORE = 'sweepclay.design.v1';
@@ -686,19 +686,7 @@ async function sliceDesign(design) {
       worker.postMessage({ id, design });
     });
   }
-  const t0 = performance.now();
-  try {
-    const r = await postDesign('/api/slice?format=binary', design);
-    const headers = performance.now() - t0;
-    if (!r.ok) return { ok: false, body: await r.json() };
-    const body = decode(await r.arrayBuffer());
-    const request = performance.now() - t0;
-    body.surface.triangles = zip(body.surface.positions, body.surface.columns);
-    body.surface.normals = normals(body.surface.positions, body.surface.triangles);
-    return { ok: true, body, timing: { headers_ms: headers, request_ms: request, worker_ms: performance.now() - t0 } };
-  } catch (e) {
-    return { ok: false, failed: String(e.message || e) };
-  }
+  return fetchSlice(design);
 }
 
 function sendSlice() {

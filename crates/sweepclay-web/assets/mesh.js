@@ -1,6 +1,7 @@
-// The slice answer read into typed arrays, and the triangles and smooth
-// normals of its surface: done in the slice worker (slice-worker.js) off
-// the main thread, and on the page only where workers are not available.
+// The slice fetched and its answer read into typed arrays, with the
+// triangles and smooth normals of its surface: done in the slice worker
+// (slice-worker.js) off the main thread, and on the page only where
+// workers are not available.
 
 /**
  * Triangles between adjacent transition curves, always advancing along the
@@ -75,4 +76,30 @@ export function decode(buf) {
     clearance: next(Float32Array),
   };
   return { ...head, surface: { positions, columns, moved, curves: head.curves }, path: { order, width, pass, top, beads } };
+}
+
+/**
+ * Slices a design (JSON text) on the server and reads the answer:
+ * `{ ok, body, timing, transfer }` (`transfer`: the buffers a worker may
+ * hand over without copying), `{ ok: false, body }` for a refusal, or
+ * `{ ok: false, failed }` when the server did not answer. Run in the slice
+ * worker, and on the page only where workers are not available.
+ */
+export async function fetchSlice(design) {
+  const t0 = performance.now();
+  try {
+    const r = await fetch('/api/slice?format=binary', { method: 'POST', headers: { 'content-type': 'application/json' }, body: design });
+    const headers = performance.now() - t0;
+    if (!r.ok) return { ok: false, body: await r.json() };
+    const buf = await r.arrayBuffer();
+    const request = performance.now() - t0;
+    const body = decode(buf);
+    const triangles = zip(body.surface.positions, body.surface.columns);
+    body.surface.triangles = triangles;
+    body.surface.normals = normals(body.surface.positions, triangles);
+    const timing = { headers_ms: headers, request_ms: request, worker_ms: performance.now() - t0 };
+    return { ok: true, body, timing, transfer: [buf, triangles.buffer, body.surface.normals.buffer] };
+  } catch (e) {
+    return { ok: false, failed: String(e.message || e) };
+  }
 }

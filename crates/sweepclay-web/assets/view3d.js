@@ -33,7 +33,6 @@ const MOVED = [1.0, 0.5, 0.0];
 // Outside the printer is violet: red is kept for a bead at a limit.
 const OUTSIDE = [0.56, 0.27, 0.88];
 const WORST = [0.55, 0.0, 0.35];
-const CURVES = [0.1, 0.2, 0.75];
 
 /** Red → yellow → green for a margin m ∈ [0, 1] (0: at the limit). */
 export function margin(m) {
@@ -81,17 +80,16 @@ function hsl(h, s, l) {
 }
 
 import { afterPaint, onFrame } from './frame.js';
-import { zip, normals } from './mesh.js';
 
 export class View3D {
   /**
    * @param {HTMLCanvasElement} canvas the WebGL view
-   * @param {HTMLCanvasElement} [overlay] a 2D canvas over it for the
+   * @param {HTMLCanvasElement} overlay a 2D canvas over it for the
    *   edited curves, so that a drag never redraws the 3D scene
    */
   constructor(canvas, overlay) {
     this.canvas = canvas;
-    this.overlay = overlay || null;
+    this.overlay = overlay;
     // Smoothed edges cost a software GPU (SwiftShader, llvmpipe) most of
     // a frame: there they are off (docs/MODELER.md).
     const gl = canvas.getContext('webgl2', { antialias: !softwareGL() });
@@ -126,14 +124,13 @@ export class View3D {
   update(data, params, fit) {
     this.data = data;
     this.lines = null;
-    this.replace('curves', null);
     this.params = params;
     const P = data.surface.positions;
     const n = P.length / 3;
-    // The triangles and their smooth normals come made (the slice worker,
-    // off the main thread); made here only for a caller that has none.
-    const T = data.surface.triangles || zip(P, data.surface.columns);
-    const N = data.surface.normals || normals(P, T);
+    // The triangles and their smooth normals come made (mesh.js, in the
+    // slice worker, off the main thread).
+    const T = data.surface.triangles;
+    const N = data.surface.normals;
     const C = new Float32Array(P.length);
     for (let i = 0; i < n; i++) C.set(CLAY, 3 * i);
     for (const i of data.surface.moved) C.set(MOVED, 3 * i);
@@ -209,23 +206,13 @@ export class View3D {
    * budget's immediate preview (docs/MODELER.md).
    */
   showCurves(lines, since) {
-    // Made into GPU buffers at the frame, never in an input handler: a
-    // drag's many moves make one buffer a frame (docs/MODELER.md).
+    // Drawn on the overlay at the frame, never in an input handler: a
+    // drag's many moves make one drawing a frame (docs/MODELER.md).
     this.curvesSince = this.curvesSince ?? since ?? null;
     onFrame('view3d-curves', () => {
       this.lines = typeof lines === 'function' ? lines() : lines;
-      if (this.overlay) {
-        this.drawOverlay();
-        this.timeCurves();
-        return;
-      }
-      const L = this.lines;
-      const P = new Float32Array(L.length * 3);
-      L.forEach((p, i) => P.set(p, 3 * i));
-      const C = new Float32Array(P.length);
-      for (let i = 0; i < C.length; i += 3) C.set(CURVES, i);
-      this.replace('curves', this.mesh(this.flat, { pos: P, col: C }));
-      this.redraw();
+      this.drawOverlay();
+      this.timeCurves();
     });
   }
 
@@ -539,7 +526,6 @@ export class View3D {
     gl.uniformMatrix4fv(gl.getUniformLocation(this.flat, 'mvp'), false, mvp);
     gl.uniform1f(gl.getUniformLocation(this.flat, 'size'), 5 * dpr);
     this.drawMesh(this.bed, gl.LINES);
-    this.drawMesh(this.curves, gl.LINES);
     if (this.showPath) {
       if (!this.trueWidth) this.drawMesh(this.path, gl.LINE_STRIP);
       this.drawMesh(this.marks, gl.POINTS);
@@ -563,8 +549,7 @@ export class View3D {
       gl.depthMask(true);
       gl.disable(gl.BLEND);
     }
-    if (this.overlay) this.drawOverlay();
-    else if (this.curves) this.timeCurves();
+    this.drawOverlay();
   }
 
   /** Times from edits to their curves on screen (ms), newest last. */
