@@ -91,7 +91,7 @@ struct SliceArgs {
     /// Output G-code file [default: the design's name with .gcode].
     #[arg(short, long)]
     output: Option<PathBuf>,
-    /// Printer preset (cerambot-plus, cerambot-mini, wasp-2040-clay, wasp-40100-clay, eazao-zero, eazao-potter, eazao-m500, eazao-m600, generic: `sweepclay printers` lists them with their sources) or a printer JSON file; overrides the design's.
+    /// Printer preset (cerambot-plus, cerambot-mini, wasp-2040-clay, wasp-40100-clay, eazao-zero, eazao-potter, eazao-m500, eazao-m600, vormvrij-lutum-4.6, generic: `sweepclay printers` lists them with their sources) or a printer JSON file; overrides the design's.
     #[arg(long)]
     printer: Option<String>,
     /// Override a parameter, e.g. `--set layer_height=1.5` (repeatable). Keys: layer_height, max_layer_height, spacing, nozzle_height, width_min, width_max, overlap, max_overhang_deg, feedrate, floor_layers (vessels), even_turn_flow (1 or 0), max_correction_mm, shrinkage_xy, shrinkage_z (firing shrinkage, fractions).
@@ -245,7 +245,7 @@ fn run(cli: Cli) -> Result<i32> {
                     ),
                 };
                 say!(
-                    "{:<16} {bed}; o at ({}, {}), box from ({}, {}, {}); body r {} mm; {:.0} mm/s², corners {:.3} mm{}{}",
+                    "{:<18} {bed}; o at ({}, {}), box from ({}, {}, {}); body r {} mm; {:.0} mm/s², corners {:.3} mm{}{}",
                     p.name,
                     p.origin[0],
                     p.origin[1],
@@ -263,7 +263,7 @@ fn run(cli: Cli) -> Result<i32> {
                         .unwrap_or_default(),
                 );
                 if let Some(src) = sweepclay_core::printer::preset_source(&p.name) {
-                    say!("{:<16} source: {src}", "");
+                    say!("{:<18} source: {src}", "");
                 }
             }
             Ok(0)

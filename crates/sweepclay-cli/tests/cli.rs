@@ -346,6 +346,19 @@ fn help_documents_every_command() {
         .assert()
         .success()
         .stdout(predicate::str::contains("--force").and(predicate::str::contains("layer_height")));
+    // Every preset and every `--set` key is named in `slice --help`.
+    let help = sweepclay(tmp.path())
+        .args(["slice", "--help"])
+        .output()
+        .unwrap();
+    let help = String::from_utf8(help.stdout).unwrap().replace('\n', " ");
+    let help = help.split_whitespace().collect::<Vec<_>>().join(" ");
+    for name in sweepclay_core::printer::PRESETS {
+        assert!(help.contains(name), "slice --help lacks the preset {name}");
+    }
+    for key in sweepclay_core::Params::KEYS {
+        assert!(help.contains(key), "slice --help lacks the key {key}");
+    }
     sweepclay(tmp.path())
         .args(["check", "--help"])
         .assert()
@@ -661,4 +674,18 @@ fn presets_from_published_definitions_print_lift_clear_and_keep_their_mode() {
     slice().success();
     let g = std::fs::read_to_string(tmp.path().join("m83.gcode")).unwrap();
     assert!(g.contains("M83 ; relative extrusion") && !g.contains("M82"));
+    // Every preset prints the cup, its start code included, and the
+    // checker (run again here, on the file) passes what it wrote.
+    for name in sweepclay_core::printer::PRESETS {
+        let out = format!("{name}.gcode");
+        sweepclay(tmp.path())
+            .args(["slice", "ex/cup.json", "--printer", name, "-o", &out])
+            .assert()
+            .success();
+        sweepclay(tmp.path())
+            .args(["check", &out])
+            .assert()
+            .success()
+            .stdout(predicate::str::contains("PRINTABLE"));
+    }
 }

@@ -103,6 +103,7 @@ pub const PRESETS: &[&str] = &[
     "eazao-potter",
     "eazao-m500",
     "eazao-m600",
+    "vormvrij-lutum-4.6",
     "generic",
 ];
 
@@ -112,11 +113,13 @@ pub fn preset_source(name: &str) -> Option<&'static str> {
     Some(match name {
         "generic" => "sweepclay's defaults (Marlin's motion limits)",
         "cerambot-plus" | "cerambot-mini" => "the paper, Fig. 10 (build volume only)",
-        "wasp-2040-clay" | "wasp-40100-clay" => "3dwasp.com technical data (printing volume only)",
+        "wasp-2040-clay" => "3dwasp.com technical data; FullControl's wasp2040clay.py",
+        "wasp-40100-clay" => "3dwasp.com technical data; DDU's clayprinting-slicer start code",
         "eazao-zero" => "Cura resources/definitions/eazao_zero.def.json",
         "eazao-potter" => "Cura resources/definitions/eazao_potter.def.json",
         "eazao-m500" => "Cura resources/definitions/eazao_m500.def.json",
         "eazao-m600" => "Cura resources/definitions/eazao_m600.def.json",
+        "vormvrij-lutum-4.6" => "IceSL's printer profile fff/Lutum_4.6 (shapeforge/icesl-printers)",
         _ => return None,
     })
 }
@@ -142,12 +145,12 @@ pub fn extrusion_mode(start: &str) -> Option<bool> {
     mode
 }
 
-/// E per mm³ of a machine whose firmware counts E as millimetres of
-/// filament of diameter `d` mm, as Cura writes it: 1 / (π d² / 4).
 /// The Eazao presets' end code: their definitions lift 10 mm, as every
 /// G-code now does before its end code, then free the steppers.
 const EAZAO_END: &str = "M84 ; steppers off\n";
 
+/// E per mm³ of a machine whose firmware counts E as millimetres of
+/// filament of diameter `d` mm, as Cura writes it: 1 / (π d² / 4).
 fn filament_e_per_mm3(d: f64) -> f64 {
     1.0 / (std::f64::consts::PI * d * d / 4.0)
 }
@@ -224,6 +227,24 @@ impl Printer {
                 bed_min: [-200.0, -200.0, 0.0],
                 bed_diameter: Some(400.0),
                 origin: [0.0, 0.0],
+                // The header of the Digital Design Unit's slicer for this
+                // machine (docs/FORMATS.md), heaters' lines left out: a
+                // clay extruder has none.
+                start_gcode: "M82 ; absolute E\nG90 ; absolute coordinates\nG28 ; home all axes\nG21 ; millimetres\nG92 E0\n".into(),
+                ..base
+            }),
+            // Vormvrij Lutum 4.6 as IceSL's profile gives it (docs/
+            // FORMATS.md): 435 × 460 × 510 mm from the corner, a 3 mm
+            // nozzle fed as 3 mm "filament", travel 150 mm/s, absolute E,
+            // and its header with the bed-levelling slot filled as IceSL
+            // fills it without a probe. Its footer is not published.
+            "vormvrij-lutum-4.6" => Some(Printer {
+                name: name.into(),
+                build_volume: [435.0, 460.0, 510.0],
+                origin: [217.5, 230.0],
+                e_per_mm3: filament_e_per_mm3(3.0),
+                travel_feedrate: 150.0 * 60.0,
+                start_gcode: "G21 ; set units to millimeters\nG90 ; use absolute coordinates\nM82 ; use absolute distances for extrusion\nG28 ; home all axes\nG0 F6200 X0 Y0\nG92 E0\nG1 Z1.0 F3000 ; move z up little to prevent scratching of surface\nG1 X20 Y10 Z0.3 F5000.0 ; move to start-line position\nG1 X150 Y10 Z0.3 F1500.0 E15 ; draw 1st line\nG1 X150 Y10 Z0.3 F5000.0 ; move to side a little\nG1 X20 Y10.3 Z0.3 F1500.0 E30 ; draw 2nd line\nG92 E0 ; reset extruder\n".into(),
                 ..base
             }),
             // Start code as the definitions give it. Their end code lifts

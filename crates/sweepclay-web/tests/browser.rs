@@ -1555,7 +1555,7 @@ async fn a_pot_on_a_phone_by_touch() {
 async fn tabs_views_and_printers_keep_the_truth() {
     let Some(Session {
         tmp: _tmp,
-        downloads: _,
+        downloads,
         driver: _driver,
         c,
         base,
@@ -1706,6 +1706,33 @@ async fn tabs_views_and_printers_keep_the_truth() {
         "the printer with relative E",
     )
     .await;
+    // Its G-code keeps M83 (no M82 after the start code) and lifts the
+    // nozzle 10 mm clear of the rim before the end code; the checker
+    // passes it on that printer.
+    let file = download_gcode(&c, &downloads, "no relative-E G-code was downloaded").await;
+    let text = std::fs::read_to_string(&file).unwrap();
+    assert!(text.contains("M83"), "no M83");
+    assert!(
+        !text.lines().any(|l| l.starts_with("M82")),
+        "an M82 cancels M83"
+    );
+    let body: Vec<&str> = text.lines().filter(|l| !l.starts_with(';')).collect();
+    let last_e = body
+        .iter()
+        .rposition(|l| l.starts_with("G1") && l.contains(" E"))
+        .unwrap();
+    let lift = &body[last_e + 1..];
+    assert!(
+        lift.len() >= 3
+            && lift[0].starts_with("G91")
+            && lift[1].starts_with("G1 Z10 ")
+            && lift[2].starts_with("G90"),
+        "no lift after the last bead: {lift:?}"
+    );
+    let printer = js(&c, "return JSON.stringify(window.sweepclay.design.printer)").await;
+    let printer: sweepclay_core::Printer = serde_json::from_str(printer.as_str().unwrap()).unwrap();
+    let report = sweepclay_check::check(&text, &sweepclay_web::verify::printer_check(&printer));
+    assert!(report.printable, "{:?}", report.failures);
     set_value(&c, "p-printer", "cerambot-mini").await;
     wait_js(
         &c,
