@@ -86,7 +86,7 @@ struct ServeArgs {
 
 #[derive(Args, Debug)]
 struct SliceArgs {
-    /// Design file; a bundled example name (`t1` … `t6`, `vase`, `flower`, `cup`) also works.
+    /// Design file; a bundled example name (`t1` … `t6`, `vase`, `flower`, `cup`, `ripple-vase`, `fluted-cup`, `twisted-lobes`, `diamond-vase`) also works.
     design: String,
     /// Output G-code file [default: the design's name with .gcode].
     #[arg(short, long)]
@@ -296,6 +296,21 @@ fn load_printer(spec: &str) -> Result<Printer> {
     r.resolve().with_context(|| spec.to_string())
 }
 
+/// Reads a file of at most `cap` bytes, refusing a larger one before
+/// reading it whole.
+fn read_capped(path: &Path, cap: usize) -> std::result::Result<Vec<u8>, String> {
+    use std::io::Read;
+    let f = std::fs::File::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
+    let mut bytes = Vec::new();
+    f.take(cap as u64 + 1)
+        .read_to_end(&mut bytes)
+        .map_err(|e| format!("{}: {e}", path.display()))?;
+    if bytes.len() > cap {
+        return Err(format!("{} is over the cap of {cap} bytes", path.display()));
+    }
+    Ok(bytes)
+}
+
 fn slice(a: SliceArgs) -> Result<i32> {
     let (text, source) = match std::fs::read_to_string(&a.design) {
         Ok(t) => (t, a.design.clone()),
@@ -313,6 +328,14 @@ fn slice(a: SliceArgs) -> Result<i32> {
         );
     }
     let mut design = Design::from_json(&text).with_context(|| source.clone())?;
+    // An image texture's `path` is relative to the design file.
+    let folder = Path::new(&a.design)
+        .parent()
+        .map(Path::to_path_buf)
+        .unwrap_or_default();
+    design
+        .load_images(|p| read_capped(&folder.join(p), sweepclay_core::texture::MAX_IMAGE_BYTES))
+        .with_context(|| source.clone())?;
     if let Some(p) = &a.printer {
         design.printer = PrinterRef::Inline(Box::new(load_printer(p)?));
     }

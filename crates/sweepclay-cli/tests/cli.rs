@@ -23,7 +23,21 @@ fn examples(dir: &Path) {
 fn every_example_slices_to_gcode_that_checks() {
     let tmp = tempfile::tempdir().unwrap();
     examples(tmp.path());
-    for t in ["t1", "t2", "t3", "t4", "t5", "t6", "vase", "flower", "cup"] {
+    for t in [
+        "t1",
+        "t2",
+        "t3",
+        "t4",
+        "t5",
+        "t6",
+        "vase",
+        "flower",
+        "cup",
+        "ripple-vase",
+        "fluted-cup",
+        "twisted-lobes",
+        "diamond-vase",
+    ] {
         let out = format!("{t}.gcode");
         sweepclay(tmp.path())
             .args(["slice", &format!("ex/{t}.json"), "-o", &out])

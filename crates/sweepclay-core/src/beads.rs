@@ -1,5 +1,5 @@
 //! How well each bead sits: the stability map the modeler colours the
-//! path by (docs/ALGORITHMS.md §10). The paper's constraints (overlap with
+//! path by (docs/ALGORITHMS.md §11). The paper's constraints (overlap with
 //! the bead below, overhang, layer height, the extruder body's height H;
 //! docs/ALGORITHMS.md §3–6) hold for the whole path; this shows, bead by
 //! bead, how much room each one has. For every path point, four figures:

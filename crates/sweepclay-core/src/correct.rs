@@ -87,8 +87,14 @@ pub struct CorrectionReport {
     /// Rounds of the correction loop after the first slicing (0: the
     /// first passed its check, or no loop ran).
     pub rounds: u32,
-    /// The largest distance of the printed surface from the drawn one.
+    /// The largest distance of the printed surface from the drawn one
+    /// (textures aside).
     pub deviation: Option<Deviation>,
+    /// Where a texture was kept at less than its amplitude, and why.
+    pub texture: Vec<crate::texture::TextureFix>,
+    /// The textures' summed amplitude (mm), for the report's words.
+    #[serde(skip)]
+    pub texture_peak: f64,
 }
 
 /// How far the printed shape lies from the drawn one at its farthest.
@@ -186,6 +192,9 @@ impl CorrectionReport {
                 "extruder body: profiles compressed along x by a further {c:.3}, the least that keeps the nozzle's body off the far parts of the wall"
             ));
         }
+        for t in &self.texture {
+            out.push(t.summary(self.texture_peak));
+        }
         if let Some(x) = &self.intersection {
             out.push(format!(
                 "self-intersection: transition curves {} and {} met at ({:.1}, {:.1}, {:.1}) mm; profiles compressed along x by {:.3} ({} steps)",
@@ -201,6 +210,9 @@ impl CorrectionReport {
 pub struct Corrected {
     /// The surface, now support-free and free of self-intersection.
     pub surface: Surface,
+    /// The amount of the texture kept at each sample, 0–1 (empty
+    /// without textures; docs/ALGORITHMS.md §11).
+    pub kept: Vec<f64>,
     /// What changed.
     pub report: CorrectionReport,
 }
@@ -308,9 +320,20 @@ pub fn correct_with(surface: &Surface, tight: &Tightening) -> Result<Corrected> 
             });
         }
     }
+    let (kept, texture) = if out.texture.is_empty() {
+        (Vec::new(), Vec::new())
+    } else {
+        let (kept, fixes) = keep_texture(&mut out, scale);
+        // What a texture pushed past the limits anyway is held back as any
+        // other step is (and reported so).
+        support.extend(support_free(&mut out, scale));
+        (kept, fixes)
+    };
     Ok(Corrected {
-        surface: out,
+        kept,
         report: CorrectionReport {
+            texture,
+            texture_peak: out.texture_label.1,
             support,
             intersection,
             corners: surface.corners.clone(),
@@ -318,7 +341,183 @@ pub fn correct_with(surface: &Surface, tight: &Tightening) -> Result<Corrected> 
             rounds: tight.rounds,
             deviation,
         },
+        surface: out,
     })
+}
+
+/// The share of the step limit a texture may use (see [`keep_texture`]).
+const TEXTURE_MARGIN: f64 = 0.85;
+
+/// The neighbours of each sample for the texture's smoothness: the
+/// samples below and above in its column, and the same pass's in the
+/// columns on either side (round a loop, the last column's pass k is
+/// followed by the first's k + 1).
+fn sample_neighbours(s: &Surface) -> Vec<[u32; 4]> {
+    let n = s.columns.len();
+    let closed = s.vessel.is_some();
+    let at = |c: usize, k: isize| -> u32 {
+        let col = &s.columns[c];
+        if k < 0 || col.is_empty() {
+            return u32::MAX;
+        }
+        col.first + (k as u32).min(col.len() as u32 - 1)
+    };
+    let mut out = vec![[u32::MAX; 4]; s.samples.len()];
+    for (c, col) in s.columns.iter().enumerate() {
+        for (k, i) in col.samples().enumerate() {
+            let k = k as isize;
+            let mut nb = [u32::MAX; 4];
+            if k > 0 {
+                nb[0] = i as u32 - 1;
+            }
+            if (k as usize) + 1 < col.len() {
+                nb[1] = i as u32 + 1;
+            }
+            if c > 0 {
+                nb[2] = at(c - 1, k);
+            } else if closed && n > 1 {
+                nb[2] = at(n - 1, k - 1);
+            }
+            if c + 1 < n {
+                nb[3] = at(c + 1, k);
+            } else if closed && n > 1 {
+                nb[3] = at(0, k + 1);
+            }
+            out[i] = nb;
+        }
+    }
+    out
+}
+
+/// Adds the textures at the largest amount a ∈ [0, 1] each sample allows
+/// (docs/ALGORITHMS.md §11): every step from the sample below must stay
+/// within the support-free and overlap limit s_max (times the loop's
+/// tightening); a step that would not caps a at both its samples, the
+/// caps spread so neighbours differ by at most 0.2, and the surface must
+/// not meet itself. Returns a per sample and where it fell short.
+fn keep_texture(s: &mut Surface, scale: &[f64]) -> (Vec<f64>, Vec<crate::texture::TextureFix>) {
+    use crate::texture::{cap, report, smooth};
+    let n = s.samples.len();
+    let base: Vec<f64> = s.samples.iter().map(|x| x.xi).collect();
+    let d = s.texture.clone();
+    let nb = sample_neighbours(s);
+    // Each step of a column: (lower sample, upper sample, limit, twist
+    // step, why).
+    let mut steps = Vec::with_capacity(n);
+    for (c, col) in s.columns.iter().enumerate() {
+        let r = col.samples();
+        for i in r.start + 1..r.end {
+            let (z0, z1) = (s.samples[i - 1].z, s.samples[i].z);
+            let (lim, by_angle) = s.params.offset_limit(z1 - z0);
+            // A textured bead runs across Ψ's direction (a rib's flank),
+            // so a step along d overhangs a little more than the
+            // untextured rule counts: a margin of TEXTURE_MARGIN.
+            let lim = lim * scale.get(c).copied().unwrap_or(1.0) * TEXTURE_MARGIN;
+            let why = if by_angle { "overhang" } else { "overlap" };
+            steps.push((i - 1, i, lim, col.twist_step(base[i - 1], z0, z1), why));
+        }
+    }
+    let mut caps = vec![1.0f64; n];
+    let mut why = vec![""; n];
+    let lower = |caps: &mut [f64], why: &mut [&'static str], i: usize, a: f64, w: &'static str| {
+        if a < caps[i] - 1e-12 {
+            caps[i] = a;
+            why[i] = w;
+        }
+    };
+    for &(i0, i1, lim, tw, w) in &steps {
+        let b = base[i1] - base[i0] + tw;
+        let a = cap(b, d[i1] - d[i0], lim);
+        lower(&mut caps, &mut why, i0, a, w);
+        lower(&mut caps, &mut why, i1, a, w);
+    }
+    // A bead much thinner than a layer (a spiral's first turn where it
+    // leaves the floor) is widened to carry an offset bead above it, and
+    // its step up then piles clay: nothing is offset above such a bead.
+    let thin = 0.5 * s.params.layer_height;
+    for w in steps.windows(2) {
+        let ((a0, a1, ..), (b0, b1, ..)) = (w[0], w[1]);
+        if a1 == b0 && s.samples[a1].z - s.samples[a0].z < thin {
+            lower(&mut caps, &mut why, b1, 0.0, "overhang");
+        }
+    }
+    let mut a = caps.clone();
+    smooth(&mut a, &nb);
+    let apply = |s: &mut Surface, a: &[f64]| {
+        for (i, smp) in s.samples.iter_mut().enumerate() {
+            smp.xi = base[i] + a[i] * d[i];
+        }
+    };
+    // Neighbours kept at different amounts step differently: tighten
+    // where a step still breaks, and again, until none does.
+    for _ in 0..40 {
+        let mut broke = false;
+        for &(i0, i1, lim, tw, w) in &steps {
+            let step = base[i1] + a[i1] * d[i1] - base[i0] - a[i0] * d[i0] + tw;
+            if step.abs() > lim + 1e-9 {
+                broke = true;
+                let f = cap(base[i1] - base[i0] + tw, a[i1] * d[i1] - a[i0] * d[i0], lim);
+                let f = f.min(0.9);
+                lower(&mut caps, &mut why, i0, f * a[i0], w);
+                lower(&mut caps, &mut why, i1, f * a[i1], w);
+            }
+        }
+        if !broke {
+            break;
+        }
+        a.copy_from_slice(&caps);
+        smooth(&mut a, &nb);
+    }
+    apply(s, &a);
+    // Where the textured surface meets itself, the texture gives way
+    // there (a few places at most, then everywhere).
+    let reach = (3.0 * s.params.width_max / s.spacing).ceil() as usize;
+    for round in 0..=6 {
+        let Some((ca, cb, at)) = find_self_intersection(s) else {
+            break;
+        };
+        let m = s.columns.len();
+        let near: Vec<usize> = if round == 6 {
+            (0..m).collect()
+        } else {
+            [ca as usize, cb as usize]
+                .into_iter()
+                .flat_map(|c| c.saturating_sub(reach)..=(c + reach).min(m - 1))
+                .collect()
+        };
+        for c in near {
+            for i in s.columns[c].samples() {
+                if round == 6 || (s.samples[i].z - at[2]).abs() < 3.0 * s.params.width_max {
+                    lower(&mut caps, &mut why, i, 0.0, "self-intersection");
+                }
+            }
+        }
+        a.copy_from_slice(&caps);
+        smooth(&mut a, &nb);
+        apply(s, &a);
+    }
+    let items: Vec<(f64, f64, f64, &'static str)> = s
+        .columns
+        .iter()
+        .flat_map(|col| col.samples().map(move |i| (i, col.u)))
+        .filter(|&(i, _)| a[i] < 0.99 && d[i].abs() > 0.01)
+        .map(|(i, u)| {
+            let w = if why[i].is_empty() {
+                // Lowered only by a neighbour: the reason nearest it.
+                nb[i]
+                    .iter()
+                    .filter(|&&j| j != u32::MAX)
+                    .map(|&j| why[j as usize])
+                    .find(|w| !w.is_empty())
+                    .unwrap_or("overhang")
+            } else {
+                why[i]
+            };
+            (s.samples[i].z, u, a[i], w)
+        })
+        .collect();
+    let gap = 3.0 * s.params.max_layer_height;
+    (a, report(items, &s.texture_label.0, gap))
 }
 
 /// The sample moved farthest from the design by the corrections, if any
@@ -393,9 +592,11 @@ fn support_free(s: &mut Surface, scale: &[f64]) -> Vec<SupportFix> {
             let mut xi = design.xi + carry;
             let (limit, by_angle) = s.params.offset_limit(design.z - prev.z);
             let limit = limit * scale.get(c).copied().unwrap_or(1.0);
-            let step = xi - prev.xi;
+            // The twist's turn overhangs too, where it crosses the wall.
+            let tw = col.twist_step(prev.xi, prev.z, design.z);
+            let step = xi - prev.xi + tw;
             if step.abs() > limit + 1e-12 {
-                let clamped = prev.xi + limit.copysign(step);
+                let clamped = prev.xi - tw + limit.copysign(step);
                 carry += clamped - xi;
                 xi = clamped;
                 let f = fix.get_or_insert(SupportFix {
@@ -447,6 +648,7 @@ fn find_self_intersection(s: &Surface) -> Option<(u32, u32, [f64; 3])> {
     // than 2 w along Ψ (a sharp corner's) are laid in one go, as fresh clay
     // the nozzle rides on (the checker counts them so too).
     let far = ((2.0 * w) / s.spacing).ceil() as usize;
+    let twisted = s.columns.iter().any(|c| c.twist != 0.0);
     let segs: Vec<[[f64; 2]; 2]> = s
         .columns
         .iter()
@@ -462,8 +664,24 @@ fn find_self_intersection(s: &Surface) -> Option<(u32, u32, [f64; 3])> {
         })
         .collect();
     let mut grid = Grid2::new(w.max(s.spacing));
-    for (c, seg) in segs.iter().enumerate() {
-        grid.insert_segment(seg[0], seg[1], c as u32);
+    if twisted {
+        // A twisted curve turns as it rises: its plan is the polyline of
+        // its samples, not one segment (every step of it in the grid).
+        for (c, col) in s.columns.iter().enumerate() {
+            let r = col.samples();
+            for i in r.start + 1..r.end {
+                let (p, q) = (s.position(c, i - 1), s.position(c, i));
+                grid.insert_segment([p[0], p[1]], [q[0], q[1]], c as u32);
+            }
+            if r.len() == 1 {
+                let p = s.position(c, r.start);
+                grid.insert_segment([p[0], p[1]], [p[0], p[1]], c as u32);
+            }
+        }
+    } else {
+        for (c, seg) in segs.iter().enumerate() {
+            grid.insert_segment(seg[0], seg[1], c as u32);
+        }
     }
     let w2 = w * w;
     let mut near: Vec<u32> = Vec::new();
@@ -471,13 +689,25 @@ fn find_self_intersection(s: &Surface) -> Option<(u32, u32, [f64; 3])> {
         near.clear();
         let n = segs.len();
         let closed = s.vessel.is_some();
-        grid.for_each_near_segment(seg[0], seg[1], w, |b| {
+        let mut take = |b: u32| {
             // Round a loop, the last curves are the first ones' neighbours.
             let apart = (b as usize) > a + far && (!closed || a + n - b as usize > far);
-            if apart && segment_distance(*seg, segs[b as usize]) < w {
+            if apart && (twisted || segment_distance(*seg, segs[b as usize]) < w) {
                 near.push(b);
             }
-        });
+        };
+        if twisted {
+            let r = s.columns[a].samples();
+            for i in r.start..r.end {
+                let (p, q) = (
+                    s.position(a, i.saturating_sub(1).max(r.start)),
+                    s.position(a, i),
+                );
+                grid.for_each_near_segment([p[0], p[1]], [q[0], q[1]], w, &mut take);
+            }
+        } else {
+            grid.for_each_near_segment(seg[0], seg[1], w, &mut take);
+        }
         near.sort_unstable();
         near.dedup();
         for &b in &near {
@@ -489,14 +719,22 @@ fn find_self_intersection(s: &Surface) -> Option<(u32, u32, [f64; 3])> {
                 let p = s.position(a, i);
                 // All of b lies on its plan segment: a sample of a farther
                 // than a bead from it in plan is farther in 3D.
-                if point_segment2([p[0], p[1]], sb) >= w2 {
+                if !twisted && point_segment2([p[0], p[1]], sb) >= w2 {
                     continue;
                 }
-                while start < rb.end && s.samples[start].z < p[2] - w {
+                // A twisted wall leans along itself: points of one pass a
+                // layer or more apart in height are the wall rising, not
+                // meeting itself, so only the same layer's are compared.
+                let dz = if twisted {
+                    s.params.max_layer_height
+                } else {
+                    w
+                };
+                while start < rb.end && s.samples[start].z < p[2] - dz {
                     start += 1;
                 }
                 for j in start..rb.end {
-                    if s.samples[j].z > p[2] + w {
+                    if s.samples[j].z > p[2] + dz {
                         break;
                     }
                     let q = s.position(b as usize, j);

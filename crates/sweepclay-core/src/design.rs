@@ -37,6 +37,18 @@ pub struct Design {
     /// Printer preset name or inline profile; default `generic`.
     #[serde(default)]
     pub printer: PrinterRef,
+    /// Textures added to the surface, kept where the clay allows
+    /// (docs/FORMATS.md, docs/ALGORITHMS.md §11).
+    #[serde(default, skip_serializing_if = "Vec::is_empty")]
+    pub texture: Vec<crate::texture::TextureSpec>,
+    /// The cross-section turns about o by this angle from base to top
+    /// (degrees; positive counter-clockwise seen from above).
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub twist_deg: f64,
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
 }
 
 /// A curve given by the control points of a clamped B-spline.
@@ -179,6 +191,12 @@ impl Default for Params {
 /// of the carriage, on top of one layer (see `docs/ALGORITHMS.md`).
 pub const COLLISION_MARGIN_MM: f64 = 1.0;
 
+/// The thinnest layer (mm) `params.layer_height` may ask for.
+pub const MIN_LAYER: f64 = 0.5;
+
+/// The closest sample spacing (mm) `params.spacing` may ask for.
+pub const MIN_SPACING: f64 = 0.01;
+
 /// Overlap of a floor bead with its neighbour in the same layer, as a
 /// fraction of its width: enough to close the floor, little enough that the
 /// clay has room (docs/ALGORITHMS.md §8). The floor is laid with it; the
@@ -188,14 +206,14 @@ pub const FLOOR_OVERLAP: f64 = 0.15;
 impl Params {
     /// Checks every parameter against its allowed range.
     pub fn validate(&self) -> Result<()> {
-        range("params.layer_height", self.layer_height, 0.5, 10.0)?;
+        range("params.layer_height", self.layer_height, MIN_LAYER, 10.0)?;
         range(
             "params.max_layer_height",
             self.max_layer_height,
             self.layer_height,
             20.0,
         )?;
-        range("params.spacing", self.spacing, 0.01, 50.0)?;
+        range("params.spacing", self.spacing, MIN_SPACING, 50.0)?;
         let h_min = self.max_layer_height + self.layer_height + COLLISION_MARGIN_MM;
         if !(self.nozzle_height.is_finite() && self.nozzle_height > h_min) {
             return Err(Error::invalid(
@@ -397,7 +415,31 @@ impl Design {
                 ),
             ));
         }
+        let mut d = d;
+        for (k, t) in d.texture.iter_mut().enumerate() {
+            t.load(&format!("texture[{k}]"))?;
+        }
         Ok(d)
+    }
+
+    /// Reads the images the textures name by `path` with `read` (the
+    /// path as written; the caller resolves it against the design's
+    /// folder), decoding each; the error names the texture.
+    pub fn load_images(
+        &mut self,
+        mut read: impl FnMut(&str) -> std::result::Result<Vec<u8>, String>,
+    ) -> Result<()> {
+        for (k, t) in self.texture.iter_mut().enumerate() {
+            if t.image.is_some() || t.kind != crate::texture::Kind::Image {
+                continue;
+            }
+            if let Some(path) = &t.path {
+                let key = format!("texture[{k}].path");
+                let bytes = read(path).map_err(|e| Error::invalid(&key, e))?;
+                t.image = Some(crate::texture::Grey::from_png(&bytes, &key)?);
+            }
+        }
+        Ok(())
     }
 
     /// The piece as printed: the geometry enlarged by 1 / (1 − s) across
@@ -407,6 +449,69 @@ impl Design {
     /// heights, bead widths and the printer are not scaled: they are the
     /// process, not the piece. Without shrinkage, the design itself.
     pub fn printed(&self) -> Design {
+        let mut d = self.scaled_for_firing();
+        d.refine_for_texture();
+        d
+    }
+
+    /// The sampling the textures ask for: the spacing and the thickest
+    /// layer that give each texture 8 samples a period (never under the
+    /// thinnest layer [`Params::validate`] allows; [`Design::check_texture`]
+    /// refuses a texture that would need less).
+    pub(crate) fn refine_for_texture(&mut self) {
+        if self.texture.is_empty() {
+            return;
+        }
+        let length = crate::trajectory_length(self);
+        let [along, up] = crate::texture::needs(&self.texture, length, self.trajectory.closed);
+        let p = &mut self.params;
+        if let Some((s, _)) = along.filter(|(s, _)| s.is_finite() && *s > 0.0) {
+            p.spacing = p.spacing.min(s.max(MIN_SPACING));
+        }
+        if let Some((z, _)) = up.filter(|(z, _)| z.is_finite()) {
+            p.max_layer_height = p.max_layer_height.min(z.max(MIN_LAYER));
+            // Room below it, so a column's height splits into whole layers.
+            p.layer_height = p
+                .layer_height
+                .min((0.6 * p.max_layer_height).max(MIN_LAYER))
+                .min(p.max_layer_height);
+        }
+    }
+
+    /// Checks the textures and the twist, and refuses a texture whose
+    /// period is too short to sample (it would need layers thinner than
+    /// [`MIN_LAYER`] or a spacing under [`MIN_SPACING`]), naming it.
+    pub fn check_texture(&self) -> Result<()> {
+        crate::texture::validate(&self.texture, self.twist_deg, self.trajectory.closed)?;
+        if self.texture.is_empty() {
+            return Ok(());
+        }
+        let d = self.scaled_for_firing();
+        let length = crate::trajectory_length(&d);
+        let [along, up] = crate::texture::needs(&d.texture, length, d.trajectory.closed);
+        if let Some((z, k)) = up.filter(|(z, _)| *z < MIN_LAYER) {
+            return Err(Error::invalid(
+                format!("texture[{k}]"),
+                format!(
+                    "needs layers of {z:.2} mm to show ({} samples a period in height), thinner than the thinnest layer ({MIN_LAYER} mm); make its period (or pitch) at least {} mm",
+                    crate::texture::SAMPLES_PER_PERIOD,
+                    MIN_LAYER * crate::texture::SAMPLES_PER_PERIOD
+                ),
+            ));
+        }
+        if let Some((s, k)) = along.filter(|(s, _)| *s < MIN_SPACING) {
+            return Err(Error::invalid(
+                format!("texture[{k}]"),
+                format!(
+                    "needs samples {s:.3} mm apart along the trajectory to show, closer than {MIN_SPACING} mm; use fewer ribs"
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The design enlarged for the firing shrinkage, textures included.
+    fn scaled_for_firing(&self) -> Design {
         let mut d = self.clone();
         let [kxy, kz] = self.params.print_scale();
         if kxy == 1.0 && kz == 1.0 {
@@ -417,6 +522,7 @@ impl Design {
                 *p = [p[0] * kxy, p[1] * kz];
             }
         }
+        d.texture = self.texture.iter().map(|t| t.scaled(kxy, kz)).collect();
         let t = &mut d.trajectory;
         for pts in [t.control_points.as_mut(), t.points.as_mut()]
             .into_iter()

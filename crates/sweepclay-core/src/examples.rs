@@ -1,6 +1,8 @@
 //! The bundled example designs: walls modelled on the paper's Table 1
-//! models t1–t6 (Fig. 11), and three vessels (a round vase, a flower vase
-//! whose two profiles differ, a cup for the cerambot-mini). `sweepclay
+//! models t1–t6 (Fig. 11), three vessels (a round vase, a flower vase
+//! whose two profiles differ, a cup for the cerambot-mini) and four
+//! textured ones (a rippled vase, a fluted cup, twisted lobes, a vase with
+//! an image texture; `scripts/texture-examples` writes them). `sweepclay
 //! examples DIR` writes them out.
 
 /// `(file name, design JSON)` for each bundled example.
@@ -14,6 +16,22 @@ pub const EXAMPLES: &[(&str, &str)] = &[
     ("vase.json", include_str!("../../../examples/vase.json")),
     ("flower.json", include_str!("../../../examples/flower.json")),
     ("cup.json", include_str!("../../../examples/cup.json")),
+    (
+        "ripple-vase.json",
+        include_str!("../../../examples/ripple-vase.json"),
+    ),
+    (
+        "fluted-cup.json",
+        include_str!("../../../examples/fluted-cup.json"),
+    ),
+    (
+        "twisted-lobes.json",
+        include_str!("../../../examples/twisted-lobes.json"),
+    ),
+    (
+        "diamond-vase.json",
+        include_str!("../../../examples/diamond-vase.json"),
+    ),
 ];
 
 /// A bundled example by name (`t1` or `t1.json`).

@@ -60,6 +60,7 @@ pub mod preview;
 pub mod printer;
 pub mod stability;
 pub mod surface;
+pub mod texture;
 pub mod toolpath;
 pub mod vessel;
 
@@ -286,9 +287,13 @@ pub fn trajectory_length(d: &Design) -> f64 {
 /// height (flat layers, the most the layering chooses), a vessel's
 /// lowest (its spiral turns) — plus a vessel's floor rings, a pitch
 /// apart over the control polygon's area. [`estimated_samples`]
-/// narrows it for walls. NaN when a coordinate is not a number
-/// (slicing then names it).
+/// narrows it for walls. Textures' finer sampling counted. NaN when a
+/// coordinate is not a number (slicing then names it).
 pub fn samples_bound(d: &Design) -> f64 {
+    // The sampling a texture asks for (idempotent: `d` may be refined).
+    let mut refined = d.clone();
+    refined.refine_for_texture();
+    let d = &refined;
     let t = &d.trajectory;
     let pts = t.given_points();
     let p = &d.params;
@@ -361,8 +366,27 @@ pub fn check_samples(design: &Design, max_samples: f64) -> Result<()> {
     // A parameter out of its range is that, not a huge estimate (a layer
     // height of 0 is no "infinitely many samples").
     design.params.validate()?;
+    design.check_texture()?;
     let estimate = estimated_samples(design);
     if estimate > max_samples {
+        // Over the cap only for the sampling a texture asks: name it.
+        let mut plain = design.clone();
+        plain.texture.clear();
+        if !design.texture.is_empty() && estimated_samples(&plain) <= max_samples {
+            let d = design.printed();
+            let [along, up] =
+                texture::needs(&d.texture, trajectory_length(&d), d.trajectory.closed);
+            let k = up.or(along).map_or(0, |(_, k)| k);
+            return Err(Error::invalid(
+                format!("texture[{k}]"),
+                format!(
+                    "needs samples {:.2} mm apart and layers of at most {:.2} mm to show ({} a period): about {estimate:.0} samples, over the cap of {max_samples:.0}; lengthen its period, use fewer ribs, or make the piece smaller",
+                    d.params.spacing,
+                    d.params.max_layer_height,
+                    texture::SAMPLES_PER_PERIOD
+                ),
+            ));
+        }
         return Err(Error::TooLarge {
             estimate,
             limit: max_samples,

@@ -32,6 +32,14 @@ pub struct Column {
     pub passes: u32,
     /// A top-edge bead sample follows the pass samples.
     pub top: bool,
+    /// The design's twist (radians): the cross-section at height z is
+    /// turned about o by `twist · z / height` (docs/ALGORITHMS.md §11).
+    pub twist: f64,
+    /// Ψ's unit normal at p (either side), for the twist's overhang.
+    pub normal: [f64; 2],
+    /// The height the twist starts from (mm): a vessel's floor layers
+    /// stand untwisted, as the floor's rings were laid out.
+    pub twist_from: f64,
 }
 
 impl Column {
@@ -50,13 +58,40 @@ impl Column {
         self.first as usize..self.first as usize + self.len()
     }
 
-    /// The position of a point at radial offset `xi` and height `z`.
+    /// The position of a point at radial offset `xi` and height `z`,
+    /// turned by the twist at that height.
     pub fn point(&self, xi: f64, z: f64) -> [f64; 3] {
-        [
-            self.p[0] + xi * self.dir[0],
-            self.p[1] + xi * self.dir[1],
-            z,
-        ]
+        let q = [self.p[0] + xi * self.dir[0], self.p[1] + xi * self.dir[1]];
+        if self.twist == 0.0 {
+            return [q[0], q[1], z];
+        }
+        let (s, c) = self.turn(z).sin_cos();
+        [c * q[0] - s * q[1], s * q[0] + c * q[1], z]
+    }
+
+    /// The twist's angle at height `z` (radians).
+    pub fn turn(&self, z: f64) -> f64 {
+        let span = (self.height - self.twist_from).max(1e-9);
+        self.twist * ((z - self.twist_from) / span).clamp(0.0, 1.0)
+    }
+
+    /// How far the twist moves the point at offset `xi` of this column
+    /// across the wall between heights `z0` and `z1`, in ξ's units (mm
+    /// along `dir`): the part of its turn that overhangs. Exact for any
+    /// turn: in the frame turned with the upper layer, the point below
+    /// sits turned back by the difference (a radial offset on a circle
+    /// gets none; the rest runs along the bead).
+    pub fn twist_step(&self, xi: f64, z0: f64, z1: f64) -> f64 {
+        if self.twist == 0.0 {
+            return 0.0;
+        }
+        let q = [self.p[0] + xi * self.dir[0], self.p[1] + xi * self.dir[1]];
+        let (s, c) = (self.turn(z0) - self.turn(z1)).sin_cos();
+        let back = [c * q[0] - s * q[1], s * q[0] + c * q[1]];
+        let n = self.normal;
+        let dn = n[0] * self.dir[0] + n[1] * self.dir[1];
+        let across = n[0] * (q[0] - back[0]) + n[1] * (q[1] - back[1]);
+        across / dn.abs().max(0.2).copysign(dn)
     }
 }
 
@@ -99,6 +134,11 @@ pub struct Surface {
     pub printer: Printer,
     /// The corners of a polyline Ψ rounded before sampling.
     pub corners: Vec<crate::curves::CornerFix>,
+    /// The textures' displacement D per sample (mm, along the offset
+    /// direction) at full amplitude; empty without textures.
+    pub texture: Vec<f64>,
+    /// The textures' labels and their summed amplitude (mm), for reports.
+    pub texture_label: (String, f64),
 }
 
 impl Surface {
@@ -150,8 +190,143 @@ fn normal(pts: &[[f64; 2]], i: usize, closed: bool) -> [f64; 2] {
 }
 
 /// Samples the design's surface. Validates every part of the design first.
+/// Textures refine the sampling ([`Design::printed`]) and give each sample
+/// its displacement D; the twist turns each column's cross-sections
+/// (docs/ALGORITHMS.md §11).
 pub fn sample_surface(design: &Design) -> Result<Surface> {
     design.params.validate()?;
+    design.check_texture()?;
+    let mut s = sample_plain(design)?;
+    let twist = design.twist_deg.to_radians();
+    // A vessel's floor layers are laid plain and untwisted: the floor
+    // fills the plain ring, and texture and twist start above it.
+    let base = s
+        .vessel
+        .as_ref()
+        .filter(|v| v.floor_layers > 0)
+        .map_or(0.0, |v| f64::from(v.base_layers) * v.base_layer_mm);
+    if twist != 0.0 {
+        // A turn moves a point across Ψ's direction (the wall's normal
+        // n) by n · (ẑ × p); ξ moves it by d · n a millimetre.
+        let pts: Vec<[f64; 2]> = s.columns.iter().map(|c| c.p).collect();
+        let closed = s.vessel.is_some();
+        if !closed {
+            twist_fits_open_ends(&s, &pts, twist)?;
+        }
+        for (i, col) in s.columns.iter_mut().enumerate() {
+            col.twist = twist;
+            col.normal = normal(&pts, i, closed);
+            col.twist_from = base;
+        }
+        twist_leans_within_limit(&s, twist)?;
+    }
+    if design.texture.iter().all(|t| t.amplitude == 0.0) {
+        return Ok(s);
+    }
+    let printed = design.printed();
+    let height = s.columns.iter().map(|c| c.height).fold(0.0, f64::max);
+    let field = crate::texture::Field::new(
+        &printed.texture,
+        s.trajectory_length,
+        height,
+        s.vessel.is_some(),
+        s.spacing,
+        s.params.max_layer_height,
+    );
+    let mut d = Vec::with_capacity(s.samples.len());
+    for col in &s.columns {
+        for smp in &s.samples[col.samples()] {
+            d.push(field.at(col.u, smp.z, col.height, base));
+        }
+    }
+    s.texture = d;
+    s.texture_label = (field.label(), field.peak());
+    Ok(s)
+}
+
+/// Refuses a twist that leans an open wall's ends out over the layers
+/// below: a turn moves an end along the wall by |t · (ẑ × p)| a radian
+/// (t: Ψ's direction there), and over a layer that must stay within the
+/// overhang limit (with the texture's margin, 0.85) and half a sample
+/// spacing — a wall's end has nothing beyond it to rest on.
+fn twist_fits_open_ends(s: &Surface, pts: &[[f64; 2]], twist: f64) -> Result<()> {
+    let n = pts.len();
+    if n < 2 {
+        return Ok(());
+    }
+    let tan = s.params.max_overhang_deg.to_radians().tan();
+    for (i, j) in [(0, 1), (n - 1, n - 2)] {
+        let (p, q) = (pts[i], pts[j]);
+        let l = (q[0] - p[0]).hypot(q[1] - p[1]).max(1e-9);
+        let t = [(q[0] - p[0]) / l, (q[1] - p[1]) / l];
+        let along = (t[1] * p[0] - t[0] * p[1]).abs();
+        let h = s.columns[i].height;
+        // Per mm of height the end moves along the wall by
+        // |twist| · along / h: within the overhang limit, and by at most
+        // half a sample spacing a layer, so the end bead keeps clay
+        // under it.
+        let rate = (0.85 * tan).min(0.5 * s.spacing / s.params.max_layer_height);
+        let allowed = rate * h / along.max(1e-9);
+        if twist.abs() > allowed {
+            return Err(Error::invalid(
+                "twist_deg",
+                format!(
+                    "turns the wall's {} end ({:.1}, {:.1}) mm along the wall faster than the layer below can hold it (overhang limit {}°, half a sample spacing a layer): its end would lean out over nothing; at most {:.0}° of twist for this wall, or close the trajectory into a vessel",
+                    if i == 0 { "start" } else { "far" },
+                    p[0],
+                    p[1],
+                    s.params.max_overhang_deg,
+                    allowed.to_degrees().floor()
+                ),
+            ));
+        }
+    }
+    Ok(())
+}
+
+/// Refuses a twist that by itself leans the wall across its own
+/// direction beyond the overhang limit somewhere (with the texture's
+/// margin, 0.85): a turn moves the wall at p across itself by
+/// |n · (ẑ × p)| a radian, which only a shape round o escapes. The
+/// support-free correction would have to undo it by reshaping the wall.
+fn twist_leans_within_limit(s: &Surface, twist: f64) -> Result<()> {
+    let tan = 0.85 * s.params.max_overhang_deg.to_radians().tan();
+    let mut worst: Option<(f64, &Column)> = None;
+    for col in &s.columns {
+        let across = (col.normal[1] * col.p[0] - col.normal[0] * col.p[1]).abs();
+        let allowed = tan * (col.height - col.twist_from) / across.max(1e-9);
+        if worst.is_none_or(|(w, _)| allowed < w) {
+            worst = Some((allowed, col));
+        }
+    }
+    match worst {
+        Some((allowed, col)) if twist.abs() > allowed => Err(Error::invalid(
+            "twist_deg",
+            format!(
+                "turns the wall at ({:.1}, {:.1}) mm (u = {:.2}) across itself faster than the overhang limit ({}°) allows: at most {:.0}° of twist for this shape (a rounder loop, about o, takes more)",
+                col.p[0],
+                col.p[1],
+                col.u,
+                s.params.max_overhang_deg,
+                allowed.to_degrees().floor()
+            ),
+        )),
+        _ => Ok(()),
+    }
+}
+
+/// How much nearer the textures can bring the wall to the extruder body
+/// (mm): their amplitudes summed, each way.
+fn texture_reach(design: &Design) -> f64 {
+    2.0 * design
+        .texture
+        .iter()
+        .map(|t| t.amplitude.abs())
+        .sum::<f64>()
+}
+
+/// [`sample_surface`] without textures and twist.
+fn sample_plain(design: &Design) -> Result<Surface> {
     // What is printed: the design enlarged for the kiln's shrinkage.
     let printed = design.printed();
     let design = &printed;
@@ -223,6 +398,9 @@ pub fn sample_surface(design: &Design) -> Result<Surface> {
             first: 0,
             passes: 0,
             top: false,
+            twist: 0.0,
+            normal: [0.0, 0.0],
+            twist_from: 0.0,
         });
     }
     if closed {
@@ -241,7 +419,7 @@ pub fn sample_surface(design: &Design) -> Result<Surface> {
     let spacing = traj.length / (n - 1) as f64;
     // The extruder body reaches r + w_max/2 around the nozzle; 20 % more
     // for the profiles' radial offsets, which move columns in plan.
-    let reach = 1.2 * (printer.nozzle_radius + params.width_max / 2.0);
+    let reach = 1.2 * (printer.nozzle_radius + params.width_max / 2.0) + texture_reach(design);
     // Clay laid within r + w_max of path is the bead just laid (exempt, as
     // in the checker); one column less for safety.
     let exempt =
@@ -262,6 +440,8 @@ pub fn sample_surface(design: &Design) -> Result<Surface> {
         params,
         printer,
         corners: traj.corners.clone(),
+        texture: Vec::new(),
+        texture_label: (String::new(), 0.0),
     };
     let mut samples = Vec::new();
     let mut columns = std::mem::take(&mut surface.columns);
@@ -432,7 +612,7 @@ fn sample_vessel(
     // The extruder body's reach, and the clay just laid along the loop
     // that it may touch, as the checker counts them; columns where the
     // rim is, where collisions happen (docs/ALGORITHMS.md §8).
-    let reach = printer.nozzle_radius + params.width_max / 2.0;
+    let reach = printer.nozzle_radius + params.width_max / 2.0 + texture_reach(design);
     let exempt = ((printer.nozzle_radius + params.width_max) / spacing) as usize;
     let offset = |c: &Column| {
         let t = 1.0;
@@ -512,6 +692,8 @@ fn sample_vessel(
         params,
         printer,
         corners: Vec::new(),
+        texture: Vec::new(),
+        texture_label: (String::new(), 0.0),
     };
     for (i, col) in columns.iter_mut().enumerate() {
         col.first = surface.samples.len() as u32;

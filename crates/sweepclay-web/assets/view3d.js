@@ -1,7 +1,7 @@
 // The 3D preview: the corrected surface (lit, translucent, moved samples in
 // orange), the toolpath as one line or as beads of their true width and
 // height, coloured by stability (the least room of overlap, overhang, layer
-// height and the extruder body's clearance, docs/ALGORITHMS.md §10), one of
+// height and the extruder body's clearance, docs/ALGORITHMS.md §11), one of
 // those four, bead width, pass or stage; the worst bead marked, the
 // returning turns' top-edge beads as dots, the bed and the printer's build
 // volume, with what lies outside it in red. WebGL 2, drawn on demand;

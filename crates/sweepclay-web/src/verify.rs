@@ -235,7 +235,8 @@ pub fn slice_checked<W: Write>(
     go_on(cancel)?;
     let w_max = sampled.params.width_max;
     let reach = (w_max / sampled.spacing).ceil() as usize;
-    let has_offsets = sampled.samples.iter().any(|s| s.xi.abs() > 1e-9);
+    let has_offsets = sampled.samples.iter().any(|s| s.xi.abs() > 1e-9)
+        || sampled.texture.iter().any(|d| d.abs() > 1e-9);
     let mut tight = Tightening::default();
     // Body compression factors: the smallest known to collide, the
     // largest known to clear (with the tightening that cleared).

@@ -1,0 +1,784 @@
+//! Textures and twist (not in the paper; docs/ALGORITHMS.md §11).
+//!
+//! A texture displaces the surface along each column's offset direction:
+//! ξ'(i, z) = ξ(i, z) + a(i, z) · D(i, z), with D the sum of the design's
+//! textures (ripple, flute, spiral, image), each times its fade envelope.
+//! Sampling ([`crate::surface`]) stores D per sample and refines the
+//! spacing and layer heights so each texture gets at least
+//! [`SAMPLES_PER_PERIOD`] samples a period ([`refine`]). The corrections
+//! ([`crate::correct`]) then choose the amount kept, a ∈ [0, 1] per
+//! sample ([`keep`]): 1 wherever the step from the bead below stays
+//! within the support-free and overlap limit, less only where it would
+//! not, and never more than [`MAX_A_STEP`] apart between neighbouring
+//! samples, so a texture fades out smoothly where the clay cannot hold it
+//! and every place where it does is reported.
+//!
+//! Twist turns each cross-section about o by `twist_deg · t` (t = z / h
+//! of the column): [`crate::surface::Column::point`] applies it.
+
+use crate::error::{Error, Result};
+use serde::{Deserialize, Serialize};
+use std::f64::consts::{PI, TAU};
+
+/// Samples a texture gets per period, along Ψ and in height (fewer
+/// cannot show a sine as one).
+pub const SAMPLES_PER_PERIOD: f64 = 8.0;
+
+/// Most the amount kept changes between neighbouring samples.
+pub const MAX_A_STEP: f64 = 0.2;
+
+/// Most textures a design may carry.
+pub const MAX_TEXTURES: usize = 16;
+
+/// Largest image a texture may use (pixels).
+pub const MAX_IMAGE_PIXELS: usize = 4_000_000;
+
+/// Largest image file, encoded (bytes).
+pub const MAX_IMAGE_BYTES: usize = 8 << 20;
+
+/// The kinds of texture.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Kind {
+    /// Horizontal rings: sin(2π z / period).
+    Ripple,
+    /// Vertical ribs: sin(2π n u), n = `count` (or Ψ's length / `period`).
+    Flute,
+    /// Ribs whose phase turns with height: sin(2π (n u + z / pitch)).
+    Spiral,
+    /// A greyscale picture over (u, t): 2 v − 1 for its grey value v.
+    Image,
+}
+
+impl Kind {
+    /// The name in the design file.
+    pub fn name(self) -> &'static str {
+        match self {
+            Kind::Ripple => "ripple",
+            Kind::Flute => "flute",
+            Kind::Spiral => "spiral",
+            Kind::Image => "image",
+        }
+    }
+}
+
+/// One entry of the design's `texture` list (docs/FORMATS.md).
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct TextureSpec {
+    /// Which texture.
+    pub kind: Kind,
+    /// Peak displacement along the offset direction (mm); positive
+    /// pushes outward at the sine's crests.
+    pub amplitude: f64,
+    /// Ripple: period in height (mm). Flute: period along Ψ (mm), instead
+    /// of `count`.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub period: Option<f64>,
+    /// Flute and spiral: ribs along Ψ (whole round a loop).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub count: Option<f64>,
+    /// Spiral: height (mm) over which the ribs move on by one rib.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub pitch: Option<f64>,
+    /// Spiral, instead of `pitch`: how fast the ribs turn round o
+    /// (degrees per mm of height; Ψ's length stands for 360°).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub deg_per_mm: Option<f64>,
+    /// Image: a PNG file, relative to the design file (the CLI reads it).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub path: Option<String>,
+    /// Image: the PNG itself, base64 (what the modeler saves).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub png_base64: Option<String>,
+    /// Rise from nothing over the first this many mm of height.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub fade_in: f64,
+    /// Fall to nothing over the last this many mm below the rim.
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub fade_out: f64,
+    /// The decoded image (grey values), filled by [`TextureSpec::load`]
+    /// from `png_base64` or by the CLI from `path`.
+    #[serde(skip)]
+    pub image: Option<Grey>,
+}
+
+fn is_zero(v: &f64) -> bool {
+    *v == 0.0
+}
+
+/// A greyscale image, rows from the top, values in [0, 1].
+#[derive(Clone, Debug, PartialEq)]
+pub struct Grey {
+    /// Pixels across.
+    pub width: usize,
+    /// Pixels down.
+    pub height: usize,
+    /// Row-major grey values.
+    pub v: Vec<f32>,
+}
+
+impl Grey {
+    /// Decodes a PNG (any colour type and depth; colour is averaged to
+    /// grey, transparency counts as white), refusing files over
+    /// [`MAX_IMAGE_BYTES`] and images over [`MAX_IMAGE_PIXELS`] before
+    /// allocating for their pixels.
+    pub fn from_png(bytes: &[u8], key: &str) -> Result<Grey> {
+        if bytes.len() > MAX_IMAGE_BYTES {
+            return Err(Error::invalid(
+                key,
+                format!(
+                    "the image is {} bytes, over the cap of {MAX_IMAGE_BYTES}",
+                    bytes.len()
+                ),
+            ));
+        }
+        let bad = |e: &dyn std::fmt::Display| Error::invalid(key, format!("not a PNG: {e}"));
+        let mut dec = png::Decoder::new(std::io::Cursor::new(bytes));
+        dec.set_transformations(png::Transformations::EXPAND | png::Transformations::STRIP_16);
+        let header = dec.read_header_info().map_err(|e| bad(&e))?;
+        let (w, h) = (header.width as usize, header.height as usize);
+        if w == 0 || h == 0 || w.saturating_mul(h) > MAX_IMAGE_PIXELS {
+            return Err(Error::invalid(
+                key,
+                format!(
+                    "the image is {w} × {h} pixels; at most {MAX_IMAGE_PIXELS} pixels, at least 1"
+                ),
+            ));
+        }
+        let mut reader = dec.read_info().map_err(|e| bad(&e))?;
+        let mut buf = vec![0; reader.output_buffer_size()];
+        let info = reader.next_frame(&mut buf).map_err(|e| bad(&e))?;
+        let chans = info.color_type.samples();
+        let line = info.line_size;
+        let mut v = Vec::with_capacity(w * h);
+        for y in 0..h {
+            let row = &buf[y * line..y * line + w * chans];
+            for px in row.chunks_exact(chans) {
+                let f = |b: u8| f32::from(b) / 255.0;
+                let (grey, alpha) = match chans {
+                    1 => (f(px[0]), 1.0),
+                    2 => (f(px[0]), f(px[1])),
+                    3 => ((f(px[0]) + f(px[1]) + f(px[2])) / 3.0, 1.0),
+                    _ => ((f(px[0]) + f(px[1]) + f(px[2])) / 3.0, f(px[3])),
+                };
+                v.push(grey * alpha + (1.0 - alpha));
+            }
+        }
+        Ok(Grey {
+            width: w,
+            height: h,
+            v,
+        })
+    }
+
+    /// The image averaged down to at most `w` × `h` cells (box filter),
+    /// so the sampling resolves what is left of it.
+    fn fit(&self, w: usize, h: usize) -> Grey {
+        let (w, h) = (w.clamp(1, self.width), h.clamp(1, self.height));
+        if w == self.width && h == self.height {
+            return self.clone();
+        }
+        let mut sum = vec![0.0f32; w * h];
+        let mut n = vec![0u32; w * h];
+        for y in 0..self.height {
+            let cy = y * h / self.height;
+            for x in 0..self.width {
+                let c = cy * w + x * w / self.width;
+                sum[c] += self.v[y * self.width + x];
+                n[c] += 1;
+            }
+        }
+        Grey {
+            width: w,
+            height: h,
+            v: sum
+                .iter()
+                .zip(&n)
+                .map(|(s, &k)| s / k.max(1) as f32)
+                .collect(),
+        }
+    }
+
+    /// Bilinear grey at (x, y) ∈ [0, 1]² (y from the top), clamped at the
+    /// edges; across x, wrapped when `wrap` (round a loop).
+    fn at(&self, x: f64, y: f64, wrap: bool) -> f64 {
+        let fx = if wrap {
+            x.rem_euclid(1.0) * self.width as f64 - 0.5
+        } else {
+            (x * self.width as f64 - 0.5).clamp(0.0, (self.width - 1) as f64)
+        };
+        let fy = (y * self.height as f64 - 0.5).clamp(0.0, (self.height - 1) as f64);
+        let (x0, y0) = (fx.floor(), fy.floor());
+        let (tx, ty) = (fx - x0, fy - y0);
+        let col = |k: f64| -> usize {
+            let k = k as i64;
+            if wrap {
+                k.rem_euclid(self.width as i64) as usize
+            } else {
+                k.clamp(0, self.width as i64 - 1) as usize
+            }
+        };
+        let (xa, xb) = (col(x0), col(x0 + 1.0));
+        let (ya, yb) = (y0 as usize, (y0 as usize + 1).min(self.height - 1));
+        let g = |x: usize, y: usize| f64::from(self.v[y * self.width + x]);
+        (g(xa, ya) * (1.0 - tx) + g(xb, ya) * tx) * (1.0 - ty)
+            + (g(xa, yb) * (1.0 - tx) + g(xb, yb) * tx) * ty
+    }
+}
+
+impl TextureSpec {
+    /// Checks the entry; `key` is `texture[k]` in messages.
+    pub fn validate(&self, key: &str, closed: bool) -> Result<()> {
+        let finite = |name: &str, v: f64, lo: f64, hi: f64| -> Result<()> {
+            if v.is_finite() && v >= lo && v <= hi {
+                Ok(())
+            } else {
+                Err(Error::invalid(
+                    format!("{key}.{name}"),
+                    format!("must be between {lo} and {hi} (got {v})"),
+                ))
+            }
+        };
+        finite("amplitude", self.amplitude, -50.0, 50.0)?;
+        finite("fade_in", self.fade_in, 0.0, 10_000.0)?;
+        finite("fade_out", self.fade_out, 0.0, 10_000.0)?;
+        let need = |name: &str, v: Option<f64>| -> Result<f64> {
+            v.ok_or_else(|| Error::invalid(key, format!("a {} needs `{name}`", self.kind.name())))
+        };
+        match self.kind {
+            Kind::Ripple => finite("period", need("period", self.period)?, 0.1, 10_000.0)?,
+            Kind::Flute | Kind::Spiral => {
+                match (self.count, self.period) {
+                    (Some(n), None) => {
+                        finite("count", n, 1.0, 10_000.0)?;
+                        if closed && n.fract() != 0.0 {
+                            return Err(Error::invalid(
+                                format!("{key}.count"),
+                                format!("must be whole round a closed trajectory, so the ribs meet at the seam (got {n})"),
+                            ));
+                        }
+                    }
+                    (None, Some(p)) if self.kind == Kind::Flute => {
+                        finite("period", p, 0.1, 100_000.0)?
+                    }
+                    _ => {
+                        return Err(Error::invalid(
+                            key,
+                            format!(
+                                "a {} needs `count`{}",
+                                self.kind.name(),
+                                if self.kind == Kind::Flute {
+                                    " or `period` (not both)"
+                                } else {
+                                    ""
+                                }
+                            ),
+                        ))
+                    }
+                }
+                if self.kind == Kind::Spiral {
+                    match (self.pitch, self.deg_per_mm) {
+                        (Some(p), None) => finite("pitch", p.abs(), 0.1, 100_000.0)?,
+                        (None, Some(d)) => finite("deg_per_mm", d.abs(), 1e-6, 360.0)?,
+                        _ => {
+                            return Err(Error::invalid(
+                                key,
+                                "a spiral needs `pitch` (mm) or `deg_per_mm` (not both)",
+                            ))
+                        }
+                    }
+                }
+            }
+            Kind::Image => {
+                if self.image.is_none() {
+                    return Err(Error::invalid(
+                        key,
+                        if self.path.is_some() {
+                            "the image at `path` was not read (the CLI reads it; elsewhere give `png_base64`)"
+                        } else {
+                            "an image needs `png_base64` or `path` (a PNG)"
+                        },
+                    ));
+                }
+            }
+        }
+        Ok(())
+    }
+
+    /// Decodes `png_base64` into [`TextureSpec::image`] (if given and not
+    /// yet decoded).
+    pub fn load(&mut self, key: &str) -> Result<()> {
+        use base64::Engine as _;
+        if self.image.is_some() {
+            return Ok(());
+        }
+        let Some(b64) = &self.png_base64 else {
+            return Ok(());
+        };
+        // 4/3 of the byte cap, and the data-URL prefix the page may send.
+        if b64.len() > MAX_IMAGE_BYTES / 3 * 4 + 64 {
+            return Err(Error::invalid(
+                format!("{key}.png_base64"),
+                format!("the image is over the cap of {MAX_IMAGE_BYTES} bytes"),
+            ));
+        }
+        let data = b64.rsplit(',').next().unwrap_or("");
+        let bytes = base64::engine::general_purpose::STANDARD
+            .decode(data.trim())
+            .map_err(|e| Error::invalid(format!("{key}.png_base64"), format!("not base64: {e}")))?;
+        self.image = Some(Grey::from_png(&bytes, &format!("{key}.png_base64"))?);
+        Ok(())
+    }
+
+    /// Short words for reports: "ripple 2 mm".
+    pub fn label(&self) -> String {
+        format!("{} {} mm", self.kind.name(), fmt_mm(self.amplitude.abs()))
+    }
+
+    /// The entry with lengths scaled for firing shrinkage (`kxy` across,
+    /// `kz` in height).
+    pub fn scaled(&self, kxy: f64, kz: f64) -> TextureSpec {
+        TextureSpec {
+            amplitude: self.amplitude * kxy,
+            period: self.period.map(|p| {
+                if self.kind == Kind::Ripple {
+                    p * kz
+                } else {
+                    p * kxy
+                }
+            }),
+            pitch: self.pitch.map(|p| p * kz),
+            deg_per_mm: self.deg_per_mm.map(|d| d / kz),
+            fade_in: self.fade_in * kz,
+            fade_out: self.fade_out * kz,
+            ..self.clone()
+        }
+    }
+
+    /// Ribs along Ψ of a flute or spiral over a Ψ `length` mm long.
+    fn ribs(&self, length: f64, closed: bool) -> f64 {
+        match (self.count, self.period) {
+            (Some(n), _) => n,
+            (None, Some(p)) if closed => (length / p).round().max(1.0),
+            (None, Some(p)) => length / p,
+            _ => 1.0,
+        }
+    }
+
+    /// The spiral's phase per mm of height, in periods.
+    fn turn_per_mm(&self, ribs: f64) -> f64 {
+        match (self.pitch, self.deg_per_mm) {
+            (Some(p), _) => 1.0 / p,
+            (None, Some(d)) => ribs * d / 360.0,
+            _ => 0.0,
+        }
+    }
+
+    /// The shortest period along Ψ (mm) and in height (mm) this texture
+    /// has over a Ψ `length` mm long; infinite where it does not vary.
+    pub fn periods(&self, length: f64, closed: bool) -> [f64; 2] {
+        match self.kind {
+            Kind::Ripple => [f64::INFINITY, self.period.unwrap_or(f64::INFINITY)],
+            Kind::Flute => [length / self.ribs(length, closed), f64::INFINITY],
+            Kind::Spiral => {
+                let n = self.ribs(length, closed);
+                [length / n, 1.0 / self.turn_per_mm(n).abs()]
+            }
+            // An image is fitted to the sampling (below).
+            Kind::Image => [f64::INFINITY; 2],
+        }
+    }
+}
+
+fn fmt_mm(v: f64) -> String {
+    let s = format!("{v:.2}");
+    s.trim_end_matches('0').trim_end_matches('.').to_string()
+}
+
+/// What a texture asks of the sampling: a step (mm) and the index of
+/// the texture that asks it, or nothing.
+pub type Need = Option<(f64, usize)>;
+
+/// Validates a design's textures and twist.
+pub fn validate(textures: &[TextureSpec], twist_deg: f64, closed: bool) -> Result<()> {
+    if textures.len() > MAX_TEXTURES {
+        return Err(Error::invalid(
+            "texture",
+            format!("has {} entries; at most {MAX_TEXTURES}", textures.len()),
+        ));
+    }
+    for (k, t) in textures.iter().enumerate() {
+        t.validate(&format!("texture[{k}]"), closed)?;
+    }
+    if !(twist_deg.is_finite() && twist_deg.abs() <= 720.0) {
+        return Err(Error::invalid(
+            "twist_deg",
+            format!("must be between -720 and 720 degrees (got {twist_deg})"),
+        ));
+    }
+    Ok(())
+}
+
+/// The sampling the textures need: the spacing along Ψ and the thickest
+/// layer that give every texture [`SAMPLES_PER_PERIOD`] samples a
+/// period, with the texture that asks most of each (index), for a Ψ
+/// `length` mm long. `None` where no texture asks.
+pub fn needs(textures: &[TextureSpec], length: f64, closed: bool) -> [Need; 2] {
+    let mut spacing: Need = None;
+    let mut layer: Need = None;
+    for (k, t) in textures.iter().enumerate() {
+        if t.amplitude == 0.0 {
+            continue;
+        }
+        let [pu, pz] = t.periods(length, closed);
+        let (su, sz) = (pu / SAMPLES_PER_PERIOD, pz / SAMPLES_PER_PERIOD);
+        if su.is_finite() && spacing.is_none_or(|(s, _)| su < s) {
+            spacing = Some((su, k));
+        }
+        if sz.is_finite() && layer.is_none_or(|(s, _)| sz < s) {
+            layer = Some((sz, k));
+        }
+    }
+    [spacing, layer]
+}
+
+/// The resolved textures of a sampled surface: D(u, z) for a column of
+/// height h.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct Field {
+    entries: Vec<Entry>,
+    closed: bool,
+}
+
+#[derive(Clone, Debug, PartialEq)]
+struct Entry {
+    spec: TextureSpec,
+    ribs: f64,
+    turn_per_mm: f64,
+    image: Option<Grey>,
+}
+
+impl Field {
+    /// The textures over a Ψ `length` mm long and `height` mm tall,
+    /// sampled every `spacing` mm and `layer` mm: images are averaged
+    /// down to half the samples a period needs.
+    pub fn new(
+        textures: &[TextureSpec],
+        length: f64,
+        height: f64,
+        closed: bool,
+        spacing: f64,
+        layer: f64,
+    ) -> Field {
+        let cells = |extent: f64, step: f64| {
+            (extent / (step * SAMPLES_PER_PERIOD / 2.0))
+                .floor()
+                .max(1.0) as usize
+        };
+        Field {
+            entries: textures
+                .iter()
+                .filter(|t| t.amplitude != 0.0)
+                .map(|t| {
+                    let ribs = t.ribs(length, closed);
+                    Entry {
+                        spec: t.clone(),
+                        ribs,
+                        turn_per_mm: t.turn_per_mm(ribs),
+                        image: t
+                            .image
+                            .as_ref()
+                            .map(|g| g.fit(cells(length, spacing), cells(height, layer))),
+                    }
+                })
+                .collect(),
+            closed,
+        }
+    }
+
+    /// Whether there is nothing to add.
+    pub fn is_empty(&self) -> bool {
+        self.entries.is_empty()
+    }
+
+    /// D at normalised arc length `u`, height `z`, in a column `h` tall,
+    /// with its base `base` mm laid plain (a vessel's floor layers).
+    pub fn at(&self, u: f64, z: f64, h: f64, base: f64) -> f64 {
+        if base > 0.0 && z <= base + 1e-9 {
+            return 0.0;
+        }
+        let t = (z / h).clamp(0.0, 1.0);
+        self.entries
+            .iter()
+            .map(|e| {
+                let s = &e.spec;
+                let g = match s.kind {
+                    Kind::Ripple => (TAU * z / s.period.unwrap_or(1.0)).sin(),
+                    Kind::Flute => (TAU * e.ribs * u).sin(),
+                    Kind::Spiral => (TAU * (e.ribs * u + z * e.turn_per_mm)).sin(),
+                    Kind::Image => e
+                        .image
+                        .as_ref()
+                        .map_or(0.0, |g| 2.0 * g.at(u, 1.0 - t, self.closed) - 1.0),
+                };
+                s.amplitude * envelope(z - base, s.fade_in) * envelope(h - z, s.fade_out) * g
+            })
+            .sum()
+    }
+
+    /// The textures' labels, for reports: "ripple 2 mm + flute 1 mm".
+    pub fn label(&self) -> String {
+        self.entries
+            .iter()
+            .map(|e| e.spec.label())
+            .collect::<Vec<_>>()
+            .join(" + ")
+    }
+
+    /// The largest |D| the textures can reach (mm): their amplitudes
+    /// summed.
+    pub fn peak(&self) -> f64 {
+        self.entries.iter().map(|e| e.spec.amplitude.abs()).sum()
+    }
+}
+
+/// Rises smoothly (half a cosine) from 0 at d ≤ 0 to 1 at d ≥ `len`; 1
+/// without a fade. Below 0 (inside a plain base) it is 0.
+fn envelope(d: f64, len: f64) -> f64 {
+    if d < 0.0 {
+        0.0
+    } else if len <= 0.0 || d >= len {
+        1.0
+    } else {
+        0.5 - 0.5 * (PI * d / len).cos()
+    }
+}
+
+/// Where a texture was kept at less than its full amplitude.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct TextureFix {
+    /// The textures (their labels).
+    pub texture: String,
+    /// The least amount kept there, 0–1.
+    pub kept: f64,
+    /// The heights between which it was reduced (mm).
+    pub z_mm: [f64; 2],
+    /// The normalised arc lengths between which it was reduced.
+    pub u: [f64; 2],
+    /// Why: `overhang` (the step from the bead below), `overlap` (the
+    /// widest bead could not cover the step) or `self-intersection`.
+    pub why: &'static str,
+}
+
+impl TextureFix {
+    /// "ripple 2 mm reduced to 60 % (1.2 mm of 2 mm) between z 40 and 55
+    /// mm, u 0.10–0.30: overhang".
+    pub fn summary(&self, peak: f64) -> String {
+        format!(
+            "texture {} reduced to {:.0} % ({} mm of {} mm) between z {:.0} and {:.0} mm, u {:.2}–{:.2}: {}",
+            self.texture,
+            100.0 * self.kept,
+            fmt_mm(self.kept * peak),
+            fmt_mm(peak),
+            self.z_mm[0],
+            self.z_mm[1],
+            self.u[0],
+            self.u[1],
+            self.why
+        )
+    }
+}
+
+/// Spreads caps so neighbouring values differ by at most [`MAX_A_STEP`]:
+/// a(s) = min over neighbours of cap + [`MAX_A_STEP`] per step, relaxed
+/// along the neighbour lists until nothing changes (a few sweeps; each
+/// linear).
+pub fn smooth(a: &mut [f64], neighbours: &[[u32; 4]]) {
+    for _ in 0..64 {
+        let mut changed = false;
+        for pass in 0..2 {
+            let order: Box<dyn Iterator<Item = usize>> = if pass == 0 {
+                Box::new(0..a.len())
+            } else {
+                Box::new((0..a.len()).rev())
+            };
+            for s in order {
+                for &nb in &neighbours[s] {
+                    if nb == u32::MAX {
+                        continue;
+                    }
+                    let lim = a[nb as usize] + MAX_A_STEP;
+                    if a[s] > lim + 1e-12 {
+                        a[s] = lim;
+                        changed = true;
+                    }
+                }
+            }
+        }
+        if !changed {
+            break;
+        }
+    }
+}
+
+/// The largest a ∈ [0, 1] with |b + a · d| ≤ `limit`, given |b| ≤ limit.
+pub fn cap(b: f64, d: f64, limit: f64) -> f64 {
+    if (b + d).abs() <= limit + 1e-12 {
+        return 1.0;
+    }
+    let a = if d > 0.0 {
+        (limit - b) / d
+    } else if d < 0.0 {
+        (limit + b) / -d
+    } else {
+        1.0
+    };
+    a.clamp(0.0, 1.0)
+}
+
+/// Groups the samples kept below full amplitude into reports: sorted by
+/// height, a new group where two reduced samples are more than `gap` mm
+/// apart in height; each group names the commonest reason. `items` are
+/// (z, u, a, why).
+pub fn report(
+    mut items: Vec<(f64, f64, f64, &'static str)>,
+    label: &str,
+    gap: f64,
+) -> Vec<TextureFix> {
+    items.sort_by(|a, b| a.0.total_cmp(&b.0));
+    let mut out: Vec<(TextureFix, [u32; 3])> = Vec::new();
+    let mut last_z = f64::NEG_INFINITY;
+    for (z, u, a, why) in items {
+        if out.is_empty() || z - last_z > gap {
+            out.push((
+                TextureFix {
+                    texture: label.to_string(),
+                    kept: a,
+                    z_mm: [z, z],
+                    u: [u, u],
+                    why,
+                },
+                [0; 3],
+            ));
+        }
+        let (f, counts) = out.last_mut().expect("pushed");
+        f.kept = f.kept.min(a);
+        f.z_mm[1] = z;
+        f.u = [f.u[0].min(u), f.u[1].max(u)];
+        counts[match why {
+            "overhang" => 0,
+            "overlap" => 1,
+            _ => 2,
+        }] += 1;
+        last_z = z;
+    }
+    out.into_iter()
+        .map(|(mut f, c)| {
+            let best = (0..3).max_by_key(|&k| c[k]).unwrap_or(0);
+            f.why = ["overhang", "overlap", "self-intersection"][best];
+            f
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ripple(a: f64, p: f64) -> TextureSpec {
+        serde_json::from_str(&format!(
+            r#"{{"kind": "ripple", "amplitude": {a}, "period": {p}}}"#
+        ))
+        .unwrap()
+    }
+
+    #[test]
+    fn a_ripple_is_a_sine_in_height_and_fades_smoothly() {
+        let f = Field::new(&[ripple(2.0, 10.0)], 100.0, 50.0, false, 1.0, 1.0);
+        assert!((f.at(0.3, 2.5, 50.0, 0.0) - 2.0).abs() < 1e-12);
+        assert!((f.at(0.7, 7.5, 50.0, 0.0) + 2.0).abs() < 1e-12);
+        assert!(f.at(0.0, 10.0, 50.0, 0.0).abs() < 1e-12);
+        let mut faded = ripple(2.0, 10.0);
+        faded.fade_in = 10.0;
+        let f = Field::new(&[faded], 100.0, 50.0, false, 1.0, 1.0);
+        // Half way up the fade, half the amplitude; nothing at the base.
+        assert!((f.at(0.0, 5.0, 50.0, 0.0) - 0.0).abs() < 1e-12);
+        assert!((f.at(0.0, 2.5, 50.0, 0.0) - 2.0 * envelope(2.5, 10.0)).abs() < 1e-12);
+        assert_eq!(f.at(0.0, 0.0, 50.0, 0.0), 0.0);
+        // A plain base 4 mm deep: nothing below it, the fade from it.
+        assert_eq!(f.at(0.0, 3.0, 50.0, 4.0), 0.0);
+    }
+
+    #[test]
+    fn flutes_and_spirals_meet_at_the_seam_and_need_eight_samples_a_period() {
+        let flute: TextureSpec =
+            serde_json::from_str(r#"{"kind": "flute", "amplitude": 1, "count": 12}"#).unwrap();
+        let f = Field::new(std::slice::from_ref(&flute), 300.0, 80.0, true, 1.0, 1.0);
+        assert!((f.at(0.0, 10.0, 80.0, 0.0) - f.at(1.0, 10.0, 80.0, 0.0)).abs() < 1e-9);
+        assert!((f.at(1.0 / 48.0, 10.0, 80.0, 0.0) - 1.0).abs() < 1e-12);
+        let [s, z] = needs(std::slice::from_ref(&flute), 300.0, true);
+        assert_eq!(s, Some((300.0 / 12.0 / 8.0, 0)));
+        assert_eq!(z, None);
+        let half: TextureSpec =
+            serde_json::from_str(r#"{"kind": "flute", "amplitude": 1, "count": 2.5}"#).unwrap();
+        assert!(half.validate("texture[0]", true).is_err());
+        assert!(half.validate("texture[0]", false).is_ok());
+        let spiral: TextureSpec =
+            serde_json::from_str(r#"{"kind": "spiral", "amplitude": 1, "count": 6, "pitch": 40}"#)
+                .unwrap();
+        let f = Field::new(std::slice::from_ref(&spiral), 300.0, 80.0, true, 1.0, 1.0);
+        // One pitch up, the ribs have moved on by one rib.
+        assert!((f.at(0.1, 5.0, 80.0, 0.0) - f.at(0.1 - 1.0 / 6.0, 45.0, 80.0, 0.0)).abs() < 1e-9);
+        assert_eq!(needs(&[spiral], 300.0, true)[1], Some((5.0, 0)));
+    }
+
+    #[test]
+    fn caps_keep_the_step_within_the_limit_and_smoothing_bounds_the_change() {
+        assert_eq!(cap(0.5, 0.3, 1.0), 1.0);
+        assert!((cap(0.5, 1.0, 1.0) - 0.5).abs() < 1e-12);
+        assert!((cap(-0.5, -1.0, 1.0) - 0.5).abs() < 1e-12);
+        assert!((cap(0.5, -3.0, 1.0) - 0.5).abs() < 1e-12);
+        // A line of ten samples, one capped at 0: its neighbours rise by
+        // 0.2 a sample.
+        let mut a = vec![1.0; 10];
+        a[4] = 0.0;
+        let nb: Vec<[u32; 4]> = (0..10u32)
+            .map(|i| {
+                [
+                    i.wrapping_sub(1),
+                    if i < 9 { i + 1 } else { u32::MAX },
+                    u32::MAX,
+                    u32::MAX,
+                ]
+            })
+            .collect();
+        smooth(&mut a, &nb);
+        let want = [0.8, 0.6, 0.4, 0.2, 0.0, 0.2, 0.4, 0.6, 0.8, 1.0];
+        for (x, w) in a.iter().zip(want) {
+            assert!((x - w).abs() < 1e-9, "{a:?}");
+        }
+    }
+
+    #[test]
+    fn png_images_decode_to_grey_and_average_down() {
+        let mut bytes = Vec::new();
+        {
+            let mut enc = png::Encoder::new(&mut bytes, 4, 2);
+            enc.set_color(png::ColorType::Grayscale);
+            enc.set_depth(png::BitDepth::Eight);
+            let mut w = enc.write_header().unwrap();
+            w.write_image_data(&[0, 255, 0, 255, 255, 255, 0, 0])
+                .unwrap();
+        }
+        let g = Grey::from_png(&bytes, "texture[0]").unwrap();
+        assert_eq!((g.width, g.height), (4, 2));
+        assert_eq!(g.v[1], 1.0);
+        let small = g.fit(2, 1);
+        assert_eq!(small.v, vec![0.75, 0.25]);
+        assert!(Grey::from_png(b"not a png", "texture[0]")
+            .unwrap_err()
+            .to_string()
+            .contains("texture[0]"));
+    }
+}
