@@ -6,7 +6,9 @@
 //!
 //! `cargo bench -p sweepclay-core` (all), or with a filter:
 //! `cargo bench -p sweepclay-core -- stages/t1`, `-- scaling`, `-- gcode_floor`,
-//! `-- bspline` (B-spline evaluation from 10 to 100,000 control points).
+//! `-- bspline` (B-spline evaluation from 10 to 100,000 control points),
+//! `-- textures` (a 44k-sample vase, plain, with ripple and flutes, and
+//! twisted too: docs/ALGORITHMS.md §11).
 //! `SWEEPCLAY_BENCH_MAX=1000000` stops the scaling series at 1 million.
 
 use criterion::{criterion_group, criterion_main, BatchSize, BenchmarkId, Criterion, Throughput};
@@ -175,8 +177,51 @@ fn bspline_bench(c: &mut Criterion) {
     g.finish();
 }
 
+/// A vase of about 44k samples, plain, textured (a ripple and flutes
+/// whose sampling needs the plain one's spacing and layers already meet)
+/// and textured and twisted: the textures' cost in sampling and
+/// correcting.
+fn textures_bench(c: &mut Criterion) {
+    let mut plain = Design::from_json(examples::example("vase").unwrap()).unwrap();
+    plain.params.layer_height = 0.7;
+    plain.params.max_layer_height = 1.0;
+    plain.params.spacing = 0.65;
+    let mut textured = plain.clone();
+    textured.texture = serde_json::from_str(
+        r#"[{"kind": "ripple", "amplitude": 1.2, "period": 12, "fade_in": 6},
+            {"kind": "flute", "amplitude": 0.8, "count": 12, "fade_out": 6}]"#,
+    )
+    .unwrap();
+    let mut twisted = textured.clone();
+    twisted.twist_deg = 20.0;
+    let mut g = c.benchmark_group("textures");
+    for (name, d) in [
+        ("plain", &plain),
+        ("textured", &textured),
+        ("twisted", &twisted),
+    ] {
+        // The extruder body's reach grows with the texture, so the
+        // vessel's layering (and its sample count) may differ: compare
+        // per sample.
+        let n = sweepclay_core::slice(d).unwrap().stats.sample_points;
+        g.throughput(Throughput::Elements(n as u64));
+        let surf = surface::sample_surface(d).unwrap();
+        g.bench_function(BenchmarkId::new("sample", name), |b| {
+            b.iter(|| surface::sample_surface(black_box(d)).unwrap())
+        });
+        g.bench_function(BenchmarkId::new("correct", name), |b| {
+            b.iter(|| correct::correct(black_box(&surf)).unwrap())
+        });
+        g.bench_function(BenchmarkId::new("slice", name), |b| {
+            b.iter(|| sweepclay_core::slice(black_box(d)).unwrap())
+        });
+    }
+    g.finish();
+}
+
 criterion_group!(
     benches,
+    textures_bench,
     examples_bench,
     gcode_floor,
     scaling_bench,

@@ -442,31 +442,53 @@ fn keep_texture(s: &mut Surface, scale: &[f64]) -> (Vec<f64>, Vec<crate::texture
         }
     }
     let mut a = caps.clone();
-    smooth(&mut a, &nb);
+    smooth(&mut a, &nb, 0..n);
     let apply = |s: &mut Surface, a: &[f64]| {
         for (i, smp) in s.samples.iter_mut().enumerate() {
             smp.xi = base[i] + a[i] * d[i];
         }
     };
     // Neighbours kept at different amounts step differently: tighten
-    // where a step still breaks, and again, until none does.
-    for _ in 0..40 {
-        let mut broke = false;
-        for &(i0, i1, lim, tw, w) in &steps {
+    // where a step still breaks, and again, until none does; after the
+    // first round only the steps at samples that changed are looked at.
+    // (Spreading only lowers, so a spread from the lowered caps alone
+    // equals a spread of all of them again.)
+    let mut up_step = vec![u32::MAX; n];
+    for (k, st) in steps.iter().enumerate() {
+        up_step[st.1] = k as u32;
+    }
+    let mut look: Vec<usize> = (0..steps.len()).collect();
+    for _ in 0..200 {
+        let mut lowered = Vec::new();
+        for &k in &look {
+            let (i0, i1, lim, tw, w) = steps[k];
             let step = base[i1] + a[i1] * d[i1] - base[i0] - a[i0] * d[i0] + tw;
             if step.abs() > lim + 1e-9 {
-                broke = true;
                 let f = cap(base[i1] - base[i0] + tw, a[i1] * d[i1] - a[i0] * d[i0], lim);
                 let f = f.min(0.9);
-                lower(&mut caps, &mut why, i0, f * a[i0], w);
-                lower(&mut caps, &mut why, i1, f * a[i1], w);
+                for i in [i0, i1] {
+                    lower(&mut caps, &mut why, i, f * a[i], w);
+                    if caps[i] < a[i] {
+                        a[i] = caps[i];
+                        lowered.push(i);
+                    }
+                }
             }
         }
-        if !broke {
+        if lowered.is_empty() {
             break;
         }
-        a.copy_from_slice(&caps);
-        smooth(&mut a, &nb);
+        let changed = smooth(&mut a, &nb, lowered);
+        look.clear();
+        for i in changed {
+            look.push(up_step[i] as usize);
+            if i + 1 < n && up_step[i + 1] != u32::MAX && steps[up_step[i + 1] as usize].0 == i {
+                look.push(up_step[i + 1] as usize);
+            }
+        }
+        look.retain(|&k| k < steps.len());
+        look.sort_unstable();
+        look.dedup();
     }
     apply(s, &a);
     // Where the textured surface meets itself, the texture gives way
@@ -485,15 +507,17 @@ fn keep_texture(s: &mut Surface, scale: &[f64]) -> (Vec<f64>, Vec<crate::texture
                 .flat_map(|c| c.saturating_sub(reach)..=(c + reach).min(m - 1))
                 .collect()
         };
+        let mut lowered = Vec::new();
         for c in near {
             for i in s.columns[c].samples() {
                 if round == 6 || (s.samples[i].z - at[2]).abs() < 3.0 * s.params.width_max {
                     lower(&mut caps, &mut why, i, 0.0, "self-intersection");
+                    a[i] = 0.0;
+                    lowered.push(i);
                 }
             }
         }
-        a.copy_from_slice(&caps);
-        smooth(&mut a, &nb);
+        smooth(&mut a, &nb, lowered);
         apply(s, &a);
     }
     let items: Vec<(f64, f64, f64, &'static str)> = s
@@ -648,7 +672,9 @@ fn find_self_intersection(s: &Surface) -> Option<(u32, u32, [f64; 3])> {
     // than 2 w along Ψ (a sharp corner's) are laid in one go, as fresh clay
     // the nozzle rides on (the checker counts them so too).
     let far = ((2.0 * w) / s.spacing).ceil() as usize;
-    let twisted = s.columns.iter().any(|c| c.twist != 0.0);
+    if s.columns.iter().any(|c| c.twist != 0.0) {
+        return find_twisted_contact(s, w, far);
+    }
     let segs: Vec<[[f64; 2]; 2]> = s
         .columns
         .iter()
@@ -664,24 +690,8 @@ fn find_self_intersection(s: &Surface) -> Option<(u32, u32, [f64; 3])> {
         })
         .collect();
     let mut grid = Grid2::new(w.max(s.spacing));
-    if twisted {
-        // A twisted curve turns as it rises: its plan is the polyline of
-        // its samples, not one segment (every step of it in the grid).
-        for (c, col) in s.columns.iter().enumerate() {
-            let r = col.samples();
-            for i in r.start + 1..r.end {
-                let (p, q) = (s.position(c, i - 1), s.position(c, i));
-                grid.insert_segment([p[0], p[1]], [q[0], q[1]], c as u32);
-            }
-            if r.len() == 1 {
-                let p = s.position(c, r.start);
-                grid.insert_segment([p[0], p[1]], [p[0], p[1]], c as u32);
-            }
-        }
-    } else {
-        for (c, seg) in segs.iter().enumerate() {
-            grid.insert_segment(seg[0], seg[1], c as u32);
-        }
+    for (c, seg) in segs.iter().enumerate() {
+        grid.insert_segment(seg[0], seg[1], c as u32);
     }
     let w2 = w * w;
     let mut near: Vec<u32> = Vec::new();
@@ -689,25 +699,13 @@ fn find_self_intersection(s: &Surface) -> Option<(u32, u32, [f64; 3])> {
         near.clear();
         let n = segs.len();
         let closed = s.vessel.is_some();
-        let mut take = |b: u32| {
+        grid.for_each_near_segment(seg[0], seg[1], w, |b| {
             // Round a loop, the last curves are the first ones' neighbours.
             let apart = (b as usize) > a + far && (!closed || a + n - b as usize > far);
-            if apart && (twisted || segment_distance(*seg, segs[b as usize]) < w) {
+            if apart && segment_distance(*seg, segs[b as usize]) < w {
                 near.push(b);
             }
-        };
-        if twisted {
-            let r = s.columns[a].samples();
-            for i in r.start..r.end {
-                let (p, q) = (
-                    s.position(a, i.saturating_sub(1).max(r.start)),
-                    s.position(a, i),
-                );
-                grid.for_each_near_segment([p[0], p[1]], [q[0], q[1]], w, &mut take);
-            }
-        } else {
-            grid.for_each_near_segment(seg[0], seg[1], w, &mut take);
-        }
+        });
         near.sort_unstable();
         near.dedup();
         for &b in &near {
@@ -719,22 +717,14 @@ fn find_self_intersection(s: &Surface) -> Option<(u32, u32, [f64; 3])> {
                 let p = s.position(a, i);
                 // All of b lies on its plan segment: a sample of a farther
                 // than a bead from it in plan is farther in 3D.
-                if !twisted && point_segment2([p[0], p[1]], sb) >= w2 {
+                if point_segment2([p[0], p[1]], sb) >= w2 {
                     continue;
                 }
-                // A twisted wall leans along itself: points of one pass a
-                // layer or more apart in height are the wall rising, not
-                // meeting itself, so only the same layer's are compared.
-                let dz = if twisted {
-                    s.params.max_layer_height
-                } else {
-                    w
-                };
-                while start < rb.end && s.samples[start].z < p[2] - dz {
+                while start < rb.end && s.samples[start].z < p[2] - w {
                     start += 1;
                 }
                 for j in start..rb.end {
-                    if s.samples[j].z > p[2] + dz {
+                    if s.samples[j].z > p[2] + w {
                         break;
                     }
                     let q = s.position(b as usize, j);
@@ -745,6 +735,88 @@ fn find_self_intersection(s: &Surface) -> Option<(u32, u32, [f64; 3])> {
                     // neighbours are still neighbours).
                     if d2 < w2 && pass_apart(s, a, b as usize, i - ca.first as usize, w) {
                         return Some((a as u32, b, p));
+                    }
+                }
+            }
+        }
+    }
+    None
+}
+
+/// [`find_self_intersection`] for a twisted surface, whose curves turn as
+/// they rise and so lie on no one plan segment: every sample goes into a
+/// grid of cells a bead wide in plan and a layer high, and each is
+/// compared with the samples of curves far along Ψ in its own and the
+/// neighbouring cells. Only samples within a layer of each other in
+/// height count: a twisted wall leans along itself, and points of it a
+/// layer or more apart are the wall rising, not meeting itself. Linear in
+/// the samples.
+fn find_twisted_contact(s: &Surface, w: f64, far: usize) -> Option<(u32, u32, [f64; 3])> {
+    let dz = s.params.max_layer_height;
+    let n = s.columns.len();
+    let closed = s.vessel.is_some();
+    let key = |p: [f64; 3]| {
+        (
+            (p[0] / w).floor() as i64,
+            (p[1] / w).floor() as i64,
+            (p[2] / dz).floor() as i64,
+        )
+    };
+    // Every sample's position once (a twisted one costs a sine), then
+    // the samples sorted by cell, and each cell's range of them.
+    let mut at = vec![[0.0; 3]; s.samples.len()];
+    let mut by_cell: Vec<((i64, i64, i64), u32, u32)> = Vec::with_capacity(s.samples.len());
+    for (c, col) in s.columns.iter().enumerate() {
+        for i in col.samples() {
+            at[i] = s.position(c, i);
+            by_cell.push((key(at[i]), c as u32, i as u32));
+        }
+    }
+    by_cell.sort_unstable_by_key(|e| e.0);
+    let mut cells: rustc_hash::FxHashMap<(i64, i64, i64), (usize, usize)> =
+        rustc_hash::FxHashMap::default();
+    let mut start = 0;
+    for k in 1..=by_cell.len() {
+        if k == by_cell.len() || by_cell[k].0 != by_cell[start].0 {
+            cells.insert(by_cell[start].0, (start, k));
+            start = k;
+        }
+    }
+    let w2 = w * w;
+    for (a, col) in s.columns.iter().enumerate() {
+        for i in col.samples() {
+            let p = at[i];
+            let (kx, ky, kz) = key(p);
+            for k in [
+                (-1i64, -1i64),
+                (-1, 0),
+                (-1, 1),
+                (0, -1),
+                (0, 0),
+                (0, 1),
+                (1, -1),
+                (1, 0),
+                (1, 1),
+            ]
+            .iter()
+            .flat_map(|&(x, y)| (-1..=1).map(move |z| (kx + x, ky + y, kz + z)))
+            {
+                let Some(&(from, to)) = cells.get(&k) else {
+                    continue;
+                };
+                for &(_, b, j) in &by_cell[from..to] {
+                    let b = b as usize;
+                    let apart = b > a + far && (!closed || a + n - b > far);
+                    if !apart {
+                        continue;
+                    }
+                    let q = at[j as usize];
+                    if (q[2] - p[2]).abs() > dz {
+                        continue;
+                    }
+                    let d2 = (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2);
+                    if d2 < w2 && pass_apart(s, a, b, i - col.first as usize, w) {
+                        return Some((a as u32, b as u32, p));
                     }
                 }
             }

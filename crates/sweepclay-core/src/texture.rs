@@ -591,35 +591,42 @@ impl TextureFix {
 }
 
 /// Spreads caps so neighbouring values differ by at most [`MAX_A_STEP`]:
-/// a(s) = min over neighbours of cap + [`MAX_A_STEP`] per step, relaxed
-/// along the neighbour lists until nothing changes (a few sweeps; each
-/// linear).
-pub fn smooth(a: &mut [f64], neighbours: &[[u32; 4]]) {
-    for _ in 0..64 {
-        let mut changed = false;
-        for pass in 0..2 {
-            let order: Box<dyn Iterator<Item = usize>> = if pass == 0 {
-                Box::new(0..a.len())
-            } else {
-                Box::new((0..a.len()).rev())
-            };
-            for s in order {
-                for &nb in &neighbours[s] {
-                    if nb == u32::MAX {
-                        continue;
-                    }
-                    let lim = a[nb as usize] + MAX_A_STEP;
-                    if a[s] > lim + 1e-12 {
-                        a[s] = lim;
-                        changed = true;
-                    }
+/// a(s) = min over samples of cap + [`MAX_A_STEP`] per step between
+/// them. Lowers `a` in place from the samples `seeds` (those lowered
+/// since `a` was last spread; all of them the first time), each lowering
+/// passed on to the neighbours it lowers: a work list, so a second
+/// spread after a few caps fall costs only what they change.
+/// Returns the samples it lowered, the seeds among them.
+pub fn smooth(
+    a: &mut [f64],
+    neighbours: &[[u32; 4]],
+    seeds: impl IntoIterator<Item = usize>,
+) -> Vec<usize> {
+    let mut queued = vec![false; a.len()];
+    let mut work: std::collections::VecDeque<usize> = seeds
+        .into_iter()
+        .filter(|&s| !std::mem::replace(&mut queued[s], true))
+        .collect();
+    let mut changed: Vec<usize> = work.iter().copied().collect();
+    while let Some(s) = work.pop_front() {
+        queued[s] = false;
+        let lim = a[s] + MAX_A_STEP;
+        for &nb in &neighbours[s] {
+            if nb == u32::MAX {
+                continue;
+            }
+            let nb = nb as usize;
+            if a[nb] > lim + 1e-12 {
+                a[nb] = lim;
+                changed.push(nb);
+                if !queued[nb] {
+                    queued[nb] = true;
+                    work.push_back(nb);
                 }
             }
         }
-        if !changed {
-            break;
-        }
     }
+    changed
 }
 
 /// The largest a ∈ [0, 1] with |b + a · d| ≤ `limit`, given |b| ≤ limit.
@@ -753,7 +760,7 @@ mod tests {
                 ]
             })
             .collect();
-        smooth(&mut a, &nb);
+        smooth(&mut a, &nb, 0..10);
         let want = [0.8, 0.6, 0.4, 0.2, 0.0, 0.2, 0.4, 0.6, 0.8, 1.0];
         for (x, w) in a.iter().zip(want) {
             assert!((x - w).abs() < 1e-9, "{a:?}");
