@@ -75,7 +75,9 @@ export function decode(buf) {
     layer_height: next(Float32Array),
     clearance: next(Float32Array),
   };
-  return { ...head, surface: { positions, columns, moved, curves: head.curves }, path: { order, width, pass, top, beads } };
+  const kept = next(Float32Array);
+  const path = { order, width, pass, top, beads, texture_kept: kept.length ? kept : null };
+  return { ...head, surface: { positions, columns, moved, curves: head.curves }, path };
 }
 
 /**

@@ -298,6 +298,7 @@ export class View3D {
       }
       if (this.colourBy === 'pass') c = ramp((d.path.pass[i] - 1) / Math.max(1, K - 1));
       else if (this.colourBy === 'stage') c = top.has(i) ? [0.1, 0.1, 0.1] : d.path.pass[i] > lower ? [0.93, 0.45, 0.1] : [0.15, 0.4, 0.8];
+      else if (this.colourBy === 'texture') c = d.path.texture_kept ? margin(d.path.texture_kept[i]) : [0.6, 0.6, 0.6];
       else if (this.colourBy === 'width' || !m) c = ramp((d.path.width[i] - w0) / Math.max(1e-6, w1 - w0));
       else c = margin(m[this.colourBy]);
       if (this.outside(PP, i)) {
@@ -431,6 +432,11 @@ export class View3D {
     if (this.colourBy === 'overhang') return `overhang ${p.max_overhang_deg}° ${m} 0°${worst}${out}`;
     if (this.colourBy === 'layer') return `layer height outside ${p.layer_height}–${p.max_layer_height} mm ${m} within${worst}${out}`;
     if (this.colourBy === 'clearance') return `body clearance 0 ${m} ${p.nozzle_height} mm${worst}${out}`;
+    if (this.colourBy === 'texture') {
+      return this.data.path.texture_kept
+        ? `texture reduced to nothing ${m} kept whole (where the clay would not hold it: Corrections says why)${out}`
+        : `no texture${out}`;
+    }
     if (this.colourBy === 'pass') return `pass 1 <i style="background:${grad()}"></i> ${this.data.plan.passes}${out}`;
     if (this.colourBy === 'stage') {
       return this.data.plan.stages === 2

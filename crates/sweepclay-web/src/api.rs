@@ -66,6 +66,10 @@ pub struct PathView {
     /// How well each bead sits (overlap, overhang, layer height, the
     /// extruder body's clearance): the stability map.
     pub beads: sweepclay_core::beads::BeadMap,
+    /// How much of the texture each path point keeps, 0–1 (1 where it
+    /// is whole; empty without textures: docs/ALGORITHMS.md §11).
+    #[serde(skip_serializing_if = "Vec::is_empty")]
+    pub texture_kept: Vec<f32>,
 }
 
 /// The printer's box and body, for the preview's build volume.
@@ -173,7 +177,8 @@ impl SliceView {
     /// arrays, each a u32 count and its little-endian values, in this
     /// order: surface positions (f32), columns (u32), moved (u32), path
     /// order (u32), width (f32), pass (u32), top (u32), then the bead
-    /// map's overlap, overhang, layer height and clearance (f32).
+    /// map's overlap, overhang, layer height and clearance (f32), then
+    /// the texture kept per path point (f32; none without textures).
     pub fn to_binary(&self) -> Vec<u8> {
         let mut json = serde_json::to_vec(&serde_json::json!({
             "stats": self.stats,
@@ -198,7 +203,8 @@ impl SliceView {
             + s.moved.len()
             + 7 * p.order.len()
             + p.top.len()
-            + 11;
+            + p.texture_kept.len()
+            + 12;
         let mut out = Vec::with_capacity(8 + json.len() + 4 * words);
         out.extend_from_slice(b"SWCL");
         out.extend_from_slice(&(json.len() as u32).to_le_bytes());
@@ -225,6 +231,7 @@ impl SliceView {
             &p.beads.overhang_deg,
             &p.beads.layer_height,
             &p.beads.clearance,
+            &p.texture_kept,
         ] {
             floats(&mut out, v);
         }
@@ -245,15 +252,24 @@ pub fn slice_view(design: &Design, cancel: &Cancel) -> Result<SliceView, ApiErro
     cancel.check()?;
     let corrected = correct::correct(&sampled)?;
     cancel.check()?;
+    // The texture is not a correction: what the corrections moved is
+    // measured with it taken out.
+    let mut plain = corrected.surface.clone();
+    for (i, smp) in plain.samples.iter_mut().enumerate() {
+        if let (Some(k), Some(d)) = (corrected.kept.get(i), sampled.texture.get(i)) {
+            smp.xi -= k * d;
+        }
+    }
     let moved: Vec<u32> = sampled
         .samples
         .iter()
-        .zip(&corrected.surface.samples)
+        .zip(&plain.samples)
         .enumerate()
         .filter(|(_, (a, b))| (a.xi - b.xi).abs() > 0.05)
         .map(|(i, _)| i as u32)
         .collect();
-    let printed = printed_curves(&sampled, &corrected.surface);
+    let printed = printed_curves(&sampled, &plain);
+    drop(plain);
     drop(sampled);
     let sliced = sweepclay_core::finish_unchecked(corrected);
     // A print that leaves the build volume is still shown, with what lies
@@ -324,6 +340,17 @@ fn view(s: &Sliced, moved: Vec<u32>, slice_ms: f64, fit_error: Option<FitError>)
             surf.printer.nozzle_radius,
             surf.params.nozzle_height,
         ),
+        texture_kept: if s.corrected.kept.is_empty() {
+            Vec::new()
+        } else {
+            pts.iter()
+                .map(|p| {
+                    mesh::sample_of_point(surf, p)
+                        .and_then(|i| s.corrected.kept.get(i))
+                        .map_or(1.0, |&k| round2(k))
+                })
+                .collect()
+        },
     };
     let plan = &surf.plan;
     let mut warnings = Vec::new();
