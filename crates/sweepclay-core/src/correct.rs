@@ -404,11 +404,30 @@ fn keep_texture(s: &mut Surface, scale: &[f64]) -> (Vec<f64>, Vec<crate::texture
     // Each step of a column: (lower sample, upper sample, limit, twist
     // step, why).
     let mut steps = Vec::with_capacity(n);
+    // Where a vessel's spiral starts, its first beads are next to nothing
+    // high and the step up to them is sized by their width: a bead above
+    // widened by the texture would widen every bead under it (the
+    // extrusion's top-down walk) down to them. Near the start the texture
+    // keeps to steps the narrowest bead covers.
+    let m = s.columns.len();
+    let near_start = |c: usize| {
+        s.vessel.as_ref().is_some_and(|v| {
+            let from_start = (c + m - v.start) % m.max(1);
+            (from_start as f64) * s.spacing <= 2.0 * s.params.width_max
+        })
+    };
+    let narrow = s.params.width_min * (1.0 - s.params.overlap);
     for (c, col) in s.columns.iter().enumerate() {
         let r = col.samples();
+        let start = near_start(c);
         for i in r.start + 1..r.end {
             let (z0, z1) = (s.samples[i - 1].z, s.samples[i].z);
             let (lim, by_angle) = s.params.offset_limit(z1 - z0);
+            let (lim, by_angle) = if start && narrow < lim {
+                (narrow, false)
+            } else {
+                (lim, by_angle)
+            };
             // A textured bead runs across Ψ's direction (a rib's flank),
             // so a step along d overhangs a little more than the
             // untextured rule counts: a margin of TEXTURE_MARGIN.

@@ -670,7 +670,8 @@ mod tests {
                 n,
                 n,
                 n,
-                n
+                n,
+                0
             ]
         );
         // Spot-check values: the last position and the last pass.
@@ -683,6 +684,22 @@ mod tests {
         assert_eq!(last, v.surface.positions[3 * n - 1]);
         let (start, _) = arrays[5];
         assert_eq!(u32_at(start + 4 * (n - 1)) as u32, v.path.pass[n - 1]);
+        // A textured design sends the texture kept, a value a path point.
+        let v = slice_view(&design("ripple-vase"), &Cancel::new()).unwrap();
+        let b = v.to_binary();
+        let last_len = {
+            let json_len = u32::from_le_bytes(b[4..8].try_into().unwrap()) as usize;
+            let mut o = 8 + json_len;
+            let mut last = 0;
+            while o < b.len() {
+                last = u32::from_le_bytes(b[o..o + 4].try_into().unwrap()) as usize;
+                o += 4 + 4 * last;
+            }
+            last
+        };
+        assert_eq!(last_len, v.path.order.len());
+        assert!(v.path.texture_kept.iter().any(|&k| k < 1.0));
+        assert!(v.path.texture_kept.iter().filter(|&&k| k == 1.0).count() > last_len / 2);
     }
 
     #[test]

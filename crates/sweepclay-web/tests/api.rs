@@ -33,7 +33,10 @@ async fn page_and_assets_are_served() {
         .json()
         .await
         .unwrap();
-    assert_eq!(meta["examples"].as_array().unwrap().len(), 9);
+    assert_eq!(
+        meta["examples"].as_array().unwrap().len(),
+        sweepclay_core::examples::EXAMPLES.len()
+    );
     assert_eq!(meta["params"]["layer_height"], 1.25);
     assert_eq!(meta["presets"][0]["name"], "cerambot-plus");
 }
