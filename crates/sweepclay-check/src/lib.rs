@@ -211,6 +211,12 @@ pub struct ConfigError {
     pub reason: String,
 }
 
+/// The largest machine dimension a check accepts (mm): 100 m.
+pub const MAX_MACHINE_MM: f64 = 100_000.0;
+
+/// The largest bead, layer or tolerance a check accepts (mm).
+pub const MAX_BEAD_MM: f64 = 100.0;
+
 impl CheckConfig {
     /// Checks every value: finite, positive where it must be, fractions in
     /// [0, 1], angles in (0, 90). A NaN would silently turn every test it
@@ -281,6 +287,42 @@ impl CheckConfig {
                     self.max_overhang_deg
                 ),
             );
+        }
+        // A physical range for every value: a huge number (1e308) would
+        // switch a rule off as surely as NaN did.
+        let most = |v: &[f64; 3]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        for (field, v, hi) in [
+            ("build_volume", most(&self.build_volume), MAX_MACHINE_MM),
+            ("bed_min", most(&self.bed_min), MAX_MACHINE_MM),
+            (
+                "bed_diameter",
+                self.bed_diameter.unwrap_or(0.0),
+                MAX_MACHINE_MM,
+            ),
+            ("e_per_mm3", self.e_per_mm3, 10_000.0),
+            ("nozzle_height", self.nozzle_height, MAX_MACHINE_MM),
+            ("nozzle_radius", self.nozzle_radius, 1_000.0),
+            ("width_min", self.width_min, MAX_BEAD_MM),
+            ("width_max", self.width_max, MAX_BEAD_MM),
+            ("min_layer_mm", self.min_layer_mm, MAX_BEAD_MM),
+            ("first_layer_min_mm", self.first_layer_min_mm, MAX_BEAD_MM),
+            ("first_layer_max_mm", self.first_layer_max_mm, MAX_BEAD_MM),
+            ("max_gap_mm", self.max_gap_mm, MAX_BEAD_MM),
+            (
+                "collision_tolerance_mm",
+                self.collision_tolerance_mm,
+                MAX_BEAD_MM,
+            ),
+            ("overhang_tolerance_deg", self.overhang_tolerance_deg, 90.0),
+        ] {
+            if v > hi {
+                return err(
+                    field,
+                    format!(
+                        "must be at most {hi} (got {v}): no clay printer or bead is that large"
+                    ),
+                );
+            }
         }
         Ok(())
     }

@@ -364,6 +364,15 @@ fn slice(a: SliceArgs) -> Result<i32> {
     // correction loop; it becomes the output only if it passes (or with
     // --force).
     let out = output_target(&out)?;
+    // `slice t4.json -o t4.json` would replace the design by its G-code.
+    if let Ok(input) = std::fs::canonicalize(&a.design) {
+        if input == out {
+            bail!(
+                "-o {}: that is the design file itself; refusing to write the G-code over it",
+                out.display()
+            );
+        }
+    }
     let tmp = temp_beside(&out)?;
     let file = tmp
         .reopen()
@@ -640,14 +649,33 @@ fn output_target(path: &Path) -> Result<PathBuf> {
     }
 }
 
+/// The prefix of our temporary files: `.sweepclay-tmp-NAME.` and random
+/// letters, beside the file NAME they will replace.
+const TMP_PREFIX: &str = ".sweepclay-tmp-";
+
+/// A temporary file older than this (seconds) beside the output is a
+/// run's leftover (a kill -9 runs no clean-up) and is removed.
+const STALE_TMP_S: u64 = 600;
+
 /// An empty temporary file in the directory of `path`, to be renamed over
 /// it by [`persist`] (deleted if dropped or if the command is interrupted).
+/// It is named for `path`, so the next run finds a killed run's leftover
+/// and removes it (once it is [`STALE_TMP_S`] old, so a run still going
+/// keeps its own).
 fn temp_beside(path: &Path) -> Result<tempfile::NamedTempFile> {
     let dir = path
         .parent()
         .filter(|d| !d.as_os_str().is_empty())
         .unwrap_or(Path::new("."));
-    let tmp = tempfile::NamedTempFile::new_in(dir)
+    let name = path
+        .file_name()
+        .map(|n| n.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let prefix = format!("{TMP_PREFIX}{name}.");
+    remove_stale(dir, &prefix);
+    let tmp = tempfile::Builder::new()
+        .prefix(&prefix)
+        .tempfile_in(dir)
         .with_context(|| format!("creating a temporary file in {}", dir.display()))?;
     if let Ok(mut live) = LIVE.lock() {
         live.push(tmp.path().to_path_buf());
@@ -655,15 +683,38 @@ fn temp_beside(path: &Path) -> Result<tempfile::NamedTempFile> {
     Ok(tmp)
 }
 
-/// Makes a finished temporary file `path`: an ordinary file (temporary
-/// files are private, 0600), synced, then renamed, so a crash never leaves
-/// a half-written file.
+/// Removes our leftover temporary files for one output (`prefix`) in
+/// `dir` that are older than [`STALE_TMP_S`]; what cannot be removed is
+/// left.
+fn remove_stale(dir: &Path, prefix: &str) {
+    let Ok(entries) = std::fs::read_dir(dir) else {
+        return;
+    };
+    for e in entries.flatten() {
+        let old = e
+            .metadata()
+            .ok()
+            .filter(|m| m.is_file())
+            .and_then(|m| m.modified().ok())
+            .and_then(|t| t.elapsed().ok())
+            .is_some_and(|age| age.as_secs() >= STALE_TMP_S);
+        if old && e.file_name().to_string_lossy().starts_with(prefix) {
+            let _ = std::fs::remove_file(e.path());
+        }
+    }
+}
+
+/// Makes a finished temporary file `path`: an ordinary file with the mode
+/// of the file it replaces (0644 for a new one; temporary files are
+/// private, 0600), synced, then renamed, so a crash never leaves a
+/// half-written file.
 fn persist(tmp: tempfile::NamedTempFile, path: &Path) -> Result<()> {
     #[cfg(unix)]
     {
         use std::os::unix::fs::PermissionsExt;
+        let mode = std::fs::metadata(path).map_or(0o644, |m| m.permissions().mode() & 0o7777);
         tmp.as_file()
-            .set_permissions(std::fs::Permissions::from_mode(0o644))?;
+            .set_permissions(std::fs::Permissions::from_mode(mode))?;
     }
     tmp.as_file().sync_all()?;
     let name = tmp.path().to_path_buf();

@@ -300,6 +300,11 @@ fn check_reports_and_exit_codes() {
         ("--min-overlap", "1.5"),
         ("--max-overhang-deg", "inf"),
         ("--width-min", "-3"),
+        // Huge values switch rules off as NaN did: every flag has a
+        // physical range.
+        ("--width-max", "1e308"),
+        ("--nozzle-height", "1e308"),
+        ("--first-layer-max", "1e9"),
     ] {
         sweepclay(tmp.path())
             .args(["check", "bad.gcode", &format!("{flag}={value}")])
@@ -702,4 +707,77 @@ fn presets_from_published_definitions_print_lift_clear_and_keep_their_mode() {
             .success()
             .stdout(predicate::str::contains("PRINTABLE"));
     }
+}
+
+/// Issue 32's files: the design is never the output, the mode of a file
+/// replaced is kept, and a killed run's temporary file is found by its
+/// name and removed by the next run.
+#[cfg(unix)]
+#[test]
+fn outputs_keep_the_design_the_mode_and_no_leftovers() {
+    use std::os::unix::fs::PermissionsExt;
+    let tmp = tempfile::tempdir().unwrap();
+    examples(tmp.path());
+    let design = tmp.path().join("ex/t4.json");
+    let before = std::fs::read(&design).unwrap();
+    sweepclay(tmp.path())
+        .args(["slice", "ex/t4.json", "-o", "ex/t4.json"])
+        .assert()
+        .failure()
+        .stderr(predicate::str::contains("the design file itself"));
+    assert_eq!(
+        std::fs::read(&design).unwrap(),
+        before,
+        "the design was overwritten"
+    );
+    for mode in [0o600, 0o444] {
+        let out = tmp.path().join(format!("t4-{mode:o}.gcode"));
+        std::fs::write(&out, "old").unwrap();
+        std::fs::set_permissions(&out, std::fs::Permissions::from_mode(mode)).unwrap();
+        sweepclay(tmp.path())
+            .args(["slice", "ex/t4.json", "-o", out.to_str().unwrap()])
+            .assert()
+            .success();
+        let m = std::fs::metadata(&out).unwrap();
+        assert_eq!(
+            m.permissions().mode() & 0o777,
+            mode,
+            "mode of {}",
+            out.display()
+        );
+        assert!(m.len() > 1000);
+    }
+    // A leftover of a killed run (old) is removed; a fresh one (a run
+    // still writing) is left alone.
+    let stale = tmp.path().join(".sweepclay-tmp-t4.gcode.AbC123");
+    let fresh = tmp.path().join(".sweepclay-tmp-t4.gcode.XyZ789");
+    std::fs::write(&stale, vec![0u8; 1 << 20]).unwrap();
+    std::fs::write(&fresh, "x").unwrap();
+    let hour_ago = std::time::SystemTime::now() - std::time::Duration::from_secs(3600);
+    std::fs::File::options()
+        .write(true)
+        .open(&stale)
+        .unwrap()
+        .set_modified(hour_ago)
+        .unwrap();
+    sweepclay(tmp.path())
+        .args(["slice", "ex/t4.json", "-o", "t4.gcode"])
+        .assert()
+        .success();
+    assert!(!stale.exists(), "a killed run's leftover stayed");
+    assert!(
+        fresh.exists(),
+        "a running slice's temporary file was removed"
+    );
+    let ours: Vec<_> = std::fs::read_dir(tmp.path())
+        .unwrap()
+        .flatten()
+        .filter(|e| {
+            e.file_name()
+                .to_string_lossy()
+                .starts_with(".sweepclay-tmp-")
+                && e.path() != fresh
+        })
+        .collect();
+    assert!(ours.is_empty(), "temporary files left: {ours:?}");
 }

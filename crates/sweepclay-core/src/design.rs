@@ -191,6 +191,10 @@ impl Default for Params {
 /// of the carriage, on top of one layer (see `docs/ALGORITHMS.md`).
 pub const COLLISION_MARGIN_MM: f64 = 1.0;
 
+/// The longest design name (characters): it becomes a file name and a
+/// download's header.
+pub const MAX_NAME_CHARS: usize = 200;
+
 /// The thinnest layer (mm) `params.layer_height` may ask for.
 pub const MIN_LAYER: f64 = 0.5;
 
@@ -413,6 +417,13 @@ impl Design {
                     "format version {} is not supported (this build reads {FORMAT_VERSION})",
                     d.sweepclay
                 ),
+            ));
+        }
+        let chars = d.name.chars().count();
+        if chars > MAX_NAME_CHARS {
+            return Err(Error::invalid(
+                "name",
+                format!("is {chars} characters long; at most {MAX_NAME_CHARS} (it names the G-code file and heads it)"),
             ));
         }
         let mut d = d;

@@ -193,16 +193,19 @@ async fn meta(State(limits): State<Shared>) -> Response {
 }
 
 /// The request body as text, with size and encoding errors as JSON.
-fn text(body: Result<Bytes, BytesRejection>) -> Result<String, ApiError> {
-    let bytes = body.map_err(|e| {
+fn bytes(body: Result<Bytes, BytesRejection>) -> Result<Bytes, ApiError> {
+    body.map_err(|e| {
         let status = e.status().as_u16();
         if status == 413 {
             ApiError::new(413, "request body too large".to_string())
         } else {
             ApiError::new(status, e.body_text())
         }
-    })?;
-    String::from_utf8(bytes.to_vec())
+    })
+}
+
+fn text(body: Result<Bytes, BytesRejection>) -> Result<String, ApiError> {
+    String::from_utf8(bytes(body)?.to_vec())
         .map_err(|e| ApiError::new(400, format!("the body is not UTF-8 text: {e}")))
 }
 
@@ -384,7 +387,9 @@ async fn check(
         })?),
         None => None,
     };
-    let text = text(body)?;
+    // Bytes, not text: a comment in Latin-1 is no reason to refuse a
+    // file the CLI checks (the checker reads G-code as bytes).
+    let text = bytes(body)?;
     state
         .pool
         .run(move |cancel| {
@@ -392,15 +397,28 @@ async fn check(
             // its header names, any other for `generic` (as the CLI does).
             let cfg = match printer {
                 Some(p) => verify::printer_check(&p),
-                None => sweepclay_check::header::config_from_header(&text, &CheckConfig::default())
-                    .unwrap_or_else(|| CheckConfig {
-                        printer: "generic (assumed: pass ?printer=)".into(),
-                        ..CheckConfig::default()
-                    }),
+                None => {
+                    // The header is read as the CLI reads it (its first
+                    // 64 KB, bytes that are not UTF-8 replaced), and its
+                    // values validated exactly as flags are.
+                    let head = String::from_utf8_lossy(&text[..text.len().min(1 << 16)]);
+                    sweepclay_check::header::config_from_header(&head, &CheckConfig::default())
+                        .unwrap_or_else(|| CheckConfig {
+                            printer: "generic (assumed: pass ?printer=)".into(),
+                            ..CheckConfig::default()
+                        })
+                }
             };
+            cfg.validate().map_err(|e| {
+                ApiError::new(
+                    422,
+                    format!("the file's header: `{}`: {}", e.field, e.reason),
+                )
+                .with_key(e.field)
+            })?;
             let read = std::io::BufReader::with_capacity(
                 1 << 16,
-                guard::CancelReader(text.as_bytes(), cancel.clone()),
+                guard::CancelReader(&text[..], cancel.clone()),
             );
             sweepclay_check::check_reader(read, &cfg).map_err(|e| cancel.io_error("checking", e))
         })

@@ -235,7 +235,7 @@ async fn imports_and_checks() {
     let mut d = Design::from_json(examples::example("t4").unwrap()).unwrap();
     d.printer = sweepclay_core::PrinterRef::Preset("cerambot-mini".into());
     let ours = sweepclay_web::verify::verify(&sweepclay_core::slice(&d).unwrap(), 0.5).gcode;
-    let r = post(&format!("{base}/api/check"), ours).await;
+    let r = post(&format!("{base}/api/check"), ours.clone()).await;
     let v: Value = r.json().await.unwrap();
     assert_eq!(v["printable"], true, "{v}");
     assert!(
@@ -245,6 +245,39 @@ async fn imports_and_checks() {
             .starts_with("cerambot-mini (from the file's header)"),
         "{v}"
     );
+    // The header is trusted no more than a flag: a width_max of 0 (a
+    // panic, "min > max", once), NaN or 1e308 (rules switched off: 217
+    // collisions called printable) are refused by name, 422.
+    for bad in [
+        "width_max=0",
+        "width_max=NaN",
+        "nozzle_height=inf",
+        "width_max=1e308",
+    ] {
+        let key = bad.split('=').next().unwrap();
+        let file = ours.replacen(&format!("{key}="), &format!("{bad} {key}_was="), 1);
+        assert!(file.contains(bad), "{bad}");
+        let r = post(&format!("{base}/api/check"), file).await;
+        assert_eq!(r.status(), 422, "{bad}");
+        let v: Value = r.json().await.unwrap();
+        assert!(v["error"].as_str().unwrap().contains(key), "{v}");
+    }
+    // A design name has a cap (it heads the download): a 200 KB name is
+    // refused by name, not sent back as a 200 KB Content-Disposition.
+    let mut long: Value = serde_json::from_str(examples::example("t4").unwrap()).unwrap();
+    long["name"] = "n".repeat(200_000).into();
+    let r = post(&format!("{base}/api/gcode"), long.to_string()).await;
+    assert_eq!(r.status(), 422);
+    let v: Value = r.json().await.unwrap();
+    assert_eq!(v["key"], "name", "{v}");
+    // A comment in Latin-1 (a byte that is not UTF-8): a verdict, as the
+    // CLI gives, not 400.
+    let mut latin1 = b"; caf\xe9 pot\n".to_vec();
+    latin1.extend_from_slice(gcode.as_bytes());
+    let r = post(&format!("{base}/api/check?printer=generic"), latin1).await;
+    assert_eq!(r.status(), 200);
+    let v: Value = r.json().await.unwrap();
+    assert_eq!(v["printable"], false, "{v}");
     // A 60 MB line is one diagnostic, not 60 million words.
     let r = post(&format!("{base}/api/check"), "X".repeat(60 << 20)).await;
     assert_eq!(r.status(), 200);

@@ -775,10 +775,12 @@ async fn truthful_state_imports_printers_and_phones() {
     set_value(&c, "p-layer_height", "1,5").await;
     wait_js(
         &c,
-        "return window.sweepclay.design.params.layer_height === 1.5",
+        &format!("return {IDLE} && window.sweepclay.design.params.layer_height === 1.5"),
         "a layer height of 1,5 read as 1.5",
     )
     .await;
+    // (Once its slice is back: a good slice's answer clears the errors,
+    // and one arriving after the next field error would clear that too.)
     set_value(&c, "p-layer_height", "1,2,5").await;
     let err = error_text(&c, "the error for 1,2,5").await;
     assert!(err.as_str().unwrap().contains("not a number"), "{err}");
