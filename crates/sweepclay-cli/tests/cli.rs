@@ -557,7 +557,11 @@ fn an_interrupted_slice_leaves_no_temporary_file() {
         std::fs::read_dir(dir)
             .unwrap()
             .filter_map(|e| e.ok())
-            .filter(|e| e.file_name().to_string_lossy().starts_with(".tmp"))
+            .filter(|e| {
+                e.file_name()
+                    .to_string_lossy()
+                    .starts_with(".sweepclay-tmp-")
+            })
             .count()
     };
     while temporary(tmp.path()) == 0 && started.elapsed().as_secs() < 60 {

@@ -60,6 +60,17 @@ pub const MAX_SHAPES: usize = 20;
 /// memory on a hostile file.
 pub const MAX_SVG_NODES: u32 = 200_000;
 
+/// Deepest nesting of elements an imported SVG may have: drawings nest
+/// groups a few levels; the cap keeps the work a shape's ancestors cost
+/// (its transforms, whether it is in `<defs>`) bounded on a hostile file
+/// (100,000 nested `<g>` took 22 s).
+pub const MAX_SVG_DEPTH: usize = 100;
+
+/// Most points the flattening of an SVG's curves may give, over all its
+/// shapes: a curve is cut every 0.5 mm, so a huge `transform` scale made
+/// 48 KB of curves into gigabytes of points.
+pub const MAX_FLAT_POINTS: usize = 400_000;
+
 /// An SVG document parsed as drawing programs write it: a `<!DOCTYPE>`
 /// (Adobe Illustrator's standard export declares the SVG 1.1 DTD) is
 /// read; entities declared in it are refused by name, since expanding
@@ -118,7 +129,21 @@ pub fn svg_shapes_skipping(text: &str, max: usize) -> Result<(Vec<Shape>, Vec<St
             ),
         ));
     }
+    // Depth by one pass in document order (a node's parent comes first).
+    let mut depth = vec![0usize; doc.descendants().count() + 1];
+    for n in root.descendants().skip(1) {
+        let d = n.parent().map_or(0, |p| depth[p.id().get_usize()]) + 1;
+        if d > MAX_SVG_DEPTH {
+            return Err(Error::invalid(
+                "svg",
+                format!("its elements nest more than {MAX_SVG_DEPTH} deep (the cap of an import): flatten the groups"),
+            ));
+        }
+        depth[n.id().get_usize()] = d;
+    }
+    drop(depth);
     let mm_per_unit = unit_scale(&root)?;
+    let mut budget = MAX_FLAT_POINTS;
     let mut out = Vec::new();
     let mut skipped: Vec<(String, Error)> = Vec::new();
     let nodes = root
@@ -137,8 +162,10 @@ pub fn svg_shapes_skipping(text: &str, max: usize) -> Result<(Vec<Shape>, Vec<St
             Some(id) => format!("<{tag}> {id}"),
             None => format!("<{tag}>"),
         };
-        let parts = match shape_of(node, mm_per_unit) {
+        let parts = match shape_of(node, mm_per_unit, &mut budget) {
             Ok(parts) => parts,
+            // Over the cap, the file is refused whole: no point going on.
+            Err(e) if budget == 0 => return Err(e),
             Err(e) => {
                 skipped.push((name, e));
                 continue;
@@ -185,7 +212,11 @@ fn skipped_notes(skipped: Vec<(String, Error)>) -> Vec<String> {
 
 /// One element's shapes in mm (y up, not yet centred): a `<path>`'s
 /// sub-paths, or the one shape of the others, each with whether it closes.
-fn shape_of(node: roxmltree::Node, mm_per_unit: f64) -> Result<Vec<(Vec<[f64; 2]>, bool)>> {
+fn shape_of(
+    node: roxmltree::Node,
+    mm_per_unit: f64,
+    budget: &mut usize,
+) -> Result<Vec<(Vec<[f64; 2]>, bool)>> {
     let tag = node.tag_name().name();
     // Accumulated transform, outermost first.
     let mut ts = Transform::default();
@@ -223,7 +254,7 @@ fn shape_of(node: roxmltree::Node, mm_per_unit: f64) -> Result<Vec<(Vec<[f64; 2]
             Ok(0.0)
         }
     };
-    let ellipse = |cx: f64, cy: f64, rx: f64, ry: f64| -> Result<Vec<[f64; 2]>> {
+    let mut ellipse = |cx: f64, cy: f64, rx: f64, ry: f64| -> Result<Vec<[f64; 2]>> {
         if !(rx > 0.0 && ry > 0.0 && rx.is_finite() && ry.is_finite()) {
             return Err(Error::invalid(
                 format!("svg <{tag}>"),
@@ -232,6 +263,7 @@ fn shape_of(node: roxmltree::Node, mm_per_unit: f64) -> Result<Vec<(Vec<[f64; 2]
         }
         let around = std::f64::consts::TAU * rx.max(ry);
         let n = ((around / step).ceil() as usize).clamp(16, 4 * MAX_POINTS);
+        spend(budget, n)?;
         Ok((0..n)
             .map(|i| {
                 let a = std::f64::consts::TAU * i as f64 / n as f64;
@@ -240,7 +272,7 @@ fn shape_of(node: roxmltree::Node, mm_per_unit: f64) -> Result<Vec<(Vec<[f64; 2]
             .collect())
     };
     let parts: Vec<(Vec<[f64; 2]>, bool)> = match tag {
-        "path" => flatten_path(attr("d")?, step)?,
+        "path" => flatten_path(attr("d")?, step, budget)?,
         "line" => vec![(
             vec![[num("x1")?, num("y1")?], [num("x2")?, num("y2")?]],
             false,
@@ -508,7 +540,21 @@ fn unit_scale(root: &roxmltree::Node) -> Result<f64> {
 
 /// Each sub-path of `d` flattened, and whether it closes (a `Z`, or an
 /// end on its start). A sub-path of one point (a bare move) is skipped.
-fn flatten_path(d: &str, step: f64) -> Result<Vec<(Vec<[f64; 2]>, bool)>> {
+/// Takes `n` points from the import's flattening budget, or refuses the
+/// file naming the cap (the budget is then 0).
+fn spend(budget: &mut usize, n: usize) -> Result<()> {
+    if n > *budget {
+        *budget = 0;
+        return Err(Error::invalid(
+            "svg",
+            format!("its curves flatten to more than {MAX_FLAT_POINTS} points at 0.5 mm (the cap of an import): the drawing is too large or scaled too far up"),
+        ));
+    }
+    *budget -= n;
+    Ok(())
+}
+
+fn flatten_path(d: &str, step: f64, budget: &mut usize) -> Result<Vec<(Vec<[f64; 2]>, bool)>> {
     let mut out = Vec::new();
     let mut closed = false;
     let mut pts: Vec<[f64; 2]> = Vec::new();
@@ -525,6 +571,7 @@ fn flatten_path(d: &str, step: f64) -> Result<Vec<(Vec<[f64; 2]>, bool)>> {
                 pts.push(cur);
             }
             SimplePathSegment::LineTo { x, y } => {
+                spend(budget, 1)?;
                 cur = [x, y];
                 pts.push(cur);
             }
@@ -545,6 +592,7 @@ fn flatten_path(d: &str, step: f64) -> Result<Vec<(Vec<[f64; 2]>, bool)>> {
             } => {
                 let (p0, p1, p2, p3) = (cur, [x1, y1], [x2, y2], [x, y]);
                 let n = pieces(&[p0, p1, p2, p3], step);
+                spend(budget, n)?;
                 for i in 1..=n {
                     let t = i as f64 / n as f64;
                     let s = 1.0 - t;
@@ -559,6 +607,7 @@ fn flatten_path(d: &str, step: f64) -> Result<Vec<(Vec<[f64; 2]>, bool)>> {
             SimplePathSegment::Quadratic { x1, y1, x, y } => {
                 let (p0, p1, p2) = (cur, [x1, y1], [x, y]);
                 let n = pieces(&[p0, p1, p2], step);
+                spend(budget, n)?;
                 for i in 1..=n {
                     let t = i as f64 / n as f64;
                     let s = 1.0 - t;

@@ -526,3 +526,43 @@ async fn connections_beyond_the_cap_wait_for_a_place() {
     assert!(served.contains("200"), "{served}");
     drop(b);
 }
+
+/// Issue 32: an SVG import's work is bounded by its input, with the caps
+/// named: 100,000 nested groups (22 s once) and 48 KB of curves scaled a
+/// million times up (1.87 GB once; 120 KB aborted the server) are refused
+/// at once, and the server answers the next request.
+#[tokio::test]
+async fn hostile_svg_imports_are_refused_by_their_caps() {
+    let base = server(Limits::default()).await;
+    let t0 = std::time::Instant::now();
+    let deep = format!(
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm" viewBox="0 0 100 100">{}<path d="M0 0 L10 10"/>{}</svg>"#,
+        "<g>".repeat(100_000),
+        "</g>".repeat(100_000)
+    );
+    let r = post(&format!("{base}/api/import/svg"), deep).await;
+    assert_eq!(r.status(), 422);
+    let v: Value = r.json().await.unwrap();
+    assert!(
+        v["error"].as_str().unwrap().contains("nest more than 100"),
+        "{v}"
+    );
+    let curve = "C 10 90 90 90 100 0 ".repeat(2_500);
+    let scaled = format!(
+        r#"<svg xmlns="http://www.w3.org/2000/svg" width="100mm" height="100mm" viewBox="0 0 100 100"><g transform="scale(1000000)"><path d="M0 0 {curve}"/></g></svg>"#
+    );
+    assert!(scaled.len() > 48_000);
+    let r = post(&format!("{base}/api/import/svg"), scaled).await;
+    assert_eq!(r.status(), 422);
+    let v: Value = r.json().await.unwrap();
+    assert!(
+        v["error"]
+            .as_str()
+            .unwrap()
+            .contains("more than 400000 points"),
+        "{v}"
+    );
+    assert!(t0.elapsed().as_secs() < 20, "{:?}", t0.elapsed());
+    let r = reqwest::get(format!("{base}/api/meta")).await.unwrap();
+    assert_eq!(r.status(), 200);
+}
