@@ -82,6 +82,47 @@ struct ServeArgs {
     /// Most connections open at once (more wait to be accepted).
     #[arg(long, default_value_t = 256)]
     max_connections: usize,
+    /// Another name the server answers to in Host, besides loopback, the
+    /// address given and (with 0.0.0.0) the machine's own names and any IP
+    /// address (repeatable): what keeps other sites' pages out.
+    #[arg(long = "allow-host", value_name = "NAME")]
+    allow_hosts: Vec<String>,
+    /// A secret the page must carry to use the API; with --host 0.0.0.0
+    /// one is made up and printed in the link unless given.
+    #[arg(long)]
+    token: Option<String>,
+}
+
+/// The machine's own names: its host name and that name in `.local`
+/// (mDNS), as the studio's other machines reach it.
+fn own_names() -> Vec<String> {
+    let name = std::fs::read_to_string("/proc/sys/kernel/hostname")
+        .or_else(|_| std::fs::read_to_string("/etc/hostname"))
+        .map(|n| n.trim().to_string())
+        .unwrap_or_default();
+    if name.is_empty() || name.len() > 253 {
+        return Vec::new();
+    }
+    let local = format!("{name}.local");
+    vec![name, local]
+}
+
+/// 128 random bits as hex, from the standard library's per-process
+/// random hash keys (no extra crate for one secret).
+fn random_token() -> String {
+    use std::hash::{BuildHasher, Hasher};
+    (0..2)
+        .map(|i| {
+            let mut h = std::collections::hash_map::RandomState::new().build_hasher();
+            h.write_u64(i);
+            h.write_u128(
+                std::time::SystemTime::now()
+                    .duration_since(std::time::UNIX_EPOCH)
+                    .map_or(0, |d| d.as_nanos()),
+            );
+            format!("{:016x}", h.finish())
+        })
+        .collect()
 }
 
 #[derive(Args, Debug)]
@@ -536,10 +577,26 @@ fn serve(a: ServeArgs) -> Result<i32> {
         } else {
             addr.ip().to_string()
         };
-        say!(
-            "sweepclay modeler: http://{host}:{}/  (Ctrl+C to stop)",
-            addr.port()
-        );
+        let lan = addr.ip().is_unspecified();
+        let token = a.token.clone().or_else(|| lan.then(random_token));
+        if token.as_ref().is_some_and(|t| {
+            t.is_empty()
+                || !t
+                    .chars()
+                    .all(|c| c.is_ascii_alphanumeric() || c == '-' || c == '_')
+        }) {
+            bail!("--token: letters, digits, - and _ only, not empty");
+        }
+        let link = |h: &str| match &token {
+            Some(t) => format!("http://{h}:{}/?token={t}", addr.port()),
+            None => format!("http://{h}:{}/", addr.port()),
+        };
+        say!("sweepclay modeler: {}  (Ctrl+C to stop)", link(&host));
+        if lan {
+            for name in own_names().iter().take(1) {
+                say!("  from the studio's other machines: {}", link(name));
+            }
+        }
         let defaults = sweepclay_web::api::Limits::default();
         let mut limits = sweepclay_web::api::Limits {
             max_samples: a.max_samples as f64,
@@ -551,13 +608,22 @@ fn serve(a: ServeArgs) -> Result<i32> {
             },
             ..defaults
         };
-        // Bound to every interface on purpose: any Host; else the names of
-        // loopback and the address given.
-        if addr.ip().is_unspecified() {
-            limits.hosts.clear();
-        } else if !limits.hosts.iter().any(|h| h == &a.host) {
-            limits.hosts.push(a.host.clone());
+        // Loopback's names, the address given, --allow-host; bound to every
+        // interface on purpose (LAN mode), also the machine's names and any
+        // IP address — never any name, which let DNS rebinding in.
+        let mut names = a.allow_hosts.clone();
+        if lan {
+            names.extend(own_names());
+        } else {
+            names.push(a.host.clone());
         }
+        for n in names {
+            if !limits.hosts.iter().any(|h| h.eq_ignore_ascii_case(&n)) {
+                limits.hosts.push(n);
+            }
+        }
+        limits.lan = lan;
+        limits.token = token;
         sweepclay_web::run(listener, limits).await?;
         Ok(0)
     })

@@ -785,3 +785,48 @@ fn outputs_keep_the_design_the_mode_and_no_leftovers() {
         .collect();
     assert!(ours.is_empty(), "temporary files left: {ours:?}");
 }
+
+/// `serve --host 0.0.0.0` (LAN mode) prints a link with a token, answers
+/// the link, and refuses the API without the token and a page of another
+/// name (DNS rebinding) with it.
+#[test]
+fn lan_mode_prints_a_token_and_keeps_strangers_out() {
+    use std::io::{BufRead, Read, Write};
+    let child = std::process::Command::new(assert_cmd::cargo::cargo_bin("sweepclay"))
+        .args(["serve", "--host", "0.0.0.0", "--port", "0"])
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut server = Server(child);
+    let mut line = String::new();
+    std::io::BufReader::new(server.0.stdout.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    let url = line
+        .split_whitespace()
+        .find(|w| w.starts_with("http://127.0.0.1:"))
+        .unwrap_or_else(|| panic!("no URL in {line:?}"));
+    let (addr, token) = url
+        .trim_start_matches("http://")
+        .split_once("/?token=")
+        .unwrap_or_else(|| panic!("no token in {line:?}"));
+    assert!(token.len() >= 32, "{token}");
+    let get = |host: &str, path: &str, extra: &str| {
+        let mut s = std::net::TcpStream::connect(addr).unwrap();
+        write!(
+            s,
+            "GET {path} HTTP/1.1\r\nHost: {host}\r\n{extra}Connection: close\r\n\r\n"
+        )
+        .unwrap();
+        let mut out = String::new();
+        let _ = s.read_to_string(&mut out);
+        out
+    };
+    let page = get(addr, &format!("/?token={token}"), "");
+    assert!(page.starts_with("HTTP/1.1 200"), "{page}");
+    assert!(page.contains(&format!("sweepclay_token={token}")), "{page}");
+    assert!(get(addr, "/api/meta", "").starts_with("HTTP/1.1 401"));
+    let cookie = format!("Cookie: sweepclay_token={token}\r\n");
+    assert!(get(addr, "/api/meta", &cookie).starts_with("HTTP/1.1 200"));
+    assert!(get("evil.example", "/api/meta", &cookie).starts_with("HTTP/1.1 421"));
+}

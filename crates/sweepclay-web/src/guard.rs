@@ -12,7 +12,7 @@
 
 use crate::error::ApiError;
 use axum::extract::Request;
-use axum::http::{header, HeaderValue, Method};
+use axum::http::{header, HeaderName, HeaderValue, Method};
 use axum::middleware::Next;
 use axum::response::{IntoResponse, Response};
 use std::sync::atomic::{AtomicUsize, Ordering};
@@ -35,8 +35,18 @@ pub struct Limits {
     pub request_timeout: std::time::Duration,
     /// The names the server answers to in `Host` (with any port):
     /// `127.0.0.1`, `localhost`, `[::1]` and the address it was started
-    /// on. Empty: any (a server bound to every interface, on purpose).
+    /// on; in LAN mode also the machine's names and `--allow-host`.
+    /// Never empty in practice: a DNS-rebinding page's requests carry its
+    /// own name, which no list holds (docs/MODELER.md, "LAN mode").
     pub hosts: Vec<String>,
+    /// LAN mode (bound to every interface): any IP address is also a
+    /// name the server answers to (a rebinding page cannot send one as
+    /// its Host: it would be that page's own origin).
+    pub lan: bool,
+    /// A secret the page must carry to use the API (its cookie, set when
+    /// the page is opened with `?token=…`, or the header
+    /// `x-sweepclay-token`); `None`: no token.
+    pub token: Option<String>,
     /// Connections open at once and their idle timeout (default 256 and
     /// the request timeout plus a minute, so a slice in flight is never
     /// cut).
@@ -58,6 +68,8 @@ impl Default for Limits {
             hosts: ["127.0.0.1", "localhost", "[::1]"]
                 .map(String::from)
                 .to_vec(),
+            lan: false,
+            token: None,
         }
     }
 }
@@ -234,16 +246,30 @@ fn host_name(v: &str) -> &str {
 /// a body larger than the route's limit before it is read; every answer
 /// carries `nosniff` and a policy that no other page may frame this one.
 pub async fn same_origin(
-    hosts: Arc<Vec<String>>,
+    who: Arc<Admission>,
     body_limit: usize,
     req: Request,
     next: Next,
 ) -> Response {
-    let mut res = match refusal(&hosts, body_limit, &req) {
+    // The page opened with the right `?token=…` gets it as a cookie, which
+    // its every request then carries (the slice worker's too).
+    let set_cookie = who.token.as_ref().filter(|t| {
+        req.uri().path() == "/"
+            && req.uri().query().is_some_and(|q| {
+                q.split('&')
+                    .any(|kv| kv.strip_prefix("token=") == Some(t.as_str()))
+            })
+    });
+    let cookie =
+        set_cookie.map(|t| format!("{TOKEN_COOKIE}={t}; Path=/; HttpOnly; SameSite=Strict"));
+    let mut res = match refusal(&who, body_limit, &req) {
         Some(e) => e.into_response(),
         None => next.run(req).await,
     };
     let headers = res.headers_mut();
+    if let Some(c) = cookie.and_then(|c| HeaderValue::from_str(&c).ok()) {
+        headers.insert(header::SET_COOKIE, c);
+    }
     headers.insert(
         header::X_CONTENT_TYPE_OPTIONS,
         HeaderValue::from_static("nosniff"),
@@ -256,23 +282,83 @@ pub async fn same_origin(
     res
 }
 
+/// Who may use the server: the names it answers to, LAN mode, a token.
+#[derive(Clone, Debug, Default)]
+pub struct Admission {
+    /// See [`Limits::hosts`].
+    pub hosts: Vec<String>,
+    /// See [`Limits::lan`].
+    pub lan: bool,
+    /// See [`Limits::token`].
+    pub token: Option<String>,
+}
+
+impl Admission {
+    /// The admission rules of `limits`.
+    pub fn of(limits: &Limits) -> Admission {
+        Admission {
+            hosts: limits.hosts.clone(),
+            lan: limits.lan,
+            token: limits.token.clone(),
+        }
+    }
+}
+
+/// The cookie that carries the token.
+pub const TOKEN_COOKIE: &str = "sweepclay_token";
+
+/// Whether `name` (a Host without its port) is an IP address literal.
+fn is_ip(name: &str) -> bool {
+    name.parse::<std::net::Ipv4Addr>().is_ok()
+        || name
+            .strip_prefix('[')
+            .and_then(|n| n.strip_suffix(']'))
+            .is_some_and(|n| n.parse::<std::net::Ipv6Addr>().is_ok())
+}
+
 /// Why `req` is refused, if it is.
-fn refusal(hosts: &[String], body_limit: usize, req: &Request) -> Option<ApiError> {
+fn refusal(who: &Admission, body_limit: usize, req: &Request) -> Option<ApiError> {
+    let hosts = &who.hosts;
     let h = req.headers();
     let text = |name| h.get(name).and_then(|v: &HeaderValue| v.to_str().ok());
     let host = text(header::HOST).unwrap_or("");
-    if !hosts.is_empty()
-        && !hosts
-            .iter()
-            .any(|a| a.eq_ignore_ascii_case(host_name(host)))
-    {
+    let name = host_name(host);
+    let known = hosts.iter().any(|a| a.eq_ignore_ascii_case(name)) || (who.lan && is_ip(name));
+    if !hosts.is_empty() && !known {
         return Some(ApiError::new(
             421,
             format!(
-                "this server answers for {} only, not for Host `{host}`",
-                hosts.join(", ")
+                "this server answers for {}{} only, not for Host `{host}` (start it with --allow-host {name} to add that name)",
+                hosts.join(", "),
+                if who.lan { " and its IP addresses" } else { "" }
             ),
         ));
+    }
+    if let Some(t) = &who.token {
+        let path = req.uri().path();
+        let carried = h
+            .get_all(header::COOKIE)
+            .iter()
+            .filter_map(|v| v.to_str().ok())
+            .flat_map(|v| v.split(';'))
+            .any(|kv| {
+                kv.trim()
+                    .strip_prefix(TOKEN_COOKIE)
+                    .and_then(|r| r.strip_prefix('='))
+                    == Some(t.as_str())
+            })
+            || text(HeaderName::from_static("x-sweepclay-token")) == Some(t.as_str())
+            || (path == "/"
+                && req.uri().query().is_some_and(|q| {
+                    q.split('&')
+                        .any(|kv| kv.strip_prefix("token=") == Some(t.as_str()))
+                }));
+        if !carried && !path.starts_with("/assets/") {
+            return Some(ApiError::new(
+                401,
+                "this server needs its token: open the link it printed when it started (…/?token=…)",
+            ));
+        }
     }
     if let Some(origin) = text(header::ORIGIN) {
         let own = ["http://", "https://"].iter().any(|s| {

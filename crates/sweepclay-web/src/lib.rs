@@ -132,14 +132,14 @@ pub fn router(limits: Limits) -> Router {
     let check_route = Router::new()
         .route("/api/check", post(check))
         .layer(DefaultBodyLimit::max(GCODE_BODY_LIMIT));
-    let hosts = Arc::new(limits.hosts.clone());
+    let who = Arc::new(guard::Admission::of(&limits));
     let guard = axum::middleware::from_fn(move |req: axum::extract::Request, next| {
         let body_limit = if req.uri().path() == "/api/check" {
             GCODE_BODY_LIMIT
         } else {
             DESIGN_BODY_LIMIT
         };
-        guard::same_origin(hosts.clone(), body_limit, req, next)
+        guard::same_origin(who.clone(), body_limit, req, next)
     });
     let state = Arc::new(AppState {
         pool: guard::Pool::new(&limits),

@@ -566,3 +566,76 @@ async fn hostile_svg_imports_are_refused_by_their_caps() {
     let r = reqwest::get(format!("{base}/api/meta")).await.unwrap();
     assert_eq!(r.status(), 200);
 }
+
+/// Issue 32's LAN mode (`--host 0.0.0.0`): the Host check stays on (the
+/// machine's names, any IP address, `--allow-host`), so a page on another
+/// site that rebinds its name to the studio machine is refused; and the
+/// API wants the token the server printed, which the page opened with
+/// `?token=…` keeps as a cookie.
+#[tokio::test]
+async fn lan_mode_keeps_other_sites_out_and_wants_the_token() {
+    let mut limits = Limits {
+        lan: true,
+        token: Some("tok123".into()),
+        ..Limits::default()
+    };
+    limits.hosts.push("studio.local".into());
+    let base = server(limits).await;
+    let get = |path: &str, host: &str, extra: &str| {
+        format!("GET {path} HTTP/1.1\r\nHost: {host}\r\n{extra}Connection: close\r\n\r\n")
+    };
+    // DNS rebinding: the page's own name as Host.
+    let r = raw(
+        &base,
+        &get(
+            "/api/meta",
+            "evil.example",
+            "Cookie: sweepclay_token=tok123\r\n",
+        ),
+    )
+    .await;
+    assert!(r.starts_with("HTTP/1.1 421"), "{r}");
+    // An IP address or the machine's name is let in, but not without the
+    // token.
+    for host in ["192.168.1.5:8080", "[fe80::1]:8080", "studio.local:8080"] {
+        let r = raw(&base, &get("/api/meta", host, "")).await;
+        assert!(r.starts_with("HTTP/1.1 401"), "{host}: {r}");
+        assert!(r.contains("token"), "{r}");
+    }
+    let r = raw(&base, &get("/", "192.168.1.5:8080", "")).await;
+    assert!(r.starts_with("HTTP/1.1 401"), "{r}");
+    // The printed link: the page, and the token as a cookie.
+    let r = raw(&base, &get("/?token=tok123", "192.168.1.5:8080", "")).await;
+    assert!(r.starts_with("HTTP/1.1 200"), "{r}");
+    assert!(
+        r.to_ascii_lowercase()
+            .contains("set-cookie: sweepclay_token=tok123; path=/; httponly; samesite=strict"),
+        "{r}"
+    );
+    let r = raw(&base, &get("/?token=wrong", "192.168.1.5:8080", "")).await;
+    assert!(r.starts_with("HTTP/1.1 401"), "{r}");
+    // With the cookie (or the header), the API answers.
+    let r = raw(
+        &base,
+        &get(
+            "/api/meta",
+            "192.168.1.5:8080",
+            "Cookie: a=b; sweepclay_token=tok123\r\n",
+        ),
+    )
+    .await;
+    assert!(r.starts_with("HTTP/1.1 200"), "{r}");
+    let r = raw(
+        &base,
+        &get(
+            "/api/meta",
+            "192.168.1.5:8080",
+            "x-sweepclay-token: tok123\r\n",
+        ),
+    )
+    .await;
+    assert!(r.starts_with("HTTP/1.1 200"), "{r}");
+    // The page's scripts and styles need no token.
+    let r = raw(&base, &get("/assets/app.js", "192.168.1.5:8080", "")).await;
+    assert!(r.starts_with("HTTP/1.1 200"), "{r}");
+}
