@@ -47,6 +47,11 @@ pub struct Limits {
     /// the page is opened with `?token=…`, or the header
     /// `x-sweepclay-token`); `None`: no token.
     pub token: Option<String>,
+    /// Most bytes of request bodies held at once, received or being
+    /// worked on (default [`BODY_BUDGET`]): each POST reserves its
+    /// `Content-Length` (its route's limit when it gives none) before any
+    /// of it is read, and frees it with its answer; past the budget, 503.
+    pub body_budget: usize,
     /// Connections open at once and their idle timeout (default 256 and
     /// the request timeout plus a minute, so a slice in flight is never
     /// cut).
@@ -70,6 +75,7 @@ impl Default for Limits {
                 .to_vec(),
             lan: false,
             token: None,
+            body_budget: BODY_BUDGET,
         }
     }
 }
@@ -264,7 +270,11 @@ pub async fn same_origin(
         set_cookie.map(|t| format!("{TOKEN_COOKIE}={t}; Path=/; HttpOnly; SameSite=Strict"));
     let mut res = match refusal(&who, body_limit, &req) {
         Some(e) => e.into_response(),
-        None => next.run(req).await,
+        None => match reserve_body(&who, body_limit, &req) {
+            // Held until the answer is made: the body and the work on it.
+            Ok(_held) => next.run(req).await,
+            Err(e) => e.into_response(),
+        },
     };
     let headers = res.headers_mut();
     if let Some(c) = cookie.and_then(|c| HeaderValue::from_str(&c).ok()) {
@@ -282,9 +292,18 @@ pub async fn same_origin(
     res
 }
 
-/// Who may use the server: the names it answers to, LAN mode, a token.
+/// The memory request bodies may hold at once by default: 512 MiB
+/// (docs/MODELER.md, "Memory budget").
+pub const BODY_BUDGET: usize = 512 << 20;
+
+/// Who may use the server: the names it answers to, LAN mode, a token,
+/// and the bodies' memory budget (in KiB permits).
 #[derive(Clone, Debug, Default)]
 pub struct Admission {
+    /// The budget of body memory, one permit a KiB.
+    pub bodies: Option<Arc<Semaphore>>,
+    /// That budget, in MiB (for the refusal's words).
+    pub budget_mib: usize,
     /// See [`Limits::hosts`].
     pub hosts: Vec<String>,
     /// See [`Limits::lan`].
@@ -297,6 +316,8 @@ impl Admission {
     /// The admission rules of `limits`.
     pub fn of(limits: &Limits) -> Admission {
         Admission {
+            bodies: Some(Arc::new(Semaphore::new(limits.body_budget >> 10))),
+            budget_mib: limits.body_budget >> 20,
             hosts: limits.hosts.clone(),
             lan: limits.lan,
             token: limits.token.clone(),
@@ -314,6 +335,38 @@ fn is_ip(name: &str) -> bool {
             .strip_prefix('[')
             .and_then(|n| n.strip_suffix(']'))
             .is_some_and(|n| n.parse::<std::net::Ipv6Addr>().is_ok())
+}
+
+/// Reserves a POST's body in the memory budget before it is read (its
+/// `Content-Length`, or its route's limit when it gives none), or refuses
+/// it with 503 and `Retry-After` when the bodies in flight hold the
+/// budget already.
+fn reserve_body(
+    who: &Admission,
+    body_limit: usize,
+    req: &Request,
+) -> Result<Option<tokio::sync::OwnedSemaphorePermit>, ApiError> {
+    let Some(bodies) = who.bodies.as_ref().filter(|_| req.method() == Method::POST) else {
+        return Ok(None);
+    };
+    let length = req
+        .headers()
+        .get(header::CONTENT_LENGTH)
+        .and_then(|v| v.to_str().ok())
+        .and_then(|v| v.parse::<usize>().ok())
+        .unwrap_or(body_limit)
+        .min(body_limit);
+    let kib = u32::try_from(length.div_ceil(1024).max(1)).unwrap_or(u32::MAX);
+    bodies.clone().try_acquire_many_owned(kib).map(Some).map_err(|_| {
+        ApiError::new(
+            503,
+            format!(
+                "the server is holding as much request data as its memory budget allows ({} MiB); try again in a moment",
+                who.budget_mib
+            ),
+        )
+        .retry_after(2)
+    })
 }
 
 /// Why `req` is refused, if it is.

@@ -639,3 +639,46 @@ async fn lan_mode_keeps_other_sites_out_and_wants_the_token() {
     let r = raw(&base, &get("/assets/app.js", "192.168.1.5:8080", "")).await;
     assert!(r.starts_with("HTTP/1.1 200"), "{r}");
 }
+
+/// Issue 32's memory budget: request bodies reserve their size before any
+/// of them is read, so stalled uploads (20 of 60 MB held 1.34 GB once)
+/// hold at most the budget; past it a request gets 503 with Retry-After,
+/// and once they close, the budget is free again.
+#[tokio::test]
+async fn stalled_uploads_hold_no_more_than_the_body_budget() {
+    let base = server(Limits {
+        body_budget: 10 << 20,
+        ..Limits::default()
+    })
+    .await;
+    let addr = base.trim_start_matches("http://").to_string();
+    let stall = |addr: String| {
+        use std::io::Write;
+        let mut s = std::net::TcpStream::connect(addr.clone()).unwrap();
+        write!(
+            s,
+            "POST /api/slice HTTP/1.1\r\nHost: {addr}\r\nContent-Type: application/json\r\nContent-Length: {}\r\n\r\n{{\"sweep",
+            4 << 20
+        )
+        .unwrap();
+        s
+    };
+    let held: Vec<std::net::TcpStream> = (0..2).map(|_| stall(addr.clone())).collect();
+    tokio::time::sleep(std::time::Duration::from_millis(300)).await;
+    let r = raw(
+        &base,
+        &format!("POST /api/slice HTTP/1.1\r\nHost: {addr}\r\nContent-Type: application/json\r\nContent-Length: {}\r\nConnection: close\r\n\r\n", 4 << 20),
+    )
+    .await;
+    assert!(r.starts_with("HTTP/1.1 503"), "{r}");
+    assert!(r.to_ascii_lowercase().contains("retry-after: 2"), "{r}");
+    assert!(r.contains("memory budget"), "{r}");
+    drop(held);
+    tokio::time::sleep(std::time::Duration::from_millis(300)).await;
+    let r = post(
+        &format!("{base}/api/slice"),
+        sweepclay_core::examples::example("t4").unwrap(),
+    )
+    .await;
+    assert_eq!(r.status(), 200);
+}
