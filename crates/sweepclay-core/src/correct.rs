@@ -417,12 +417,20 @@ fn keep_texture(s: &mut Surface, scale: &[f64]) -> (Vec<f64>, Vec<crate::texture
         })
     };
     let narrow = s.params.width_min * (1.0 - s.params.overlap);
+    // `Params::offset_limit`, its tangent taken once.
+    let tan = s.params.max_overhang_deg.to_radians().tan();
+    let by_width = s.params.width_max * (1.0 - s.params.overlap);
     for (c, col) in s.columns.iter().enumerate() {
         let r = col.samples();
         let start = near_start(c);
         for i in r.start + 1..r.end {
             let (z0, z1) = (s.samples[i - 1].z, s.samples[i].z);
-            let (lim, by_angle) = s.params.offset_limit(z1 - z0);
+            let by_angle = (z1 - z0) * tan;
+            let (lim, by_angle) = if by_angle <= by_width {
+                (by_angle, true)
+            } else {
+                (by_width, false)
+            };
             let (lim, by_angle) = if start && narrow < lim {
                 (narrow, false)
             } else {
@@ -460,8 +468,10 @@ fn keep_texture(s: &mut Surface, scale: &[f64]) -> (Vec<f64>, Vec<crate::texture
             lower(&mut caps, &mut why, b1, 0.0, "overhang");
         }
     }
+    // Only a capped sample can lower another.
     let mut a = caps.clone();
-    smooth(&mut a, &nb, 0..n);
+    let capped: Vec<usize> = (0..n).filter(|&i| caps[i] < 1.0).collect();
+    smooth(&mut a, &nb, capped);
     let apply = |s: &mut Surface, a: &[f64]| {
         for (i, smp) in s.samples.iter_mut().enumerate() {
             smp.xi = base[i] + a[i] * d[i];

@@ -3,18 +3,18 @@
 //! A texture displaces the surface along each column's offset direction:
 //! ξ'(i, z) = ξ(i, z) + a(i, z) · D(i, z), with D the sum of the design's
 //! textures (ripple, flute, spiral, image), each times its fade envelope.
-//! Sampling (the surface stage, `surface.rs`) stores D per sample and refines the
-//! spacing and layer heights so each texture gets at least
-//! [`SAMPLES_PER_PERIOD`] samples a period ([`refine`]). The corrections
-//! (the corrections, `correct.rs`) then choose the amount kept, a ∈ [0, 1] per
-//! sample ([`keep`]): 1 wherever the step from the bead below stays
-//! within the support-free and overlap limit, less only where it would
-//! not, and never more than [`MAX_A_STEP`] apart between neighbouring
-//! samples, so a texture fades out smoothly where the clay cannot hold it
-//! and every place where it does is reported.
+//! Sampling (`surface.rs`) stores D per sample, its spacing and layer
+//! heights refined so each texture gets at least [`SAMPLES_PER_PERIOD`]
+//! samples a period ([`needs`], which `Design::printed` applies). The
+//! corrections (`keep_texture` in `correct.rs`) then choose the amount
+//! kept, a ∈ [0, 1] per sample: 1 wherever the step from the bead below
+//! stays within the support-free and overlap limit, less only where it
+//! would not, and never more than [`MAX_A_STEP`] apart between
+//! neighbouring samples, so a texture fades out smoothly where the clay
+//! cannot hold it and every place where it does is reported.
 //!
 //! Twist turns each cross-section about o by `twist_deg · t` (t = z / h
-//! of the column): `Column::point` (surface.rs) applies it.
+//! of the column): `Column::point` (`surface.rs`) applies it.
 
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
