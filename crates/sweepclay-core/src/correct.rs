@@ -324,6 +324,24 @@ pub fn correct_with(surface: &Surface, tight: &Tightening) -> Result<Corrected> 
         (Vec::new(), Vec::new())
     } else {
         let (kept, fixes) = keep_texture(&mut out, scale);
+        // A texture the clay can hold nowhere (less than a quarter of it
+        // anywhere) is refused, not printed all but plain under its name.
+        let textured = || {
+            out.texture
+                .iter()
+                .zip(&kept)
+                .filter(|(d, _)| d.abs() > 0.01)
+        };
+        if textured().next().is_some() && textured().all(|(_, &a)| a < 0.25) {
+            let why = fixes.first().map_or("overhang", |f| f.why);
+            return Err(Error::invalid(
+                "texture",
+                format!(
+                    "{} cannot be kept anywhere (not a quarter of it at any place: {why}); make it shallower or its period longer",
+                    out.texture_label.0
+                ),
+            ));
+        }
         // What a texture pushed past the limits anyway is held back as any
         // other step is (and reported so).
         support.extend(support_free(&mut out, scale));

@@ -12,8 +12,8 @@ fn profile(h: f64, lean: f64) -> serde_json::Value {
 }
 
 /// A texture the clay cannot hold anywhere (ribs 40 mm deep every 4 mm)
-/// is reduced everywhere and said so; one too fine to sample is refused
-/// by name.
+/// is refused by name, as is one too fine to sample; a steep one is kept
+/// where it can be and its reductions said.
 #[test]
 fn impossible_textures_are_reduced_or_refused_by_name() {
     let v = |tex: serde_json::Value| {
@@ -31,9 +31,18 @@ fn impossible_textures_are_reduced_or_refused_by_name() {
     let fine = v(serde_json::json!({ "kind": "ripple", "amplitude": 1, "period": 2 }));
     let e = slice(&fine).unwrap_err().to_string();
     assert!(e.contains("texture[0]") && e.contains("period"), "{e}");
+    // Ribs 40 mm deep every 4 mm: no layer can hold a step of them.
     let deep = v(serde_json::json!({ "kind": "ripple", "amplitude": 40, "period": 4 }));
-    let s = slice(&deep).unwrap();
+    let e = slice(&deep).unwrap_err().to_string();
+    assert!(
+        e.contains("texture: ripple 40 mm cannot be kept anywhere"),
+        "{e}"
+    );
+    // 4 mm deep every 8 mm: kept where the wall allows, reduced elsewhere
+    // and said so.
+    let steep = v(serde_json::json!({ "kind": "ripple", "amplitude": 4, "period": 8 }));
+    let s = slice(&steep).unwrap();
     let said = s.corrected.report.summary().join("\n");
-    assert!(said.contains("texture ripple 40 mm reduced to"), "{said}");
+    assert!(said.contains("texture ripple 4 mm reduced to"), "{said}");
     assert!(common::check_fast(&s).printable);
 }

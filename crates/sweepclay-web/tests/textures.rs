@@ -179,7 +179,7 @@ proptest! {
             Err(Unchecked::Design(e)) => {
                 let m = e.to_string();
                 prop_assert!(
-                    m.contains("too steeply") || m.contains("varies") || m.contains("twist_deg: turns the wall"),
+                    m.contains("too steeply") || m.contains("varies") || m.contains("twist_deg: turns the wall") || m.contains("cannot be kept anywhere"),
                     "{m}\n{}",
                     d.to_json()
                 );
