@@ -408,11 +408,13 @@ fn http_get(addr: &str, path: &str) -> String {
     out
 }
 
-#[test]
-fn serve_prints_its_url_and_answers() {
+/// Starts `sweepclay serve` with `args`; the server and the first line it
+/// prints (its URL).
+fn serve(args: &[&str]) -> (Server, String) {
     use std::io::BufRead;
     let child = std::process::Command::new(assert_cmd::cargo::cargo_bin("sweepclay"))
-        .args(["serve", "--port", "0"])
+        .arg("serve")
+        .args(args)
         .stdout(std::process::Stdio::piped())
         .spawn()
         .unwrap();
@@ -421,6 +423,12 @@ fn serve_prints_its_url_and_answers() {
     std::io::BufReader::new(server.0.stdout.take().unwrap())
         .read_line(&mut line)
         .unwrap();
+    (server, line)
+}
+
+#[test]
+fn serve_prints_its_url_and_answers() {
+    let (_server, line) = serve(&["--port", "0"]);
     // "sweepclay modeler: http://127.0.0.1:PORT/  (Ctrl+C to stop)"
     let url = line
         .split_whitespace()
@@ -791,17 +799,8 @@ fn outputs_keep_the_design_the_mode_and_no_leftovers() {
 /// name (DNS rebinding) with it.
 #[test]
 fn lan_mode_prints_a_token_and_keeps_strangers_out() {
-    use std::io::{BufRead, Read, Write};
-    let child = std::process::Command::new(assert_cmd::cargo::cargo_bin("sweepclay"))
-        .args(["serve", "--host", "0.0.0.0", "--port", "0"])
-        .stdout(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut server = Server(child);
-    let mut line = String::new();
-    std::io::BufReader::new(server.0.stdout.take().unwrap())
-        .read_line(&mut line)
-        .unwrap();
+    use std::io::{Read, Write};
+    let (_server, line) = serve(&["--host", "0.0.0.0", "--port", "0"]);
     let url = line
         .split_whitespace()
         .find(|w| w.starts_with("http://127.0.0.1:"))

@@ -9,22 +9,15 @@
 
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
+mod seeds;
 use sweepclay_web::api;
 
 fn cases() -> u32 {
-    std::env::var("PROPTEST_CASES")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(300)
+    seeds::cases(300)
 }
 
 fn seed() -> RngSeed {
-    RngSeed::Fixed(
-        std::env::var("FUZZ_SEED")
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(20261204),
-    )
+    seeds::seed("FUZZ_SEED", 20261204)
 }
 
 fn number() -> impl Strategy<Value = String> {

@@ -9,25 +9,18 @@
 
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
+mod seeds;
 use sweepclay_core::{correct, surface, Design};
 use sweepclay_web::guard::Cancel;
 use sweepclay_web::verify::{slice_checked, Unchecked};
 
 /// 40 cases in CI; `PROPTEST_CASES` for more.
 fn cases() -> u32 {
-    std::env::var("PROPTEST_CASES")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(40)
+    seeds::cases(40)
 }
 
 fn seed() -> RngSeed {
-    RngSeed::Fixed(
-        std::env::var("TEXTURE_SEED")
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(20261204),
-    )
+    seeds::seed("TEXTURE_SEED", 20261204)
 }
 
 /// A small greyscale PNG of `w` × `h` stripes and a spot, base64.

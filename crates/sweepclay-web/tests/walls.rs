@@ -8,25 +8,18 @@
 
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
+mod seeds;
 use sweepclay_core::Design;
 use sweepclay_web::guard::Cancel;
 use sweepclay_web::verify::{slice_checked, Unchecked};
 
 /// 1,000 cases with `PROPTEST_CASES=1000`; a fixed sample of 40 in CI.
 fn cases() -> u32 {
-    std::env::var("PROPTEST_CASES")
-        .ok()
-        .and_then(|v| v.parse().ok())
-        .unwrap_or(40)
+    seeds::cases(40)
 }
 
 fn seed() -> RngSeed {
-    RngSeed::Fixed(
-        std::env::var("WALL_SEED")
-            .ok()
-            .and_then(|v| v.parse().ok())
-            .unwrap_or(20261203),
-    )
+    seeds::seed("WALL_SEED", 20261203)
 }
 
 fn profile(kind: u8, h: f64, a: f64) -> serde_json::Value {
