@@ -461,7 +461,7 @@ impl Design {
     /// process, not the piece. Without shrinkage, the design itself.
     pub fn printed(&self) -> Design {
         let mut d = self.scaled_for_firing();
-        d.refine_for_texture();
+        d.params = d.texture_params();
         d
     }
 
@@ -469,13 +469,13 @@ impl Design {
     /// layer that give each texture 8 samples a period (never under the
     /// thinnest layer [`Params::validate`] allows; [`Design::check_texture`]
     /// refuses a texture that would need less).
-    pub(crate) fn refine_for_texture(&mut self) {
+    pub(crate) fn texture_params(&self) -> Params {
+        let mut p = self.params.clone();
         if self.texture.is_empty() {
-            return;
+            return p;
         }
         let length = crate::trajectory_length(self);
         let [along, up] = crate::texture::needs(&self.texture, length, self.trajectory.closed);
-        let p = &mut self.params;
         if let Some((s, _)) = along.filter(|(s, _)| s.is_finite() && *s > 0.0) {
             p.spacing = p.spacing.min(s.max(MIN_SPACING));
         }
@@ -487,6 +487,7 @@ impl Design {
                 .min((0.6 * p.max_layer_height).max(MIN_LAYER))
                 .min(p.max_layer_height);
         }
+        p
     }
 
     /// Checks the textures and the twist, and refuses a texture whose

@@ -290,13 +290,10 @@ pub fn trajectory_length(d: &Design) -> f64 {
 /// narrows it for walls. Textures' finer sampling counted. NaN when a
 /// coordinate is not a number (slicing then names it).
 pub fn samples_bound(d: &Design) -> f64 {
-    // The sampling a texture asks for (idempotent: `d` may be refined).
-    let mut refined = d.clone();
-    refined.refine_for_texture();
-    let d = &refined;
     let t = &d.trajectory;
     let pts = t.given_points();
-    let p = &d.params;
+    // The sampling a texture asks for (idempotent: `d` may be refined).
+    let p = &d.texture_params();
     let mut floor = 0.0;
     if t.closed && pts.len() > 1 {
         let area = 0.5 * crate::plane::signed_area2(pts).abs();

@@ -196,7 +196,10 @@ fn normal(pts: &[[f64; 2]], i: usize, closed: bool) -> [f64; 2] {
 pub fn sample_surface(design: &Design) -> Result<Surface> {
     design.params.validate()?;
     design.check_texture()?;
-    let mut s = sample_plain(design)?;
+    // What is printed: the design enlarged for the kiln's shrinkage, its
+    // sampling refined for its textures.
+    let printed = design.printed();
+    let mut s = sample_plain(&printed)?;
     let twist = design.twist_deg.to_radians();
     // A vessel's floor layers are laid plain and untwisted: the floor
     // fills the plain ring, and texture and twist start above it.
@@ -223,7 +226,6 @@ pub fn sample_surface(design: &Design) -> Result<Surface> {
     if design.texture.iter().all(|t| t.amplitude == 0.0) {
         return Ok(s);
     }
-    let printed = design.printed();
     let height = s.columns.iter().map(|c| c.height).fold(0.0, f64::max);
     let field = crate::texture::Field::new(
         &printed.texture,
@@ -325,11 +327,9 @@ fn texture_reach(design: &Design) -> f64 {
         .sum::<f64>()
 }
 
-/// [`sample_surface`] without textures and twist.
+/// [`sample_surface`] of the design as printed ([`Design::printed`]),
+/// without textures and twist.
 fn sample_plain(design: &Design) -> Result<Surface> {
-    // What is printed: the design enlarged for the kiln's shrinkage.
-    let printed = design.printed();
-    let design = &printed;
     let params = design.params.clone();
     let printer = design.printer.resolve()?;
     let start = Profile::new("profile_start", &design.profile_start)?;

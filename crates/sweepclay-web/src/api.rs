@@ -316,7 +316,7 @@ fn view(s: &Sliced, moved: Vec<u32>, slice_ms: f64, fit_error: Option<FitError>)
     // A vessel's floor beads are not surface samples: their positions
     // follow the samples', in print order.
     let mut extra = surf.samples.len() as u32;
-    let order = pts
+    let order: Vec<u32> = pts
         .iter()
         .map(|p| match mesh::sample_of_point(surf, p) {
             Some(i) => i as u32,
@@ -327,6 +327,16 @@ fn view(s: &Sliced, moved: Vec<u32>, slice_ms: f64, fit_error: Option<FitError>)
             }
         })
         .collect();
+    // A floor bead's index is past the samples: it keeps no texture.
+    let kept = &s.corrected.kept;
+    let texture_kept = if kept.is_empty() {
+        Vec::new()
+    } else {
+        order
+            .iter()
+            .map(|&i| kept.get(i as usize).map_or(1.0, |&k| round2(k)))
+            .collect()
+    };
     let path = PathView {
         order,
         width: s.extrusion.width.iter().map(|&w| round2(w)).collect(),
@@ -340,17 +350,7 @@ fn view(s: &Sliced, moved: Vec<u32>, slice_ms: f64, fit_error: Option<FitError>)
             surf.printer.nozzle_radius,
             surf.params.nozzle_height,
         ),
-        texture_kept: if s.corrected.kept.is_empty() {
-            Vec::new()
-        } else {
-            pts.iter()
-                .map(|p| {
-                    mesh::sample_of_point(surf, p)
-                        .and_then(|i| s.corrected.kept.get(i))
-                        .map_or(1.0, |&k| round2(k))
-                })
-                .collect()
-        },
+        texture_kept,
     };
     let plan = &surf.plan;
     let mut warnings = Vec::new();

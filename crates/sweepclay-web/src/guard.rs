@@ -259,13 +259,7 @@ pub async fn same_origin(
 ) -> Response {
     // The page opened with the right `?token=…` gets it as a cookie, which
     // its every request then carries (the slice worker's too).
-    let set_cookie = who.token.as_ref().filter(|t| {
-        req.uri().path() == "/"
-            && req.uri().query().is_some_and(|q| {
-                q.split('&')
-                    .any(|kv| kv.strip_prefix("token=") == Some(t.as_str()))
-            })
-    });
+    let set_cookie = who.token.as_ref().filter(|t| link_carries(&req, t));
     let cookie =
         set_cookie.map(|t| format!("{TOKEN_COOKIE}={t}; Path=/; HttpOnly; SameSite=Strict"));
     let mut res = match refusal(&who, body_limit, &req) {
@@ -369,6 +363,15 @@ fn reserve_body(
     })
 }
 
+/// Whether `req` opens the page by the printed link: `/?token=` `t`.
+fn link_carries(req: &Request, t: &str) -> bool {
+    req.uri().path() == "/"
+        && req
+            .uri()
+            .query()
+            .is_some_and(|q| q.split('&').any(|kv| kv.strip_prefix("token=") == Some(t)))
+}
+
 /// Why `req` is refused, if it is.
 fn refusal(who: &Admission, body_limit: usize, req: &Request) -> Option<ApiError> {
     let hosts = &who.hosts;
@@ -401,11 +404,7 @@ fn refusal(who: &Admission, body_limit: usize, req: &Request) -> Option<ApiError
                     == Some(t.as_str())
             })
             || text(HeaderName::from_static("x-sweepclay-token")) == Some(t.as_str())
-            || (path == "/"
-                && req.uri().query().is_some_and(|q| {
-                    q.split('&')
-                        .any(|kv| kv.strip_prefix("token=") == Some(t.as_str()))
-                }));
+            || link_carries(req, t);
         if !carried && !path.starts_with("/assets/") {
             return Some(ApiError::new(
                 401,
