@@ -329,6 +329,9 @@ struct Checker<'a> {
     /// Consecutive beads under the least overlap, and over a layer gap,
     /// not yet recorded.
     weak: [Weak; 2],
+    /// Under-extruded moves since the last full bead (line, width): a
+    /// failure once a bead follows them, the final taper if none does.
+    under: Vec<(usize, f64)>,
     /// The gap under the beads judged for it so far, a running mean
     /// (mm; 0 before the first): the layers the print lays.
     typical_gap: f64,
@@ -397,6 +400,7 @@ impl<'a> Checker<'a> {
             prev_stub: false,
             prev_overlap: 0.0,
             weak: Default::default(),
+            under: Vec::new(),
             typical_gap: 0.0,
             beads: Vec::new(),
             bent_before: vec![0],
@@ -1026,10 +1030,7 @@ impl<'a> Checker<'a> {
                     // A thin bead (a floor's narrowed tail between its
                     // neighbours) fails only over a gap well beyond the
                     // layers laid so far: clay two layers down.
-                    if xy >= 0.25 * cfg.width_min
-                        && rise < cfg.min_layer_mm
-                        && !crate::support::is_smear(width, cfg)
-                    {
+                    if xy >= 0.25 * cfg.width_min && rise < cfg.min_layer_mm {
                         let thin = width < cfg.width_min * (1.0 - WIDTH_TOLERANCE);
                         let deep = *typical_gap == 0.0 || dz > DEEP_GAP * *typical_gap;
                         let over = dz > gap_limit
@@ -1089,10 +1090,7 @@ impl<'a> Checker<'a> {
                 } else if width < cfg.width_min * (1.0 - WIDTH_TOLERANCE) {
                     r.support.thin.add(m.line, cfg.width_min - width);
                 }
-                // A smear (a join across clay) carries no clay to hold up:
-                // what it overlaps or leans over is not judged
-                // (docs/CHECKER.md, "Clay on clay").
-                if !crate::support::is_smear(width, cfg) {
+                {
                     let bin = if overlap < 0.5 {
                         0
                     } else if overlap < 0.6 {
@@ -1226,6 +1224,18 @@ impl<'a> Checker<'a> {
         }
         if let Some((line, ratio)) = pile {
             self.record(Finding::TurnPile, line, ratio, false);
+        }
+        // Less than a quarter of the narrowest bead's clay on a move that
+        // is no climbing step: an under-extruded bead, unless nothing but
+        // more of them follows (the final taper).
+        if !step && width.is_finite() {
+            if width < crate::report::UNDER_EXTRUDED * cfg.width_min {
+                self.under.push((m.line, width));
+            } else if !self.under.is_empty() {
+                for (line, w) in std::mem::take(&mut self.under) {
+                    self.record(Finding::UnderExtruded, line, w, false);
+                }
+            }
         }
         if self.lead.print_run.is_some() {
             return;

@@ -88,7 +88,16 @@ pub enum Finding {
     /// the end of the bead after it needs: clay piles up at the turn
     /// (docs/CHECKER.md, "Turns"). Worst: that ratio.
     TurnPile,
+    /// A move between two beads of the print, no climbing step, that
+    /// carries less than [`UNDER_EXTRUDED`] of a `width_min` bead of its
+    /// layer: no clay extruder drops its flow that far within a move
+    /// (docs/CHECKER.md, "Under-extruded moves"). Worst: its width (mm).
+    UnderExtruded,
 }
+
+/// The share of a `width_min` bead's clay under which a move of the print
+/// is an under-extruded bead (docs/CHECKER.md, "Under-extruded moves").
+pub const UNDER_EXTRUDED: f64 = 0.25;
 
 /// A bead whose clay cross-section (volume over length) exceeds this many
 /// times that of the widest bead laid half as high as it is wide carries
@@ -103,7 +112,7 @@ pub const TURN_FACTOR: f64 = 2.0;
 
 impl Finding {
     /// Every kind, in the order reports list them.
-    pub const ALL: [Finding; 18] = [
+    pub const ALL: [Finding; 19] = [
         Finding::TravelMove,
         Finding::Retraction,
         Finding::Pause,
@@ -122,6 +131,7 @@ impl Finding {
         Finding::UnreadableNumber,
         Finding::ClayOverflow,
         Finding::TurnPile,
+        Finding::UnderExtruded,
     ];
 
     /// The row of the text report (with the unit of the worst value).
@@ -145,6 +155,7 @@ impl Finding {
             Finding::UnreadableNumber => "unreadable numbers",
             Finding::ClayOverflow => "clay beyond the nozzle (mm²)",
             Finding::TurnPile => "clay piled at turns (x)",
+            Finding::UnderExtruded => "under-extruded moves (mm)",
         }
     }
 
@@ -176,6 +187,9 @@ impl Finding {
             }
             Finding::TurnPile => {
                 "turnaround step(s) carrying more than twice the clay the end of the next bead needs (it piles up at the turn)"
+            }
+            Finding::UnderExtruded => {
+                "under-extruded move(s) between beads (less than a quarter of the narrowest bead's clay: no clay extruder drops its flow that fast)"
             }
         }
     }

@@ -473,13 +473,18 @@ fn slice(a: SliceArgs) -> Result<i32> {
             st.curves
         );
         if let Some(v) = &st.vessel {
-            say!(
-                "  floor              {} layer{} of {} rings inside the base ring ({:.1} cm²)",
-                v.floor_layers,
-                if v.floor_layers == 1 { "" } else { "s" },
-                v.floor_rings,
-                v.floor_area_cm2
-            );
+            if v.floor_layers > 0 {
+                say!(
+                    "  floor              {} layer{}, each one spiral of {} turns ({:.1} cm², {:.1} % covered)",
+                    v.floor_layers,
+                    if v.floor_layers == 1 { "" } else { "s" },
+                    v.floor_turns,
+                    v.floor_area_cm2,
+                    v.floor_cover_pct
+                );
+            } else {
+                say!("  floor              none (bottomless)");
+            }
             say!(
                 "  wall               {} spiral turns and a rim turn, one continuous path",
                 v.wall_turns

@@ -61,12 +61,6 @@ impl Extrusion {
     }
 }
 
-/// The clay of a join ([`crate::toolpath::VesselPath::joins`]), as a
-/// fraction of a bead's cuboid: the step from one floor element to the next
-/// runs across clay both already cover (docs/ALGORITHMS.md §8), so it gets
-/// next to none — but some, so E keeps rising and the clay never stops.
-pub const JOIN_CLAY: f64 = 0.05;
-
 /// The slowest a step is printed, as a fraction of the feedrate: a
 /// screw or piston cannot slow much further without stalling the clay.
 pub const MIN_TURN_FEED: f64 = 0.25;
@@ -86,8 +80,8 @@ pub fn plan_extrusion(path: &Toolpath, params: &Params, origin: [f64; 2]) -> Ext
     let n = path.points.len();
     let (wmin, wmax, ov) = (params.width_min, params.width_max, params.overlap);
     let mut width = vec![wmin; n];
-    let joins = path.vessel.as_ref().map_or(&[][..], |v| &v.joins[..]);
-    let mut joins = joins.iter().peekable();
+    // A vessel's wall starts on its floor's top (or the bed).
+    let floor_top = path.vessel.as_ref().map_or(0.0, |v| v.floor_top_mm);
     let mut layer_height = Vec::with_capacity(n);
     let mut offset = Vec::with_capacity(n);
     for (i, p) in path.points.iter().enumerate() {
@@ -97,8 +91,12 @@ pub fn plan_extrusion(path: &Toolpath, params: &Params, origin: [f64; 2]) -> Ext
                 layer_height.push(p.pos[2] - q[2]);
                 offset.push((p.pos[0] - q[0]).hypot(p.pos[1] - q[1]));
             }
-            None => {
+            None if p.kind == crate::toolpath::PointKind::Floor => {
                 layer_height.push(p.pos[2]);
+                offset.push(0.0);
+            }
+            None => {
+                layer_height.push(p.pos[2] - floor_top);
                 offset.push(0.0);
             }
         }
@@ -118,11 +116,10 @@ pub fn plan_extrusion(path: &Toolpath, params: &Params, origin: [f64; 2]) -> Ext
             }
         }
     }
-    // A thin floor ring's beads are laid narrower where its sides come
-    // close, the line down one's middle wider, whatever lies below them
-    // (docs/ALGORITHMS.md §8).
+    // A floor's beads are as wide as their neighbours in the layer need,
+    // whatever lies below them (docs/ALGORITHMS.md §8).
     if let Some(v) = &path.vessel {
-        for &(i, w) in &v.narrow {
+        for &(i, w) in &v.floor_widths {
             width[i as usize] = w;
         }
     }
@@ -139,7 +136,6 @@ pub fn plan_extrusion(path: &Toolpath, params: &Params, origin: [f64; 2]) -> Ext
         let l = (xy2 + (a[2] - b[2]).powi(2)).sqrt();
         let cuboid =
             l * 0.5 * (width[i] + width[i - 1]) * 0.5 * (layer_height[i] + layer_height[i - 1]);
-        while joins.next_if(|&&j| (j as usize) < i).is_some() {}
         let v = if steep(a, b, xy2, origin) {
             turn_cuboid += cuboid;
             turn_steps += 1;
@@ -152,12 +148,7 @@ pub fn plan_extrusion(path: &Toolpath, params: &Params, origin: [f64; 2]) -> Ext
                 slow.push((i as u32, (bead_rate / rate).max(MIN_TURN_FEED)));
             }
             v
-        } else if joins.peek().is_some_and(|&&j| j as usize == i) {
-            JOIN_CLAY * cuboid
         } else {
-            // The first turn of a vase rises from nothing: its first beads
-            // still get the least clay that keeps the flow going.
-            let cuboid = cuboid.max(JOIN_CLAY * wmin * params.layer_height * l);
             if l > 1e-9 {
                 bead_rate = cuboid / l;
             }

@@ -78,8 +78,8 @@ pub fn emit<W: Write>(s: &Sliced, out: &mut W) -> io::Result<Vec<usize>> {
     if let Some(v) = &st.vessel {
         writeln!(
             out,
-            "; vessel: floor_layers={} floor_rings={} floor_area_cm2={:.1} wall_turns={}",
-            v.floor_layers, v.floor_rings, v.floor_area_cm2, v.wall_turns
+            "; vessel: floor_layers={} floor_turns={} floor_area_cm2={:.1} floor_cover_pct={:.1} wall_turns={}",
+            v.floor_layers, v.floor_turns, v.floor_area_cm2, v.floor_cover_pct, v.wall_turns
         )?;
     }
     writeln!(out, "; layer_heights: {}", st.layers.summary())?;
@@ -162,8 +162,7 @@ pub fn emit<W: Write>(s: &Sliced, out: &mut W) -> io::Result<Vec<usize>> {
 }
 
 /// Where a vessel's moves change between floor and wall, for `;TYPE:`
-/// comments (a wall's are not typed: it is all wall). The base ring under
-/// the wall counts as wall.
+/// comments (a wall's are not typed: it is all wall).
 pub fn move_types(t: &Toolpath) -> Vec<(usize, &'static str)> {
     if t.vessel.is_none() {
         return Vec::new();

@@ -129,10 +129,12 @@ pub struct Stats {
 pub struct VesselStats {
     /// Flat floor layers (0: bottomless).
     pub floor_layers: u32,
-    /// Concentric rings inside the base ring, each floor layer.
-    pub floor_rings: u32,
-    /// Area of the floor inside the base ring (cm²).
+    /// Turns of each floor layer's spiral.
+    pub floor_turns: u32,
+    /// Area of the floor inside the wall's first turn (cm²).
     pub floor_area_cm2: f64,
+    /// The share of that area the floor's beads cover, in per cent.
+    pub floor_cover_pct: f64,
     /// Spiral turns of the wall, the rim turn not counted.
     pub wall_turns: u32,
 }
@@ -285,7 +287,7 @@ pub fn trajectory_length(d: &Design) -> f64 {
 /// anything for it): columns (Ψ's length / spacing + 1) times the
 /// samples a column can get — a wall's mean height over the layer
 /// height (flat layers, the most the layering chooses), a vessel's
-/// lowest (its spiral turns) — plus a vessel's floor rings, a pitch
+/// lowest (its spiral turns) — plus a vessel's floor spirals, a pitch
 /// apart over the control polygon's area. [`estimated_samples`]
 /// narrows it for walls. Textures' finer sampling counted. NaN when a
 /// coordinate is not a number (slicing then names it).
@@ -511,8 +513,9 @@ fn stats(c: &Corrected, t: &Toolpath, e: &Extrusion) -> Stats {
         layers: layer_stats(c),
         vessel: t.vessel.as_ref().map(|v| VesselStats {
             floor_layers: v.floor_layers,
-            floor_rings: v.floor_rings,
+            floor_turns: v.floor_turns,
             floor_area_cm2: v.floor_area_mm2 / 100.0,
+            floor_cover_pct: 100.0 * v.floor_cover,
             wall_turns: v.turns,
         }),
     }
@@ -631,11 +634,13 @@ mod tests {
             ))
             .unwrap()
         };
+        // The wall's (the floor's outermost turn starts outside it).
         let reach = |s: &Sliced| {
             let r = s
                 .toolpath
                 .points
                 .iter()
+                .filter(|p| p.kind != crate::toolpath::PointKind::Floor)
                 .map(|p| p.pos[0].hypot(p.pos[1]))
                 .fold(0.0, f64::max);
             let z = s

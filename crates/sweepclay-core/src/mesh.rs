@@ -61,11 +61,12 @@ pub fn path_index_of_samples(s: &Sliced) -> Vec<u32> {
 }
 
 /// The surface sample a toolpath point visits (`None` for a vessel's
-/// floor beads inside the base ring, which are not surface samples).
+/// floor beads, which are not surface samples).
 pub fn sample_of_point(s: &Surface, p: &crate::toolpath::PathPoint) -> Option<usize> {
     let col = &s.columns[p.column as usize];
     let local = match p.kind {
-        PointKind::Pass => p.pass as usize - 1,
+        // A vessel's wall passes are numbered on from its floor layers.
+        PointKind::Pass => (p.pass - s.vessel.as_ref().map_or(0, |v| v.base_layers)) as usize - 1,
         PointKind::Top => col.passes as usize,
         PointKind::Floor => return None,
     };
@@ -115,7 +116,7 @@ pub fn solid(s: &Sliced) -> Vec<[[f64; 3]; 3]> {
         .vessel
         .as_ref()
         .filter(|v| v.floor_layers > 0)
-        .map(|v| v.base_layers as usize);
+        .map(|v| v.base_mm());
     // A ring of vertices round the loop: `side` 0 is the outer (o), n the
     // inner, at the samples `local` up their columns.
     let ring_at = |side: usize, local: usize| -> Vec<usize> {
@@ -133,25 +134,12 @@ pub fn solid(s: &Sliced) -> Vec<[[f64; 3]; 3]> {
     } else {
         (n, 0)
     };
-    if floor == Some(1) {
-        // The inside starts at the floor's top, the first layer's.
+    if let Some(top) = floor {
+        // The inside starts at the floor's top.
         for c in cols {
-            let si = c.first as usize;
-            v[inside + si][2] = surface.samples[si].z;
+            v[inside + c.first as usize][2] = top;
         }
     }
-    // Each sample's place up its column (0 at the bed).
-    let mut local_of = vec![0usize; n];
-    for c in cols {
-        for (k, si) in c.samples().enumerate() {
-            local_of[si] = k;
-        }
-    }
-    let local = |i: usize| local_of[i % n];
-    let below_floor = |t: &[usize; 3]| match floor {
-        Some(base) => t.iter().all(|&i| i - i % n == inside && local(i) < base),
-        None => false,
-    };
     let mut idx: Vec<[usize; 3]> = Vec::with_capacity(4 * n + 4 * cols.len());
     let quad = |idx: &mut Vec<[usize; 3]>, a: usize, b: usize, c: usize, d: usize| {
         idx.push([a, b, c]);
@@ -159,11 +147,8 @@ pub fn solid(s: &Sliced) -> Vec<[[f64; 3]; 3]> {
     };
     for t in surface_triangles(surface) {
         let [a, b, c] = t.map(|i| i as usize);
-        for tri in [[o(a), o(b), o(c)], [inner(c), inner(b), inner(a)]] {
-            if !below_floor(&tri) {
-                idx.push(tri);
-            }
-        }
+        idx.push([o(a), o(b), o(c)]);
+        idx.push([inner(c), inner(b), inner(a)]);
     }
     for (ca, cb) in column_pairs(surface) {
         let (a, b) = (cols[ca].samples(), cols[cb].samples());
@@ -191,11 +176,11 @@ pub fn solid(s: &Sliced) -> Vec<[[f64; 3]; 3]> {
             quad(&mut idx, o(s + 1), o(s), inner(s), inner(s + 1));
         }
     }
-    if let Some(base) = floor {
+    if floor.is_some() {
         // The bottom across the outside ring, the floor's top across the
         // inside ring where the wall's inside stands on it.
         idx.extend(cap(&v, &ring_at(outside, 0)));
-        idx.extend(cap(&v, &ring_at(inside, base - 1)));
+        idx.extend(cap(&v, &ring_at(inside, 0)));
     }
     orient(&mut idx);
     let mut tris: Vec<[[f64; 3]; 3]> = idx.iter().map(|t| t.map(|i| v[i])).collect();

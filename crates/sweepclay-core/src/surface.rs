@@ -469,23 +469,17 @@ fn sample_plain(design: &Design) -> Result<Surface> {
     Ok(surface)
 }
 
-/// The columns a vessel's path may start each layer and turn at, best
-/// first: Ψ's start, or the one nearest the floor's innermost ring, where
-/// each ring is entered a short step from the one before
-/// (docs/ALGORITHMS.md §8). Refuses a floor whose islands split more
-/// than `MAX_SPLITS` times, or whose innermost line is out of a short
-/// step's reach.
-fn floor_start(
+/// Refuses a floor that one spiral cannot fill (docs/ALGORITHMS.md §8),
+/// tried on the wall's first turn as drawn; the path stage lays it under
+/// the corrected one.
+fn floor_fits(
     columns: &[Column],
     params: &Params,
     spacing: f64,
     start: &Profile,
     end: &Profile,
     first_layer: f64,
-) -> Result<(Vec<usize>, crate::vessel::FloorOf)> {
-    use crate::floor::{floor_entries, floor_plan, FloorRefusal};
-    // The base ring as its first layer lies (it stands straight through
-    // the floor).
+) -> Result<()> {
     let ring: Vec<[f64; 2]> = columns
         .iter()
         .map(|c| {
@@ -495,63 +489,30 @@ fn floor_start(
             [q[0], q[1]]
         })
         .collect();
-    let beads = crate::vessel::floor_beads(params, spacing);
-    let pitch = beads.pitch();
-    let rings = match floor_plan(&ring, beads) {
-        Ok(rings) => rings,
-        Err(FloorRefusal::Islands { depth, count: k }) => return Err(Error::invalid(
-            "trajectory",
-            format!(
-                "the floor's rings split at waists into islands more than {} times over, the last into {k} islands {depth:.1} mm inside the island before (a waist about {:.0} mm wide or narrower): widen the narrowest waists, or print the vessel bottomless (params.floor_layers = 0)",
-                crate::floor::MAX_SPLITS,
-                2.0 * depth
-            ),
-        )),
-    };
-    let Some(inner) = rings.last() else {
-        return Ok((spread_starts(ring.len()).collect(), Some((ring, rings))));
-    };
-    let nearest_to = |c: [f64; 2]| crate::floor::nearest(&ring, c);
-    let centre = nearest_to(crate::floor::centroid(&inner.pts));
-    // A line down an elongated core is entered at an end: from the column
-    // beyond that end, the rings' nearest points lead to it.
-    let ends = inner
-        .open
-        .then(|| [inner.pts[0], inner.pts[inner.pts.len() - 1]].map(nearest_to));
-    // The start of Ψ first (where the default interpolation keeps the rim
-    // flat across the seam), then the column nearest the floor's centre.
-    let mut worst = 0.0f64;
-    // Each moved off any corner where the base ring's seam would lay its
-    // last beads alongside its first.
-    // Then eight columns evenly round the loop, for a seam the extruder
-    // body clears where the rim rises and falls.
-    let n = ring.len();
-    let ok: Vec<usize> = [0, centre]
-        .into_iter()
-        .chain(ends.into_iter().flatten())
-        .chain(spread_starts(n).skip(1))
-        .map(|st| crate::floor::seam_at(&ring, st, params.width_min))
-        .filter(|&st| {
-            let (_, step) = floor_entries(&rings, ring[st], params.width_min);
-            worst = worst.max(step);
-            step <= 2.0 * pitch
+    crate::floor::spiral_floor(&ring, crate::vessel::floor_beads(params, spacing))
+        .map(|_| ())
+        .map_err(|why| {
+            Error::invalid(
+                "trajectory",
+                format!("{why}: make the shape rounder there, or print the vessel bottomless (params.floor_layers = 0)"),
+            )
         })
-        .collect();
-    if ok.is_empty() {
-        return Err(Error::invalid(
-            "trajectory",
-            format!(
-                "the floor's innermost ring is a sliver the path would reach only by a step of {worst:.1} mm across clay of the same layer; widen the narrow part of the shape, or print the vessel bottomless (params.floor_layers = 0)"
-            ),
-        ));
-    }
-    Ok((ok, Some((ring, rings))))
 }
 
-/// Where a spiral may begin on a loop of `n` columns when the start of Ψ
-/// will not do: Ψ's start, then seven more evenly round the loop.
-fn spread_starts(n: usize) -> impl Iterator<Item = usize> {
-    (0..8).map(move |m| m * n / 8).filter(move |&c| c < n)
+/// Where a spiral may begin on a loop whose columns' rims are `h`: just
+/// past the lowest rim (the first turn then ends where its rise is least,
+/// docs/ALGORITHMS.md §8), Ψ's start, then seven more evenly round the
+/// loop.
+fn spiral_starts(h: &[f64]) -> Vec<usize> {
+    let n = h.len();
+    let lowest = (0..n).min_by(|&a, &b| h[a].total_cmp(&h[b])).unwrap_or(0);
+    let mut starts = vec![(lowest + 1) % n];
+    for c in (0..8).map(|m| m * n / 8).filter(|&c| c < n) {
+        if !starts.contains(&c) {
+            starts.push(c);
+        }
+    }
+    starts
 }
 
 /// The layering with the most turns, from `v.turns` down to
@@ -564,27 +525,27 @@ fn clear_layering(
     near: &crate::vessel::Neighbours,
     heights: &[f64],
     exempt: usize,
+    params: &Params,
 ) -> std::result::Result<VesselPlan, (usize, f64)> {
     for turns in (v.fewest_turns..=v.turns).rev() {
-        let mut w = v.with_turns(turns);
         for &st in starts {
-            w.start = st;
-            if w.body_violation(near, heights, exempt).is_none() {
+            let w = v.with(turns, st, params);
+            if w.first_fits() && w.body_violation(near, heights, exempt).is_none() {
                 return Ok(w);
             }
         }
     }
-    let mut w = v.with_turns(v.fewest_turns);
-    w.start = starts[0];
+    let w = v.with(v.fewest_turns, starts[0], params);
     match w.body_violation(near, heights, exempt) {
         None => Ok(w),
         Some(worst) => Err(worst),
     }
 }
 
-/// The samples of a vessel (docs/ALGORITHMS.md §8): each column's base
-/// layers, its spiral turns and, but for the last column, whose last turn
-/// already ends on the rim, the rim bead.
+/// The samples of a vessel (docs/ALGORITHMS.md §8): each column's spiral
+/// turns and, where the last turn ends half a layer or more below the
+/// rim, the rim bead. The floor is not sampled: the path stage fills the
+/// first turn's inside.
 fn sample_vessel(
     design: &Design,
     mut columns: Vec<Column>,
@@ -601,14 +562,10 @@ fn sample_vessel(
         .unwrap_or(crate::design::DEFAULT_FLOOR_LAYERS);
     let mut v = VesselPlan::choose(&heights, &params, floor)?;
     let spacing = length / n as f64;
-    let starts = if v.floor_layers > 0 {
-        let (starts, floor) =
-            floor_start(&columns, &params, spacing, &start, &end, v.base_layer_mm)?;
-        v.floor = floor;
-        starts
-    } else {
-        spread_starts(n).collect()
-    };
+    if v.floor_layers > 0 {
+        floor_fits(&columns, &params, spacing, &start, &end, v.base_mm())?;
+    }
+    let starts = spiral_starts(&heights);
     // The extruder body's reach, and the clay just laid along the loop
     // that it may touch, as the checker counts them; columns where the
     // rim is, where collisions happen (docs/ALGORITHMS.md §8).
@@ -629,7 +586,7 @@ fn sample_vessel(
     // The most turns (the thinnest layers) whose spiral the extruder body
     // clears, from the first start whose seam it clears; where a rim rises
     // and falls, thicker layers keep the turn below out of its way.
-    match clear_layering(&v, &starts, &near, &heights, exempt) {
+    match clear_layering(&v, &starts, &near, &heights, exempt, &params) {
         Ok(clear) => v = clear,
         Err((i, over)) => {
             let c = &columns[i];
@@ -640,7 +597,7 @@ fn sample_vessel(
             let clears = |share: f64| {
                 let h: Vec<f64> = heights.iter().map(|&h| lo + share * (h - lo)).collect();
                 VesselPlan::choose(&h, &params, floor)
-                    .is_ok_and(|w| clear_layering(&w, &starts, &near, &h, exempt).is_ok())
+                    .is_ok_and(|w| clear_layering(&w, &starts, &near, &h, exempt, &params).is_ok())
             };
             let (mut ok, mut bad) = (0.0, 1.0);
             for _ in 0..12 {
@@ -659,7 +616,7 @@ fn sample_vessel(
                     c.p[1],
                     c.u,
                     v.fewest_turns,
-                    v.with_turns(v.fewest_turns).turn_mm[1],
+                    v.with(v.fewest_turns, starts[0], &params).turn_mm[1],
                     printer.nozzle_radius,
                     ok * (hi - lo),
                     hi - lo
@@ -668,7 +625,7 @@ fn sample_vessel(
         }
     }
     let rim = v.rim_beads(&near, &heights, exempt);
-    let layers = v.base_layers + v.turns;
+    let layers = v.turns;
     let plan = LayerPlan {
         passes: layers + 1,
         lower_passes: layers + 1,
@@ -699,14 +656,6 @@ fn sample_vessel(
         col.first = surface.samples.len() as u32;
         col.passes = layers;
         col.top = rim[i];
-        // The base ring stands straight through the floor's layers (as
-        // its first layer lies), so the floor's rings fit inside it on
-        // every layer; the wall's lean starts above the floor.
-        let first = surface.design_offset(col, v.base_layer_mm, 1.0);
-        for b in 1..=v.base_layers {
-            let z = f64::from(b) * v.base_layer_mm;
-            surface.samples.push(Sample { z, xi: first });
-        }
         let spiral = (1..=v.turns).map(|k| v.spiral_z(k, i, n, col.height));
         let rim = col.top.then_some(col.height);
         for z in spiral.chain(rim) {

@@ -10,7 +10,7 @@
 //! turn. Every sample is visited exactly once.
 
 use crate::correct::Corrected;
-use crate::floor::{floor_entries, floor_rings, ring_area, seam_at, FloorRing};
+use crate::floor::{coverage, ring_area, spiral_floor, FloorSpiral};
 use crate::vessel::{floor_beads, VesselPlan};
 use serde::Serialize;
 
@@ -141,66 +141,61 @@ pub fn plan_path(c: &Corrected) -> Toolpath {
     }
 }
 
-/// The toolpath of a vessel: the base layers (floor elements inward on one
-/// layer, outward on the next, so the last ends on the base ring), the
-/// spiral turns, and the rim. Every sample of the surface is visited once,
-/// the base ring's first point of each base layer twice (the ring closes
-/// over it); the floor's elements add their own points, each ring closing
-/// on its entry. The move into each element, and from the floor to the
-/// base ring, is a join ([`VesselPath::joins`]).
+/// The toolpath of a vessel (docs/ALGORITHMS.md §8): the floor's layers,
+/// each one spiral ([`crate::floor`]) inside the wall's first turn, inward
+/// on one layer and outward on the next so that the last ends where the
+/// wall starts; then the spiral turns of the wall and the rim. Nothing
+/// closes on itself at its own height and no move crosses clay: a floor
+/// layer steps straight up onto the next where the one below ended, and
+/// the last steps up onto the wall's first turn, a layer above the floor.
 pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
     let s = &c.surface;
     let n = s.columns.len();
-    let base_ring: Vec<[f64; 2]> = (0..n)
-        .map(|i| {
-            let p = s.position(i, s.columns[i].first as usize);
-            [p[0], p[1]]
-        })
-        .collect();
-    let rings = match &v.floor {
-        _ if v.floor_layers == 0 => Vec::new(),
-        Some((ring, rings)) if *ring == base_ring => rings.clone(),
-        _ => floor_rings(&base_ring, floor_beads(&s.params, s.spacing)),
-    };
-    // Where each ring is entered: nearest the previous ring's entry,
-    // the first nearest column 0 (where the base ring starts).
-    let c0 = &s.columns[v.start];
-    let entry = floor_entries(&rings, base_ring[v.start], s.params.width_min).0;
-    // An outward layer enters its rings about a bead farther along: its
-    // joins then lie on the rings of the layer below, not on its joins.
-    // The innermost, where the layer below turned, and a line are entered
-    // where that layer left them.
-    let shift = (s.params.width_min / s.spacing).ceil() as usize;
-    let outward_entry: Vec<usize> = rings
-        .iter()
-        .zip(&entry)
-        .enumerate()
-        .map(|(r, (ring, &e))| match ring.open || r + 1 == rings.len() {
-            true => e,
-            false => seam_at(&ring.pts, (e + shift) % ring.pts.len(), s.params.width_min),
-        })
-        .collect();
-    // A ring's points and its closing point again; a line's points.
-    let floor_points: usize = rings
-        .iter()
-        .map(|r| r.pts.len() + usize::from(!r.open))
-        .sum();
-    let total = s.samples.len() + (floor_points + 1) * v.base_layers as usize;
+    let order = |m: usize| (v.start + m) % n;
+    let floor = (v.floor_layers > 0).then(|| vessel_floor(c, v)).flatten();
+    let floor_pts = floor.as_ref().map_or(0, |f| f.pts.len());
+    let total = s.samples.len() + floor_pts * v.base_layers as usize;
     let mut points = Vec::with_capacity(total);
-    let mut below = Vec::with_capacity(total);
-    let mut joins = Vec::new();
-    let mut narrow = Vec::new();
-    // Path index of each column's samples, and of each floor ring's points
-    // on the layer below.
+    let mut below: Vec<Option<u32>> = Vec::with_capacity(total);
+    let mut floor_widths = Vec::with_capacity(floor_pts * v.base_layers as usize);
+    if let Some(f) = &floor {
+        let m = f.pts.len();
+        for layer in 1..=v.base_layers {
+            let z = f64::from(layer) * v.base_layer_mm;
+            // The last floor layer runs outward, ending at the wall's
+            // start; the one before inward, …
+            let outward = (v.base_layers - layer).is_multiple_of(2);
+            let first = points.len() as u32;
+            for step in 0..m {
+                let j = if outward { m - 1 - step } else { step };
+                // The layer below ran the same points the other way.
+                below.push((layer > 1).then(|| first - 1 - step as u32));
+                floor_widths.push((points.len() as u32, f.widths[j]));
+                points.push(PathPoint {
+                    pos: [f.pts[j][0], f.pts[j][1], z],
+                    column: order(0) as u32,
+                    pass: layer,
+                    kind: PointKind::Floor,
+                });
+            }
+        }
+    }
+    if let (Some(last), Some(_)) = (points.last().copied(), &floor) {
+        // The floor ends just outside the wall's start: the path steps
+        // straight up there to the wall's first height, then lays its
+        // first bead on the floor's edge (a step up a slope would be read
+        // as a thin bead under the wall's first).
+        let first = s.position(order(0), s.columns[order(0)].first as usize);
+        below.push(None);
+        points.push(PathPoint {
+            pos: [last.pos[0], last.pos[1], first[2]],
+            column: order(0) as u32,
+            pass: v.base_layers + 1,
+            kind: PointKind::Pass,
+        });
+    }
     let mut path_of = vec![u32::MAX; s.samples.len()];
-    let mut ring_below: Vec<Vec<u32>> = rings.iter().map(|r| vec![u32::MAX; r.pts.len()]).collect();
-    let visit_column = |points: &mut Vec<PathPoint>,
-                        below: &mut Vec<Option<u32>>,
-                        path_of: &mut Vec<u32>,
-                        i: usize,
-                        local: usize,
-                        pass: u32,
-                        kind: PointKind| {
+    let mut visit = |points: &mut Vec<PathPoint>, i: usize, local: usize, pass, kind| {
         let col = &s.columns[i];
         let si = col.first as usize + local;
         path_of[si] = points.len() as u32;
@@ -212,132 +207,32 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
             kind,
         });
     };
-    // Sample `local` of every column, round the loop from the start.
-    let visit_turn = |points: &mut Vec<PathPoint>,
-                      below: &mut Vec<Option<u32>>,
-                      path_of: &mut Vec<u32>,
-                      local: usize,
-                      pass: u32| {
-        for m in 0..n {
-            let i = (v.start + m) % n;
-            visit_column(points, below, path_of, i, local, pass, PointKind::Pass);
-        }
-    };
-    // The base ring closes on its own height: back over its first point
-    // before the floor or the spiral goes on from there. Ended on the
-    // spiral's first point, barely above the ring, the closing bead would
-    // be sized for half the ring's height and leave a thin place under the
-    // seam; ended on a join, it would leave a gap.
-    let close_ring = |points: &mut Vec<PathPoint>, below: &mut Vec<Option<u32>>, first: usize| {
-        below.push(below[first]);
-        points.push(PathPoint {
-            kind: PointKind::Pass,
-            ..points[first]
-        });
-    };
     let base = v.base_layers;
-    for layer in 1..=base {
-        let z = f64::from(layer) * v.base_layer_mm;
-        let local = layer as usize - 1;
-        // The last base layer runs outward, the one before inward, …
-        let outward = (base - layer).is_multiple_of(2);
-        let mut floor = |points: &mut Vec<PathPoint>, below: &mut Vec<Option<u32>>, r: usize| {
-            let FloorRing {
-                pts: ring,
-                open,
-                widths,
-                ..
-            } = &rings[r];
-            let m = ring.len();
-            // A ring closes on its entry; a line runs inward from its
-            // entry end, outward back to it.
-            let steps = if *open { m } else { m + 1 };
-            if !points.is_empty() {
-                joins.push(points.len() as u32);
-            }
-            let e = if outward { outward_entry[r] } else { entry[r] };
-            let mut entered_on = u32::MAX;
-            for step in 0..steps {
-                let j = match (*open, outward == (e == 0)) {
-                    (false, _) => (e + step) % m,
-                    (true, true) => m - 1 - step,
-                    (true, false) => step,
-                };
-                // The closing point lies on what the entry lay on.
-                let under = if step < m {
-                    std::mem::replace(&mut ring_below[r][j], points.len() as u32)
-                } else {
-                    entered_on
-                };
-                if step == 0 {
-                    entered_on = under;
-                }
-                below.push((under != u32::MAX).then_some(under));
-                if let Some(w) = widths
-                    .as_ref()
-                    .map(|w| w[j])
-                    .filter(|&w| (w - s.params.width_min).abs() > 1e-9)
-                {
-                    narrow.push((points.len() as u32, w));
-                }
-                points.push(PathPoint {
-                    pos: [ring[j][0], ring[j][1], z],
-                    column: 0,
-                    pass: layer,
-                    kind: PointKind::Floor,
-                });
-            }
-        };
-        // A floor layer that runs inward starts on the base ring; one that
-        // runs outward ends on it.
-        let floor_order: Vec<usize> = match layer <= v.floor_layers {
-            false => Vec::new(),
-            true if outward => (0..rings.len()).rev().collect(),
-            true => (0..rings.len()).collect(),
-        };
-        let ring_at = |path_of: &[u32]| path_of[c0.first as usize + local] as usize;
-        if !outward {
-            visit_turn(&mut points, &mut below, &mut path_of, local, layer);
-            close_ring(&mut points, &mut below, ring_at(&path_of));
-        }
-        for r in floor_order {
-            floor(&mut points, &mut below, r);
-        }
-        if outward {
-            if !points.is_empty() {
-                joins.push(points.len() as u32);
-            }
-            visit_turn(&mut points, &mut below, &mut path_of, local, layer);
-            close_ring(&mut points, &mut below, ring_at(&path_of));
-        }
-    }
     for k in 1..=v.turns {
-        let local = (base + k) as usize - 1;
-        visit_turn(&mut points, &mut below, &mut path_of, local, base + k);
+        for m in 0..n {
+            visit(
+                &mut points,
+                order(m),
+                k as usize - 1,
+                base + k,
+                PointKind::Pass,
+            );
+        }
     }
     let rim = base + v.turns + 1;
-    for i in (0..n).map(|m| (v.start + m) % n) {
+    for i in (0..n).map(order) {
         if s.columns[i].top {
             let local = s.columns[i].passes as usize;
-            visit_column(
-                &mut points,
-                &mut below,
-                &mut path_of,
-                i,
-                local,
-                rim,
-                PointKind::Top,
-            );
+            visit(&mut points, i, local, rim, PointKind::Top);
         }
     }
     debug_assert!(
         path_of.iter().all(|&p| p != u32::MAX),
         "every sample is visited"
     );
-    let floor_area = if v.floor_layers > 0 {
-        ring_area(&base_ring)
-    } else {
-        0.0
+    let (floor_area, floor_cover, floor_turns) = match &floor {
+        Some(f) => (ring_area(&f.ring), f.cover, f.spiral.turns),
+        None => (0.0, 0.0, 0),
     };
     Toolpath {
         points,
@@ -346,14 +241,63 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
         stages: 1,
         returning_points: 0,
         vessel: Some(VesselPath {
-            floor_layers: v.floor_layers,
-            floor_rings: rings.len() as u32,
+            floor_layers: if floor.is_some() { v.floor_layers } else { 0 },
+            floor_turns,
             floor_area_mm2: floor_area,
+            floor_cover,
+            floor_top_mm: v.base_mm(),
             turns: v.turns,
-            joins,
-            narrow,
+            floor_widths,
         }),
     }
+}
+
+/// A floor laid out under a vessel's first turn.
+struct LaidFloor {
+    /// The first turn in plan, from the start column on.
+    ring: Vec<[f64; 2]>,
+    spiral: FloorSpiral,
+    cover: f64,
+}
+
+impl std::ops::Deref for LaidFloor {
+    type Target = FloorSpiral;
+    fn deref(&self) -> &FloorSpiral {
+        &self.spiral
+    }
+}
+
+/// The floor spiral inside the wall's first turn as corrected, from the
+/// start column on; if the corrections bent that turn past what one
+/// spiral fills, inside the turn as drawn (which sampling checked).
+fn vessel_floor(c: &Corrected, v: &VesselPlan) -> Option<LaidFloor> {
+    let s = &c.surface;
+    let n = s.columns.len();
+    let beads = floor_beads(&s.params, s.spacing);
+    let corrected: Vec<[f64; 2]> = (0..n)
+        .map(|m| {
+            let i = (v.start + m) % n;
+            let p = s.position(i, s.columns[i].first as usize);
+            [p[0], p[1]]
+        })
+        .collect();
+    let drawn: Vec<[f64; 2]> = (0..n)
+        .map(|m| {
+            let col = &s.columns[(v.start + m) % n];
+            let z = s.samples[col.first as usize].z;
+            let q = col.point(s.design_offset(col, z, 1.0), 0.0);
+            [q[0], q[1]]
+        })
+        .collect();
+    [corrected, drawn].into_iter().find_map(|ring| {
+        let spiral = spiral_floor(&ring, beads).ok()?;
+        let cover = coverage(&ring, &spiral, 0.5);
+        Some(LaidFloor {
+            ring,
+            spiral,
+            cover,
+        })
+    })
 }
 
 /// What the path of a vessel holds beyond its points.
@@ -361,22 +305,20 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
 pub struct VesselPath {
     /// Floor layers (0: bottomless).
     pub floor_layers: u32,
-    /// Inner rings of each floor layer (the base ring not counted).
-    pub floor_rings: u32,
-    /// Area inside the base ring (mm²), 0 for a bottomless vessel.
+    /// Turns of each floor layer's spiral.
+    pub floor_turns: u32,
+    /// Area inside the wall's first turn (mm²), 0 for a bottomless vessel.
     pub floor_area_mm2: f64,
+    /// The share of that area the floor's beads cover (0 to 1).
+    pub floor_cover: f64,
+    /// The top of the floor (mm): where the wall's first turn stands; 0
+    /// for a bottomless vessel.
+    pub floor_top_mm: f64,
     /// Spiral turns of the wall.
     pub turns: u32,
-    /// The points (in order) the move into which is a join: from one floor
-    /// element to the next, or between the floor and the base ring. It
-    /// runs across clay both already cover, so it carries almost no clay
-    /// (the extrusion stage's `JOIN_CLAY`).
-    pub joins: Vec<u32>,
-    /// The floor points (in order) laid at another width than the floor's
-    /// bead, and that width (mm): narrower where a thin ring's two sides
-    /// come closer than a pitch, wider along the line down a thin ring's
-    /// middle (`FloorRing::widths` in the floor module).
-    pub narrow: Vec<(u32, f64)>,
+    /// Every floor point (in order) and its bead width (mm): as wide as
+    /// its neighbouring turns' distance needs ([`crate::floor`]).
+    pub floor_widths: Vec<(u32, f64)>,
 }
 
 #[cfg(test)]

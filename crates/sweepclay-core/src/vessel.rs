@@ -1,37 +1,43 @@
 //! Vessels: a closed Ψ printed as a floor and a spiral wall in one
 //! continuous path (not in the paper; docs/ALGORITHMS.md §8).
 //!
-//! The layering ([`VesselPlan::choose`]) gives every column of the loop the
-//! same flat base layers (the floor's outer ring, or one ring for a
-//! bottomless vessel) and then the same number K of spiral turns: turn k
-//! visits column i of n at
+//! The layering ([`VesselPlan::choose`]) puts the floor's flat layers
+//! (none for a bottomless vessel) under K spiral turns of the wall: turn k
+//! visits column i of n, the f_i = (order(i) + 1)/n part of the way round
+//! from the start column, at
 //!
 //! ```text
-//! z = z_base + (k − 1 + (i + 1) / n) · δ_i,    δ_i = (h_i − z_base) / K
+//! z = z_floor + a + (k − 1 + f_i) · δ_i,    δ_i = (h_i − z_floor − a) / K
 //! ```
 //!
 //! so z rises along every turn with no seam, and a last, partial turn lays
-//! the rim level at h_i. The floor inside the base ring is filled by the
-//! elements of [`crate::floor`]; the path stage (`plan_vessel_path` in
-//! the toolpath module) joins them, layer by layer, into the path with no
-//! travel.
+//! the rim level at h_i. The first turn starts a full layer `a` above the
+//! floor (or the bed) and rises to a + δ over the loop, so it never closes
+//! over its own start at its own height and no bead sits on a gap near
+//! zero (a ≤ `layer_height`, and a + f_i δ_i ≤ `max_layer_height`).
+//! The floor inside the first turn is one spiral per layer
+//! ([`crate::floor`]); the path stage (`plan_vessel_path` in the toolpath
+//! module) lays it inward and outward in turn, so the last floor layer
+//! ends where the wall begins.
 
 use crate::design::{Params, COLLISION_MARGIN_MM};
 use crate::error::{Error, Result};
-#[cfg(test)]
-use crate::floor::FLOOR_OVERLAP;
-use crate::floor::{FloorBeads, FloorRing};
+use crate::floor::FloorBeads;
 
 /// The layering of a vessel.
 #[derive(Clone, Debug, PartialEq)]
 pub struct VesselPlan {
     /// Floor layers asked for (0: bottomless).
     pub floor_layers: u32,
-    /// Flat layers of the base ring under the spiral: the floor's layers,
-    /// or one ring for a bottomless vessel.
+    /// Flat layers under the spiral: the floor's (0 for a bottomless
+    /// vessel).
     pub base_layers: u32,
-    /// Height of each base layer (`layer_height`, mm).
+    /// Height of each floor layer (`layer_height`, mm).
     pub base_layer_mm: f64,
+    /// a: the first turn's height above the floor (or the bed) where it
+    /// starts (mm): `layer_height`, or less where the first turn's end,
+    /// a + δ above the floor, would pass `max_layer_height`.
+    pub first_mm: f64,
     /// K: spiral turns of the wall.
     pub turns: u32,
     /// The fewest turns that keep every layer within `max_layer_height`:
@@ -40,21 +46,15 @@ pub struct VesselPlan {
     pub fewest_turns: u32,
     /// Thinnest and thickest spiral layer δ_i round the loop (mm).
     pub turn_mm: [f64; 2],
-    /// The column each layer and turn begins at (the path's start in
-    /// plan, chosen near the floor's centre so the rings join by short
-    /// steps; docs/ALGORITHMS.md §8).
+    /// The column each turn begins at (where the floor's spiral ends
+    /// and the wall starts; docs/ALGORITHMS.md §8).
     pub start: usize,
-    /// The floor's rings as sampling found them, and the base ring they
-    /// fill: the path reuses them while the corrections leave that ring
-    /// as it was.
-    pub floor: FloorOf,
+    /// The columns' rims h_i (mm).
+    pub heights: Vec<f64>,
 }
 
-/// A base ring and the floor rings that fill it, if computed.
-pub type FloorOf = Option<(Vec<[f64; 2]>, Vec<FloorRing>)>;
-
 impl VesselPlan {
-    /// z_base: the top of the base layers (mm).
+    /// z_floor: the top of the floor's layers, 0 without (mm).
     pub fn base_mm(&self) -> f64 {
         f64::from(self.base_layers) * self.base_layer_mm
     }
@@ -65,15 +65,19 @@ impl VesselPlan {
     /// more than that allows, or more than the extruder body clears.
     pub fn choose(h: &[f64], params: &Params, floor_layers: u32) -> Result<VesselPlan> {
         let (dmin, dmax) = (params.layer_height, params.max_layer_height);
-        let base_layers = floor_layers.max(1);
+        let base_layers = floor_layers;
         let base = f64::from(base_layers) * dmin;
         let lo = h.iter().copied().fold(f64::INFINITY, f64::min);
         let hi = h.iter().copied().fold(0.0, f64::max);
-        if lo < base + dmin - 1e-9 {
+        // The first turn starts a layer up and ends two up; where two of
+        // the thinnest layers pass the thickest, it starts lower.
+        let a0 = dmin.min(dmax - dmin);
+        if lo < base + a0 + dmin - 1e-9 {
             return Err(Error::invalid(
                 "profile_start",
                 format!(
-                    "the vessel is {lo:.2} mm tall at its lowest, less than its {base_layers} base layer(s) ({base:.2} mm) and one turn of wall; make it taller or lower params.floor_layers"
+                    "the vessel is {lo:.2} mm tall at its lowest, less than its {base_layers} floor layer(s) ({base:.2} mm) and one turn of wall ({:.2} mm); make it taller or lower params.floor_layers",
+                    a0 + dmin
                 ),
             ));
         }
@@ -90,45 +94,70 @@ impl VesselPlan {
                 ),
             ));
         }
-        let most = ((lo - base) / dmin + 1e-9).floor() as u32;
-        let fewest = ((hi - base) / dmax - 1e-9).ceil().max(1.0) as u32;
+        let most = ((lo - base - a0) / dmin + 1e-9).floor() as u32;
+        let fewest = ((hi - base - a0) / dmax - 1e-9).ceil().max(1.0) as u32;
         if most < fewest {
             return Err(Error::invalid(
                 "params.max_layer_height",
                 format!(
-                    "the rim's height varies from {lo:.1} to {hi:.1} mm round the loop: no whole number of spiral turns keeps every layer between {dmin} and {dmax} mm (at most {most} turns of {dmin} mm on the low side, at least {fewest} of {dmax} mm on the high side); raise params.max_layer_height or bring the profiles' heights closer"
+                    "the rim's height varies from {lo:.1} to {hi:.1} mm round the loop: no whole number of spiral turns keeps every layer between {dmin} and {dmax} mm (at most {most} turns of {dmin} mm on the low side, at least {fewest} on the high side); raise params.max_layer_height or bring the profiles' heights closer"
                 ),
             ));
         }
-        let turns = most;
-        let k = f64::from(turns);
-        Ok(VesselPlan {
+        let plan = VesselPlan {
             floor_layers,
             base_layers,
             base_layer_mm: dmin,
-            turns,
+            first_mm: a0,
+            turns: most,
             fewest_turns: fewest,
-            turn_mm: [(lo - base) / k, (hi - base) / k],
+            turn_mm: [0.0, 0.0],
             start: 0,
-            floor: None,
-        })
+            heights: h.to_vec(),
+        };
+        Ok(plan.with(most, 0, params))
     }
 
     /// The same layering with `turns` spiral turns (between
-    /// [`VesselPlan::fewest_turns`] and the most `choose` found).
-    pub fn with_turns(&self, turns: u32) -> VesselPlan {
-        let scale = f64::from(self.turns) / f64::from(turns);
-        VesselPlan {
+    /// [`VesselPlan::fewest_turns`] and the most `choose` found) starting
+    /// at column `start`: the first turn's height `a` fitted so that its
+    /// end stays within `max_layer_height` of the floor.
+    pub fn with(&self, turns: u32, start: usize, params: &Params) -> VesselPlan {
+        let (dmin, dmax) = (params.layer_height, params.max_layer_height);
+        let mut v = VesselPlan {
             turns,
-            turn_mm: self.turn_mm.map(|d| d * scale),
+            start,
             ..self.clone()
-        }
+        };
+        let n = v.heights.len();
+        let base = v.base_mm();
+        let k = f64::from(turns);
+        // a + f_i (h_i − z_floor − a) / K ≤ dmax at every column, solved
+        // for a.
+        let a = (0..n)
+            .map(|i| {
+                let f = (v.order(i, n) + 1) as f64 / n as f64;
+                (dmax - f * (v.heights[i] - base) / k) / (1.0 - f / k)
+            })
+            .fold(dmin.min(dmax - dmin), f64::min);
+        v.first_mm = a;
+        let d = |h: f64| (h - base - a) / k;
+        let lo = v.heights.iter().copied().fold(f64::INFINITY, f64::min);
+        let hi = v.heights.iter().copied().fold(0.0, f64::max);
+        v.turn_mm = [d(lo), d(hi)];
+        v
+    }
+
+    /// Whether the first turn's start stands at least half the thinnest
+    /// layer above the floor (see [`VesselPlan::with`]).
+    pub fn first_fits(&self) -> bool {
+        self.first_mm >= 0.5 * self.base_layer_mm - 1e-9
     }
 
     /// The height of spiral turn `k` (1-based) at column `i` of `n`, whose
     /// rim is `h` (mm).
     pub fn spiral_z(&self, k: u32, i: usize, n: usize, h: f64) -> f64 {
-        let base = self.base_mm();
+        let base = self.base_mm() + self.first_mm;
         let d = (h - base) / f64::from(self.turns);
         base + (f64::from(k - 1) + (self.order(i, n) + 1) as f64 / n as f64) * d
     }
@@ -294,7 +323,7 @@ impl<'a> Neighbours<'a> {
 pub const BODY_GRAZE_MM: f64 = 0.2;
 
 /// The bead sizes of a vessel's floor from its parameters and the loop's
-/// sample spacing.
+/// sample spacing (docs/ALGORITHMS.md §8).
 pub fn floor_beads(params: &Params, spacing: f64) -> FloorBeads {
     FloorBeads {
         width: params.width_min,
@@ -359,25 +388,30 @@ mod tests {
     }
 
     #[test]
-    fn a_cylinder_is_a_helix_over_a_floor_of_rings() {
+    fn a_cylinder_is_a_helix_over_a_spiral_floor() {
         let s = cup(30.0, 40.0, 2);
         let t = &s.toolpath;
         let v = t.vessel.as_ref().unwrap();
-        // 40 mm: 2 floor layers of 1.25 mm, then 30 turns of 1.25 mm.
-        assert_eq!((v.floor_layers, v.turns), (2, 30));
-        // Rings 2.55 mm apart inside a base ring of radius 30.
-        assert_eq!(v.floor_rings, 11);
+        // 40 mm: 2 floor layers of 1.25 mm, the first turn a layer above
+        // them, then 1.25 mm a turn: (40 − 2.5 − 1.25) / 1.25 = 29 turns.
+        assert_eq!((v.floor_layers, v.turns), (2, 29));
+        // Turns 2.55 mm apart from 0.6 of one outside the first turn to
+        // half of one from the centre: (30 + 0.1 · 2.55) / 2.55 → 11.
+        assert_eq!(v.floor_turns, 11);
         let wall: Vec<&PathPoint> = t
             .points
             .iter()
-            .filter(|p| p.kind == PointKind::Pass && p.pos[2] > 2.5 + 1e-9)
+            .filter(|p| p.kind == PointKind::Pass)
             .collect();
         let per_turn = s.corrected.surface.columns.len() as f64;
+        // The wall starts a layer above the floor, not on it.
+        let z0 = wall[0].pos[2];
+        assert!((z0 - (2.5 + 1.25 + 1.25 / per_turn)).abs() < 1e-9, "{z0}");
         for w in wall.windows(2) {
             let (a, b) = (w[0].pos, w[1].pos);
             // On the cylinder (the polygon's points are within 0.01 mm)...
             assert!((a[0].hypot(a[1]) - 30.0).abs() < 0.02, "{a:?}");
-            // ... rising one pitch a turn: 1.25 mm over the loop.
+            // ... rising one layer a turn: 1.25 mm over the loop.
             let rise = b[2] - a[2];
             assert!((rise - 1.25 / per_turn).abs() < 1e-9, "{rise}");
         }
@@ -393,93 +427,48 @@ mod tests {
     fn the_floor_covers_the_inside_of_the_loop() {
         for r in [12.0, 30.0, 55.0] {
             let s = cup(r, 20.0, 1);
-            let t = &s.toolpath;
-            // Each floor bead covers the pitch across and the spacing
-            // along; the base ring covers half a pitch inward.
-            let pitch = 3.0 * (1.0 - FLOOR_OVERLAP);
-            let floor: f64 = t
-                .points
-                .windows(2)
-                .filter(|w| w[1].kind == PointKind::Floor && w[0].kind == PointKind::Floor)
-                .map(|w| {
-                    let (a, b) = (w[0].pos, w[1].pos);
-                    (a[0] - b[0])
-                        .hypot(a[1] - b[1])
-                        .min(2.0 * s.corrected.surface.spacing)
-                })
-                .sum::<f64>()
-                * pitch;
-            let base = std::f64::consts::TAU * r * pitch / 2.0;
-            let inside = std::f64::consts::PI * r * r;
-            let covered = (floor + base) / inside;
-            assert!((covered - 1.0).abs() < 0.02, "r = {r}: {covered}");
-            // Every point inside lies under a bead: within half a bead
-            // width of a floor or base-ring point (points 1.1 mm apart).
-            let beads: Vec<[f64; 3]> = t
-                .points
-                .iter()
-                .filter(|p| p.pos[2] < 1.3)
-                .map(|p| p.pos)
-                .collect();
-            let (mut inside, mut under) = (0, 0);
-            for gx in -60..=60 {
-                for gy in -60..=60 {
-                    let q = [gx as f64, gy as f64];
-                    if q[0].hypot(q[1]) > r {
-                        continue;
-                    }
-                    inside += 1;
-                    let reach = 1.5f64.hypot(0.55);
-                    if beads
-                        .iter()
-                        .any(|b| (b[0] - q[0]).hypot(b[1] - q[1]) <= reach)
-                    {
-                        under += 1;
-                    }
-                }
+            let v = s.toolpath.vessel.as_ref().unwrap();
+            assert!(v.floor_cover >= 0.97, "r = {r}: {}", v.floor_cover);
+            // Its beads are between the thinnest and the widest.
+            for &(_, w) in &v.floor_widths {
+                assert!((3.0..=6.0).contains(&w), "r = {r}: {w}");
             }
-            assert!(
-                under as f64 >= 0.98 * inside as f64,
-                "r = {r}: {under} of {inside}"
-            );
         }
     }
 
     #[test]
-    fn a_bottomless_vessel_stands_on_one_ring() {
+    fn a_bottomless_vessel_starts_its_first_turn_a_layer_up() {
         let s = cup(30.0, 20.0, 0);
         let t = &s.toolpath;
         assert!(t.points.iter().all(|p| p.kind != PointKind::Floor));
-        assert_eq!(t.vessel.as_ref().unwrap().floor_rings, 0);
-        assert_eq!(t.points[0].pos[2], 1.25);
+        assert_eq!(t.vessel.as_ref().unwrap().floor_turns, 0);
+        let n = s.corrected.surface.columns.len() as f64;
+        assert!((t.points[0].pos[2] - (1.25 + 1.25 / n)).abs() < 1e-9);
     }
 
     #[test]
-    fn the_base_ring_closes_at_its_own_height() {
+    fn no_turn_closes_over_its_own_start_at_its_own_height() {
         for floor in [0, 2] {
             let s = cup(30.0, 20.0, floor);
             let (t, e) = (&s.toolpath, &s.extrusion);
-            let z_base = 1.25 * f64::from(floor.max(1));
-            // The spiral's first point, barely above the base ring...
-            let i = t
+            let n = s.corrected.surface.columns.len();
+            let first = t
                 .points
                 .iter()
-                .position(|p| p.pos[2] > z_base + 1e-9)
+                .position(|p| p.kind == PointKind::Pass)
                 .unwrap();
-            // ... comes after the ring's first point again, at the ring's
-            // height, so the ring's closing bead is a whole ring bead.
-            let (close, ring) = (&t.points[i - 1], &t.points[i - 2]);
-            assert_eq!(close.pos[2], z_base);
-            assert_eq!(e.layer_height[i - 1], 1.25);
-            let per_mm = |k: usize| {
-                let (a, b) = (t.points[k - 1].pos, t.points[k].pos);
-                e.volume[k] / (a[0] - b[0]).hypot(a[1] - b[1])
-            };
-            assert!((per_mm(i - 1) - per_mm(i - 2)).abs() < 1e-6 * per_mm(i - 2));
-            assert_eq!(ring.pos[2], z_base);
-            // From there the spiral only rises.
-            let (a, b) = (close.pos, t.points[i].pos);
-            assert!((a[0] - b[0]).hypot(a[1] - b[1]) < 1e-9, "{a:?} {b:?}");
+            // The first turn ends a whole layer above where it began, on
+            // a layer twice as thick: 1.25 → 2.5 mm over the floor.
+            let (a, b) = (t.points[first].pos, t.points[first + n - 1].pos);
+            assert!((b[2] - a[2] - 1.25 * (n - 1) as f64 / n as f64).abs() < 1e-9);
+            assert!((e.layer_height[first] - 1.25 * (1.0 + 1.0 / n as f64)).abs() < 1e-9);
+            assert!((e.layer_height[first + n - 1] - 2.5).abs() < 1e-9);
+            // Every later wall bead lies a layer over the one below.
+            for i in first + n..t.points.len() {
+                if t.points[i].kind == PointKind::Pass {
+                    assert!((e.layer_height[i] - 1.25).abs() < 1e-9);
+                }
+            }
         }
     }
 
@@ -487,11 +476,28 @@ mod tests {
     fn spiral_heights_rise_one_layer_a_turn() {
         let p = Params::default();
         let v = VesselPlan::choose(&[50.0; 10], &p, 2).unwrap();
-        // 47.5 mm above the floor in 38 turns of 1.25 mm.
-        assert_eq!((v.base_layers, v.turns), (2, 38));
-        assert!((v.spiral_z(1, 9, 10, 50.0) - 3.75).abs() < 1e-12);
-        assert!((v.spiral_z(38, 9, 10, 50.0) - 50.0).abs() < 1e-12);
+        // 46.25 mm above the floor and the first layer in 37 turns.
+        assert_eq!((v.base_layers, v.turns), (2, 37));
+        assert!((v.first_mm - 1.25).abs() < 1e-12);
+        assert!((v.spiral_z(1, 9, 10, 50.0) - 5.0).abs() < 1e-12);
+        assert!((v.spiral_z(37, 9, 10, 50.0) - 50.0).abs() < 1e-12);
         assert!((v.spiral_z(2, 0, 10, 50.0) - v.spiral_z(1, 0, 10, 50.0) - 1.25).abs() < 1e-12);
+    }
+
+    #[test]
+    fn thick_thinnest_layers_start_the_first_turn_lower() {
+        // 2 mm layers, at most 3.75: the first turn cannot start 2 mm up
+        // and end 4 mm up; it starts 1.75 mm up.
+        let p = Params {
+            layer_height: 2.0,
+            max_layer_height: 3.75,
+            ..Params::default()
+        };
+        let v = VesselPlan::choose(&[60.0; 10], &p, 2).unwrap();
+        assert!(v.first_mm <= 1.75 + 1e-9, "{}", v.first_mm);
+        let top_of_first = v.spiral_z(1, 9, 10, 60.0) - v.base_mm();
+        assert!(top_of_first <= 3.75 + 1e-9, "{top_of_first}");
+        assert!(v.turn_mm[0] >= 2.0 - 1e-9);
     }
 
     #[test]
@@ -532,8 +538,8 @@ mod tests {
             .map(|i| 40.0 + 4.0 * (1.0 - (std::f64::consts::TAU * i as f64 / n as f64).cos()))
             .collect();
         let p = Params::default();
-        let mut v = VesselPlan::choose(&h, &p, 2).unwrap();
-        v.start = n / 4;
+        let v = VesselPlan::choose(&h, &p, 2).unwrap();
+        let v = v.with(v.turns, n / 4, &p);
         let near = Neighbours::new(&pts, 5.0 + 3.0);
         let spacing = std::f64::consts::TAU * 40.0 / n as f64;
         let exempt = ((5.0 + 6.0) / spacing) as usize;

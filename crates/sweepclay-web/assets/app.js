@@ -769,7 +769,9 @@ function render(data, fit) {
     ['transition curves', s.curves.toLocaleString('en')],
     ...(s.vessel
       ? [
-        ['floor', `${s.vessel.floor_layers} layers × ${s.vessel.floor_rings} rings, ${s.vessel.floor_area_cm2.toFixed(1)} cm²`],
+        ['floor', s.vessel.floor_layers > 0
+          ? `${s.vessel.floor_layers} layers, each a spiral of ${s.vessel.floor_turns} turns, ${s.vessel.floor_area_cm2.toFixed(1)} cm² (${s.vessel.floor_cover_pct.toFixed(1)} % covered)`
+          : 'none (bottomless)'],
         ['wall', `${s.vessel.wall_turns} spiral turns + rim`],
       ]
       : [
