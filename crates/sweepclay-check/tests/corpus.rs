@@ -120,7 +120,11 @@ fn each_hand_made_fault_fails_for_its_fault() {
             "overhang",
             // The jog onto the shifted half runs 4.5 mm on the clay of a
             // 2 mm bead, over the pass two layers down: under-extruded.
-            &["overlapping the bead below", "farther below", "under-extruded"][..],
+            &[
+                "overlapping the bead below",
+                "farther below",
+                "under-extruded",
+            ][..],
         ),
         (
             "fault-twice.gcode",

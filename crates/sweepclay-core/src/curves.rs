@@ -265,6 +265,12 @@ pub struct Trajectory {
 /// other (docs/ALGORITHMS.md §4).
 pub const SHARPEST_CORNER_DEG: f64 = 60.0;
 
+/// Corners of a closed Ψ (a vessel) sharper than this are rounded too:
+/// at an acute corner the floor's turns, offsets of the wall's line, lie
+/// farther from the corner's tip than the wall's first turn can lean
+/// over (docs/ALGORITHMS.md §8).
+pub const SHARPEST_VESSEL_CORNER_DEG: f64 = 90.0;
+
 /// A sharp corner of a polyline Ψ, rounded by a circular arc tangent to
 /// both arms (docs/ALGORITHMS.md §4).
 #[derive(Clone, Debug, PartialEq, serde::Serialize)]
@@ -282,7 +288,8 @@ pub struct CornerFix {
 }
 
 /// A polyline (`closed`: its last vertex joins its first, not repeated)
-/// with every corner sharper than [`SHARPEST_CORNER_DEG`] replaced by an
+/// with every corner sharper than [`SHARPEST_CORNER_DEG`] (a loop's:
+/// [`SHARPEST_VESSEL_CORNER_DEG`]) replaced by an
 /// arc of points about `step` apart, and the corners it rounded. `bead`
 /// is the widest bead the wall lays.
 pub fn round_corners(
@@ -291,9 +298,14 @@ pub fn round_corners(
     bead: f64,
     step: f64,
 ) -> (Vec<[f64; 2]>, Vec<CornerFix>) {
+    let sharpest = if closed {
+        SHARPEST_VESSEL_CORNER_DEG
+    } else {
+        SHARPEST_CORNER_DEG
+    };
     round_corners_by(v, closed, step, |_, theta| {
         let half = 0.5 * theta;
-        (theta.to_degrees() < SHARPEST_CORNER_DEG).then(|| 1.1 * bead / (2.0 * half.cos()))
+        (theta.to_degrees() < sharpest - 1e-9).then(|| 1.1 * bead / (2.0 * half.cos()))
     })
 }
 

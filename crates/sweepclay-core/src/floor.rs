@@ -15,9 +15,10 @@
 //! closes on itself, and the spiral ends half a pitch from the spine, so
 //! the beads beside the spine cover it.
 //!
-//! The outermost turn runs from 0.6 pitch outside the polygon to 0.4
-//! inside: the wall's first turn, standing on the polygon, then rests on
-//! floor clay with at least two thirds of a bead width all round.
+//! The outermost turn runs from half a pitch outside the polygon to half
+//! a pitch inside: the wall's first turn, standing on the polygon, then
+//! has a floor bead within half a pitch of its middle all round, and
+//! rests on it with more than half its width.
 //!
 //! Each bead is as wide as its neighbours' mean distance needs for them
 //! to touch with [`FLOOR_OVERLAP`], within `[width, widest]`. A region so
@@ -40,8 +41,8 @@ pub use crate::design::FLOOR_OVERLAP;
 pub const MIN_GAP: f64 = 0.85;
 
 /// Where the outermost turn starts, in pitches outside the polygon (it
-/// ends one pitch further in, 0.4 inside).
-pub const OUTER_START: f64 = 0.75;
+/// ends one pitch further in, half a pitch inside).
+pub const OUTER_START: f64 = 0.5;
 
 /// Most turns a floor may have (a floor 5 m across at 3 mm beads, far
 /// beyond any printer; the sample cap refuses such designs first): bounds
@@ -863,19 +864,19 @@ mod tests {
             (sp[0][0] - sp[1][0]).hypot(sp[0][1] - sp[1][1]) < 1.0,
             "spine {sp:?}"
         );
-        // Turns: (r + 0.1 p) / p whole ones, each exactly that far in.
-        let expect = ((r + 0.1 * p) / p).floor();
+        // Turns: r / p whole ones, each exactly that far in.
+        let expect = (r / p).floor();
         assert_eq!(f64::from(s.turns), expect);
-        let q = (r + 0.1 * p) / expect;
+        let q = r / expect;
         assert!(
             (s.min_gap - q).abs() < 0.05 * q && (s.max_gap - q).abs() < 0.05 * q,
             "gaps {}–{} mm, expected {q:.3}",
             s.min_gap,
             s.max_gap
         );
-        // An Archimedean spiral from r + 0.6 p to 0.5 p: its length is
-        // the area it sweeps over its pitch, π (R² − r²) / q.
-        let (outer_r, inner_r) = (r + 0.6 * p, 0.5 * p);
+        // An Archimedean spiral from r + p/2 to p/2: its length is the
+        // area it sweeps over its pitch, π (R² − r²) / q.
+        let (outer_r, inner_r) = (r + 0.5 * p, 0.5 * p);
         let closed = std::f64::consts::PI * (outer_r * outer_r - inner_r * inner_r) / q;
         let l = length(&s);
         assert!(

@@ -186,12 +186,12 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
         // first bead on the floor's edge (a step up a slope would be read
         // as a thin bead under the wall's first).
         let first = s.position(order(0), s.columns[order(0)].first as usize);
-        below.push(None);
+        below.push(Some(points.len() as u32 - 1));
         points.push(PathPoint {
             pos: [last.pos[0], last.pos[1], first[2]],
             column: order(0) as u32,
-            pass: v.base_layers + 1,
-            kind: PointKind::Pass,
+            pass: v.base_layers,
+            kind: PointKind::Floor,
         });
     }
     let mut path_of = vec![u32::MAX; s.samples.len()];

@@ -395,8 +395,8 @@ mod tests {
         // 40 mm: 2 floor layers of 1.25 mm, the first turn a layer above
         // them, then 1.25 mm a turn: (40 − 2.5 − 1.25) / 1.25 = 29 turns.
         assert_eq!((v.floor_layers, v.turns), (2, 29));
-        // Turns 2.55 mm apart from 0.6 of one outside the first turn to
-        // half of one from the centre: (30 + 0.1 · 2.55) / 2.55 → 11.
+        // Turns 2.55 mm apart from half of one outside the first turn to
+        // half of one from the centre: 30 / 2.55 → 11.
         assert_eq!(v.floor_turns, 11);
         let wall: Vec<&PathPoint> = t
             .points

@@ -191,7 +191,8 @@ fn floor_coverage(s: &sweepclay_core::Sliced) -> f64 {
     let mut segs = Vec::new();
     for i in 1..t.points.len() {
         let (a, b) = (t.points[i - 1].pos, t.points[i].pos);
-        let floor = t.points[i].kind == PointKind::Floor && t.points[i - 1].kind == PointKind::Floor;
+        let floor =
+            t.points[i].kind == PointKind::Floor && t.points[i - 1].kind == PointKind::Floor;
         if floor && a[2] <= z1 && b[2] <= z1 {
             let w = 0.5 * (s.extrusion.width[i - 1] + s.extrusion.width[i]);
             segs.push(([a[0], a[1]], [b[0], b[1]], w));
@@ -302,29 +303,42 @@ fn a_peanut_pot_gets_one_spiral_floor_and_prints() {
     // Two lobes joined by a waist: its offsets split into two islands,
     // the rays to a spine along its length do not. One spiral a layer,
     // and the whole pot is one path the checker passes.
-    let pts: Vec<[f64; 2]> = (0..48)
-        .map(|i| {
-            let a = std::f64::consts::TAU * i as f64 / 48.0;
-            [
-                55.0 * a.cos(),
-                32.0 * a.sin() * (0.35 + 0.65 * a.cos().abs()),
-            ]
-        })
-        .collect();
-    let d = Design::from_json(
-        &serde_json::json!({
-            "sweepclay": 1,
-            "profile_start": { "control_points": [[0.0, 0.0], [0.0, 40.0]] },
-            "trajectory": { "control_points": pts, "closed": true, "offset": "normal" },
-            "params": { "floor_layers": 3 },
-            "printer": "cerambot-plus",
-        })
-        .to_string(),
-    )
-    .unwrap();
-    let s = slice(&d).unwrap();
+    let peanut = |waist: f64| {
+        let pts: Vec<[f64; 2]> = (0..48)
+            .map(|i| {
+                let a = std::f64::consts::TAU * i as f64 / 48.0;
+                [
+                    55.0 * a.cos(),
+                    32.0 * a.sin() * (waist + (1.0 - waist) * a.cos().abs()),
+                ]
+            })
+            .collect();
+        Design::from_json(
+            &serde_json::json!({
+                "sweepclay": 1,
+                "profile_start": { "control_points": [[0.0, 0.0], [0.0, 40.0]] },
+                "trajectory": { "control_points": pts, "closed": true, "offset": "normal" },
+                "params": { "floor_layers": 3 },
+                "printer": "cerambot-plus",
+            })
+            .to_string(),
+        )
+        .unwrap()
+    };
+    let s = slice(&peanut(0.6)).unwrap();
     let v = s.toolpath.vessel.as_ref().expect("a vessel");
     assert!(v.floor_cover >= 0.97, "{}", v.floor_cover);
     let r = common::check_full(&s);
     assert!(r.printable, "{}", r.render());
+    assert_eq!(r.support.on_clay, 0, "{}", r.render());
+    // A waist a third of the lobes: one spiral still, or refused naming
+    // the floor and the way out.
+    match slice(&peanut(0.35)) {
+        Ok(s) => assert!(common::check_full(&s).printable),
+        Err(e) => {
+            let e = e.to_string();
+            assert!(e.contains("spiral fills the floor"), "{e}");
+            assert!(e.contains("floor_layers = 0"), "{e}");
+        }
+    }
 }
