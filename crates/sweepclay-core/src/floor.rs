@@ -133,6 +133,18 @@ impl std::fmt::Display for FloorRefusal {
 /// first, running against the polygon's order (so the same path reversed,
 /// run outward, ends at point 0 heading along the polygon's order).
 pub fn spiral_floor(outer: &[[f64; 2]], beads: FloorBeads) -> Result<FloorSpiral, FloorRefusal> {
+    spiral_floor_covering(outer, beads, MIN_COVER)
+}
+
+/// [`spiral_floor`], taking the spiral that covers most of the region
+/// whenever it covers at least `min_cover` of it (0: any spiral whose
+/// turns keep their distance; the path stage lays the best there is
+/// where the corrections bent the outline after sampling checked it).
+pub fn spiral_floor_covering(
+    outer: &[[f64; 2]],
+    beads: FloorBeads,
+    min_cover: f64,
+) -> Result<FloorSpiral, FloorRefusal> {
     let n = outer.len();
     let pitch = beads.pitch();
     if n < 3 || signed_area2(outer).abs() < 1e-9 {
@@ -186,7 +198,7 @@ pub fn spiral_floor(outer: &[[f64; 2]], beads: FloorBeads) -> Result<FloorSpiral
         }
     }
     match best {
-        Some((cover, m)) if cover >= MIN_COVER => Ok(m.spiral),
+        Some((cover, m)) if cover >= min_cover => Ok(m.spiral),
         Some((_, m)) => Err(FloorRefusal::Uneven {
             at: m.farthest.0,
             gap: m.farthest.1,

@@ -530,7 +530,7 @@ fn clear_layering(
     for turns in (v.fewest_turns..=v.turns).rev() {
         for &st in starts {
             let w = v.with(turns, st, params);
-            if w.first_fits() && w.body_violation(near, heights, exempt).is_none() {
+            if w.first_fits(params) && w.body_violation(near, heights, exempt).is_none() {
                 return Ok(w);
             }
         }
@@ -587,6 +587,17 @@ fn sample_vessel(
     // clears, from the first start whose seam it clears; where a rim rises
     // and falls, thicker layers keep the turn below out of its way.
     match clear_layering(&v, &starts, &near, &heights, exempt, &params) {
+        Ok(clear) if !clear.first_fits(&params) => {
+            return Err(Error::invalid(
+                "params.max_layer_height",
+                format!(
+                    "the rim's height varies from {:.1} to {:.1} mm round the loop: the wall's first turn, starting a layer above the floor, would end more than {} mm above it wherever it starts; raise params.max_layer_height or bring the profiles' heights closer",
+                    clear.heights.iter().copied().fold(f64::INFINITY, f64::min),
+                    clear.heights.iter().copied().fold(0.0, f64::max),
+                    params.max_layer_height
+                ),
+            ))
+        }
         Ok(clear) => v = clear,
         Err((i, over)) => {
             let c = &columns[i];

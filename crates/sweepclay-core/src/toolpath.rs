@@ -10,7 +10,7 @@
 //! turn. Every sample is visited exactly once.
 
 use crate::correct::Corrected;
-use crate::floor::{coverage, ring_area, spiral_floor, FloorSpiral};
+use crate::floor::{coverage, ring_area, spiral_floor_covering, FloorSpiral, MIN_COVER};
 use crate::vessel::{floor_beads, VesselPlan};
 use serde::Serialize;
 
@@ -269,7 +269,8 @@ impl std::ops::Deref for LaidFloor {
 
 /// The floor spiral inside the wall's first turn as corrected, from the
 /// start column on; if the corrections bent that turn past what one
-/// spiral fills, inside the turn as drawn (which sampling checked).
+/// spiral fills, inside the turn as drawn (which sampling checked); else
+/// the best spiral inside the corrected turn, its cover reported.
 fn vessel_floor(c: &Corrected, v: &VesselPlan) -> Option<LaidFloor> {
     let s = &c.surface;
     let n = s.columns.len();
@@ -289,8 +290,13 @@ fn vessel_floor(c: &Corrected, v: &VesselPlan) -> Option<LaidFloor> {
             [q[0], q[1]]
         })
         .collect();
-    [corrected, drawn].into_iter().find_map(|ring| {
-        let spiral = spiral_floor(&ring, beads).ok()?;
+    let rings = [
+        (corrected.clone(), MIN_COVER),
+        (drawn, MIN_COVER),
+        (corrected, 0.0),
+    ];
+    rings.into_iter().find_map(|(ring, min_cover)| {
+        let spiral = spiral_floor_covering(&ring, beads, min_cover).ok()?;
         let cover = coverage(&ring, &spiral, 0.5);
         Some(LaidFloor {
             ring,

@@ -149,9 +149,11 @@ impl VesselPlan {
     }
 
     /// Whether the first turn's start stands at least half the thinnest
-    /// layer above the floor (see [`VesselPlan::with`]).
-    pub fn first_fits(&self) -> bool {
+    /// layer above the floor (see [`VesselPlan::with`]) and no turn is
+    /// thicker than `max_layer_height`.
+    pub fn first_fits(&self, params: &Params) -> bool {
         self.first_mm >= 0.5 * self.base_layer_mm - 1e-9
+            && self.turn_mm[1] <= params.max_layer_height + 1e-9
     }
 
     /// The height of spiral turn `k` (1-based) at column `i` of `n`, whose
