@@ -781,8 +781,8 @@ impl<'a> Checker<'a> {
     /// than a `w_min`-wide bead of `min_layer_mm` a millimetre, over at
     /// least `w_min`): a pass laid again, or the step from one ring of a
     /// floor to the next laid as a full bead over both (docs/CHECKER.md,
-    /// "Clay on clay"). A join carrying next to no clay across them, of
-    /// any length, is a smear, not a bead on a bead.
+    /// "Clay on clay"). A move carrying next to no clay across them fails
+    /// as under-extruded instead (docs/CHECKER.md, "Under-extruded moves").
     ///
     /// A *ramp* is neither: a stretch whose gap only grows, by at least
     /// half the thinnest layer, and that the path leaves by a bead resting
@@ -802,9 +802,8 @@ impl<'a> Checker<'a> {
         if ramp {
             return;
         }
-        // Either way its excess must be a bead's clay: a join laid with
-        // next to no clay across a floor's rings, however long, is a
-        // smear, not a bead on a bead.
+        // Either way its excess must be a bead's clay: a move with next
+        // to no clay is judged as under-extruded, not here.
         let bead = cfg.width_min * cfg.min_layer_mm * st.length.max(cfg.width_min);
         if st.excess > 0.75 * st.volume && st.excess > bead && st.length >= 0.75 * cfg.width_min {
             self.record(Finding::DoubleDeposition, st.first_line, st.excess, false);
@@ -1006,7 +1005,7 @@ impl<'a> Checker<'a> {
                 } else {
                     // No gap to measure it by: as wide as its clay would
                     // be on the thinnest layer, at most the widest bead (a
-                    // join carrying next to no clay is a smear, not a bead).
+                    // move carrying next to no clay reads as under-extruded).
                     width = (volume / (len * cfg.min_layer_mm)).min(cfg.width_max);
                 }
             }
@@ -1023,8 +1022,8 @@ impl<'a> Checker<'a> {
                     width = volume / (len * dz);
                     // Taller than wide over the clay it rests on: the
                     // bead does not stand (docs/CHECKER.md, "Layer gaps").
-                    // A stub (a blob joined to the bead before) and a
-                    // smear carry no bead of their own; a bead climbing
+                    // A stub (a blob joined to the bead before) carries no
+                    // bead of its own; a bead climbing
                     // a thinnest layer or more climbs from the clay it
                     // was just laid on (a finishing pass, a sloping edge).
                     // A thin bead (a floor's narrowed tail between its

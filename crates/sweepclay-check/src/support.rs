@@ -440,9 +440,10 @@ pub(crate) fn follow_support(
     Some(best)
 }
 
-/// Whether a bead `width` mm wide is a smear of clay: under a quarter of
-/// `w_min`, it holds nothing up, is no clay to be laid on, and is not
-/// judged itself (docs/CHECKER.md, "Clay on clay").
+/// Whether a bead `width` mm wide is a wisp of clay: under a quarter of
+/// `w_min`, it holds nothing up and is no clay to be laid on; in the
+/// print it fails as under-extruded (docs/CHECKER.md, "Under-extruded
+/// moves").
 pub(crate) fn is_smear(width: f64, cfg: &CheckConfig) -> bool {
     width < 0.25 * cfg.width_min
 }
