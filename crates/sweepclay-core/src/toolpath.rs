@@ -23,7 +23,7 @@ pub enum PointKind {
     /// A top-edge bead laid by a returning turn; in a vessel, a bead of
     /// the last turn, which lays the rim level.
     Top,
-    /// A bead of a vessel's floor inside its base ring (not a surface
+    /// A bead of a vessel's floor inside its first turn (not a surface
     /// sample).
     Floor,
 }
