@@ -8,7 +8,8 @@
 //! `cargo bench -p sweepclay-core -- stages/t1`, `-- scaling`, `-- gcode_floor`,
 //! `-- bspline` (B-spline evaluation from 10 to 100,000 control points),
 //! `-- textures` (a 44k-sample vase, plain, with ripple and flutes, and
-//! twisted too: docs/ALGORITHMS.md §11).
+//! twisted too: docs/ALGORITHMS.md §11), `-- floor` (the floor spiral in
+//! circles and ovals of growing size: docs/ALGORITHMS.md §8).
 //! `SWEEPCLAY_BENCH_MAX=1000000` stops the scaling series at 1 million.
 
 use criterion::{criterion_group, criterion_main, BatchSize, BenchmarkId, Criterion, Throughput};
@@ -219,8 +220,43 @@ fn textures_bench(c: &mut Criterion) {
     g.finish();
 }
 
+/// The floor spiral alone (docs/ALGORITHMS.md §8) inside circles and
+/// 10:7 ovals of growing size, points 1.1 mm apart: its cost against the
+/// area over the pitch (the throughput is that, in mm² / pitch).
+fn floor_bench(c: &mut Criterion) {
+    use sweepclay_core::floor::{spiral_floor, FloorBeads};
+    let beads = FloorBeads {
+        width: 3.0,
+        spacing: 1.1,
+        widest: 6.0,
+    };
+    let mut g = c.benchmark_group("floor");
+    for (name, a, b) in [
+        ("circle_25", 25.0, 25.0),
+        ("circle_50", 50.0, 50.0),
+        ("circle_100", 100.0, 100.0),
+        ("oval_50x35", 50.0, 35.0),
+        ("oval_100x70", 100.0, 70.0),
+    ] {
+        let n = (std::f64::consts::PI * (a + b) / 1.1) as usize;
+        let ring: Vec<[f64; 2]> = (0..n)
+            .map(|i| {
+                let t = std::f64::consts::TAU * i as f64 / n as f64;
+                [a * t.cos(), b * t.sin()]
+            })
+            .collect();
+        let area_over_pitch = std::f64::consts::PI * a * b / beads.pitch();
+        g.throughput(Throughput::Elements(area_over_pitch as u64));
+        g.bench_function(name, |bch| {
+            bch.iter(|| spiral_floor(black_box(&ring), beads).unwrap())
+        });
+    }
+    g.finish();
+}
+
 criterion_group!(
     benches,
+    floor_bench,
     textures_bench,
     examples_bench,
     gcode_floor,

@@ -156,8 +156,13 @@ pub fn spiral_floor_covering(
     // wins.
     let mut candidates: Vec<Measured> = Vec::new();
     let mut even: Option<(f64, Measured)> = None;
-    for spine in spines(outer) {
-        let rays = rays_to(outer, spine);
+    let families = spines(outer).into_iter().flat_map(|spine| {
+        [
+            (spine, rays_to(outer, spine)),
+            (spine, normal_rays_to(outer, spine)),
+        ]
+    });
+    for (spine, rays) in families {
         let span = |r: &Ray| r.len + (OUTER_START - 0.5) * pitch;
         let short = rays.iter().map(span).fold(f64::INFINITY, f64::min);
         if short < pitch {
@@ -541,17 +546,10 @@ fn spines(outer: &[[f64; 2]]) -> Vec<[[f64; 2]; 2]> {
 /// The rays from each polygon point to its nearest point on the spine.
 fn rays_to(outer: &[[f64; 2]], spine: [[f64; 2]; 2]) -> Vec<Ray> {
     let [a, b] = spine;
-    let ab = [b[0] - a[0], b[1] - a[1]];
-    let l2 = ab[0] * ab[0] + ab[1] * ab[1];
     outer
         .iter()
         .map(|&p| {
-            let t = if l2 > 0.0 {
-                (((p[0] - a[0]) * ab[0] + (p[1] - a[1]) * ab[1]) / l2).clamp(0.0, 1.0)
-            } else {
-                0.0
-            };
-            let foot = [a[0] + t * ab[0], a[1] + t * ab[1]];
+            let foot = project(p, a, b);
             let d = [foot[0] - p[0], foot[1] - p[1]];
             let len = d[0].hypot(d[1]);
             let dir = if len > 0.0 {
@@ -579,6 +577,58 @@ fn rays_to(outer: &[[f64; 2]], spine: [[f64; 2]; 2]) -> Vec<Ray> {
             let normal = [-t[1] * sign / tl, t[0] * sign / tl];
             r.cos = (r.dir[0] * normal[0] + r.dir[1] * normal[1]).max(0.3);
             r
+        })
+        .collect()
+}
+
+/// The rays from each polygon point along its inward normal to where
+/// that meets the spine (clamped to the spine's ends; the nearest point
+/// where the normal runs along the spine or away from it): straight
+/// normals keep neighbouring turns square to the outline a pitch apart
+/// where a region pinches at a waist, where rays to the nearest point of
+/// the spine slant across the turns.
+fn normal_rays_to(outer: &[[f64; 2]], spine: [[f64; 2]; 2]) -> Vec<Ray> {
+    let nearest = rays_to(outer, spine);
+    let n = outer.len();
+    let sign = if signed_area2(outer) > 0.0 { 1.0 } else { -1.0 };
+    let [a, b] = spine;
+    let e = [b[0] - a[0], b[1] - a[1]];
+    let el = e[0].hypot(e[1]);
+    (0..n)
+        .map(|i| {
+            let p = outer[i];
+            let (u, v) = (outer[(i + n - 1) % n], outer[(i + 1) % n]);
+            let t = [v[0] - u[0], v[1] - u[1]];
+            let tl = t[0].hypot(t[1]).max(1e-12);
+            let normal = [-t[1] * sign / tl, t[0] * sign / tl];
+            if el < 1e-9 {
+                return nearest[i];
+            }
+            // p + s·normal = a + w·e, for s and w.
+            let det = normal[0] * (-e[1]) - normal[1] * (-e[0]);
+            if det.abs() < 1e-9 * el {
+                return nearest[i];
+            }
+            let d = [a[0] - p[0], a[1] - p[1]];
+            let s_along = (d[0] * (-e[1]) - d[1] * (-e[0])) / det;
+            let w = (normal[0] * d[1] - normal[1] * d[0]) / det;
+            if s_along <= 0.0 {
+                return nearest[i];
+            }
+            let w = w.clamp(0.0, 1.0);
+            let foot = [a[0] + w * e[0], a[1] + w * e[1]];
+            let dd = [foot[0] - p[0], foot[1] - p[1]];
+            let len = dd[0].hypot(dd[1]);
+            if len < 1e-9 {
+                return nearest[i];
+            }
+            let dir = [dd[0] / len, dd[1] / len];
+            Ray {
+                from: p,
+                dir,
+                len,
+                cos: (dir[0] * normal[0] + dir[1] * normal[1]).max(0.3),
+            }
         })
         .collect()
 }
@@ -781,14 +831,7 @@ pub fn contains(poly: &[[f64; 2]], p: [f64; 2]) -> bool {
 
 /// Distance from `p` to the segment `a`–`b`.
 pub fn segment_distance(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> f64 {
-    let ab = [b[0] - a[0], b[1] - a[1]];
-    let l2 = ab[0] * ab[0] + ab[1] * ab[1];
-    let t = if l2 > 0.0 {
-        (((p[0] - a[0]) * ab[0] + (p[1] - a[1]) * ab[1]) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (p[0] - a[0] - t * ab[0]).hypot(p[1] - a[1] - t * ab[1])
+    dist(p, project(p, a, b))
 }
 
 /// The centroid of a closed polygon's area (its vertices' mean if it has
