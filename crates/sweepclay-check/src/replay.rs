@@ -69,7 +69,12 @@ pub fn replay(lines: &[Line], diags: &mut Vec<Diagnostic>) -> Vec<Event> {
 /// The machine state of a replay, fed one line at a time.
 #[derive(Debug)]
 pub struct Replayer {
+    /// Where the nozzle is, in the file's coordinates (after `G92`).
     pos: [f64; 3],
+    /// The machine's position minus the file's, per axis: what `G92`
+    /// declared (Marlin's position shift, Klipper's and RepRapFirmware's
+    /// alike); homing an axis clears it.
+    shift: [f64; 3],
     e: f64,
     abs_xyz: bool,
     abs_e: bool,
@@ -101,6 +106,7 @@ impl Default for Replayer {
     fn default() -> Self {
         Replayer {
             pos: [0.0; 3],
+            shift: [0.0; 3],
             e: 0.0,
             abs_xyz: true,
             abs_e: true,
@@ -122,6 +128,15 @@ impl Replayer {
     /// any is left.
     pub fn next_segment(&mut self) -> Option<Move> {
         self.segments.pop()
+    }
+
+    /// A position in the file's coordinates as the machine has it.
+    fn machine(&self, p: [f64; 3]) -> [f64; 3] {
+        [
+            p[0] + self.shift[0],
+            p[1] + self.shift[1],
+            p[2] + self.shift[2],
+        ]
     }
 
     /// Where a move's X Y Z take the nozzle (absolute or relative).
@@ -246,8 +261,8 @@ impl Replayer {
         for k in (1..=n).rev() {
             self.segments.push(Move {
                 line: l.line,
-                from: at(k - 1),
-                to: at(k),
+                from: self.machine(at(k - 1)),
+                to: self.machine(at(k)),
                 de: de / n as f64,
                 feed: self.feed,
             });
@@ -279,8 +294,8 @@ impl Replayer {
                 let de = self.take_e_and_feed(l);
                 let m = Move {
                     line: l.line,
-                    from: self.pos,
-                    to,
+                    from: self.machine(self.pos),
+                    to: self.machine(to),
                     de,
                     feed: self.feed,
                 };
@@ -298,14 +313,18 @@ impl Replayer {
             ('G', 21.0) => self.scale = 1.0,
             ('G', 28.0) => {
                 let any = ['X', 'Y', 'Z'].iter().any(|k| l.get(*k).is_some());
-                let mut to = self.pos;
+                let from = self.machine(self.pos);
+                let mut to = from;
                 if let Some(home) = self.delta_home {
                     // A delta homes all three towers at once.
                     to = home;
+                    self.shift = [0.0; 3];
                 } else {
                     for (a, k) in ['X', 'Y', 'Z'].into_iter().enumerate() {
                         if !any || l.get(k).is_some() {
                             to[a] = 0.0;
+                            // Homing an axis clears what G92 declared.
+                            self.shift[a] = 0.0;
                         }
                     }
                 }
@@ -314,12 +333,16 @@ impl Replayer {
                 }
                 let m = Move {
                     line: l.line,
-                    from: self.pos,
+                    from,
                     to,
                     de: 0.0,
                     feed: self.feed,
                 };
-                self.pos = to;
+                self.pos = [
+                    to[0] - self.shift[0],
+                    to[1] - self.shift[1],
+                    to[2] - self.shift[2],
+                ];
                 return Some(Event::Move(m));
             }
             ('G', 90.0) => {
@@ -335,13 +358,19 @@ impl Replayer {
                 }
             }
             ('G', 92.0) => {
-                if l.params.is_empty() {
-                    self.pos = [0.0; 3];
+                // The machine stays where it is; the file's coordinates
+                // of that place change (an end code's `G92 Z0`, then
+                // `G1 Z10`, lifts 10 mm).
+                let here = self.machine(self.pos);
+                let all = l.params.is_empty();
+                if all {
                     self.e = 0.0;
                 }
                 for (a, k) in ['X', 'Y', 'Z'].into_iter().enumerate() {
-                    if let Some(v) = l.get(k) {
+                    let v = if all { Some(0.0) } else { l.get(k) };
+                    if let Some(v) = v {
                         self.pos[a] = v * scale;
+                        self.shift[a] = here[a] - self.pos[a];
                     }
                 }
                 if let Some(v) = l.get('E') {
