@@ -297,7 +297,7 @@ fn vessel_floor(c: &Corrected, v: &VesselPlan) -> Option<LaidFloor> {
     ];
     rings.into_iter().find_map(|(ring, min_cover)| {
         let spiral = spiral_floor_covering(&ring, beads, min_cover).ok()?;
-        let cover = coverage(&ring, &spiral, 0.5);
+        let cover = coverage(&ring, &spiral, 1.0);
         Some(LaidFloor {
             ring,
             spiral,
