@@ -154,7 +154,7 @@ pub fn spiral_floor_covering(
     let mut best: Option<(f64, Measured)> = None;
     // Keeps a spiral whose turns keep their distance; whether it covers
     // enough to stop looking.
-    let mut consider = |m: Measured, best: &mut Option<(f64, Measured)>| {
+    let consider = |m: Measured, best: &mut Option<(f64, Measured)>| {
         if m.closest.1 < MIN_GAP * pitch {
             return false;
         }
@@ -282,7 +282,9 @@ fn offset_spiral(outer: &[[f64; 2]], beads: FloorBeads) -> Option<Measured> {
     for k in 0..turns {
         let ring = rotated(&rings[k], entry);
         let next = rings.get(k + 1);
-        let target = next.map(|r| SegmentIndex::new(r, 2.0 * pitch));
+        // The next offset lies a pitch away: cells of 3/4 of one, searched
+        // 1.3 pitches round.
+        let target = next.map(|r| SegmentIndex::new(r, 0.75 * pitch));
         let c = centroid(&ring);
         let total = perimeter(&ring);
         let mut acc = 0.0;
@@ -430,7 +432,7 @@ impl SegmentIndex {
     /// The point of `ring` (the one indexed) nearest `p`.
     fn nearest(&self, ring: &[[f64; 2]], p: [f64; 2]) -> [f64; 2] {
         let n = ring.len();
-        let mut pad = self.cell;
+        let mut pad = 1.7 * self.cell;
         loop {
             let mut best = (f64::INFINITY, p);
             self.grid.for_each_near_segment(p, p, pad, |i| {
@@ -843,7 +845,7 @@ pub fn coverage(outer: &[[f64; 2]], spiral: &FloorSpiral, cell: f64) -> f64 {
         y1 = y1.max(p[1]);
     }
     let widest = spiral.widths.iter().copied().fold(0.0, f64::max);
-    let mut grid = Grid2::new(widest.max(cell));
+    let mut grid = Grid2::new(0.5 * widest.max(cell));
     for i in 1..spiral.pts.len() {
         grid.insert_segment(spiral.pts[i - 1], spiral.pts[i], i as u32);
     }
@@ -858,8 +860,10 @@ pub fn coverage(outer: &[[f64; 2]], spiral: &FloorSpiral, cell: f64) -> f64 {
                 let mut hit = false;
                 grid.for_each_near_segment(p, p, 0.5 * widest, |i| {
                     let i = i as usize;
-                    let w = 0.5 * (spiral.widths[i - 1] + spiral.widths[i]);
-                    hit |= segment_distance(p, spiral.pts[i - 1], spiral.pts[i]) <= 0.5 * w;
+                    if !hit {
+                        let w = 0.5 * (spiral.widths[i - 1] + spiral.widths[i]);
+                        hit = segment_distance(p, spiral.pts[i - 1], spiral.pts[i]) <= 0.5 * w;
+                    }
                 });
                 covered += usize::from(hit);
             }

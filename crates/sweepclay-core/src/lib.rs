@@ -433,9 +433,21 @@ pub fn finish_unchecked(corrected: Corrected) -> Sliced {
     }
 }
 
-/// Whether a sliced design fits its printer's build volume (and round bed).
+/// Whether a sliced design fits its printer's build volume (and round
+/// bed), and a vessel's floor could be laid as one spiral covering its
+/// inside (docs/ALGORITHMS.md §8).
 pub fn fits(s: &Sliced) -> Result<()> {
     let (toolpath, extrusion, stats) = (&s.toolpath, &s.extrusion, &s.stats);
+    if let Some(why) = toolpath
+        .vessel
+        .as_ref()
+        .and_then(|v| v.floor_refusal.as_ref())
+    {
+        return Err(Error::invalid(
+            "trajectory",
+            format!("{why}: make the shape rounder or its narrow parts wider, or print the vessel bottomless (params.floor_layers = 0)"),
+        ));
+    }
     let pr = &s.corrected.surface.printer;
     if let Some(d) = pr.bed_diameter {
         let c = pr.bed_centre();

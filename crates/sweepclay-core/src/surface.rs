@@ -469,36 +469,6 @@ fn sample_plain(design: &Design) -> Result<Surface> {
     Ok(surface)
 }
 
-/// Refuses a floor that one spiral cannot fill (docs/ALGORITHMS.md §8),
-/// tried on the wall's first turn as drawn; the path stage lays it under
-/// the corrected one.
-fn floor_fits(
-    columns: &[Column],
-    params: &Params,
-    spacing: f64,
-    start: &Profile,
-    end: &Profile,
-    first_layer: f64,
-) -> Result<()> {
-    let ring: Vec<[f64; 2]> = columns
-        .iter()
-        .map(|c| {
-            let t = (first_layer / c.height).min(1.0);
-            let xi = (1.0 - c.lambda) * start.offset(t) + c.lambda * end.offset(t);
-            let q = c.point(xi, 0.0);
-            [q[0], q[1]]
-        })
-        .collect();
-    crate::floor::spiral_floor(&ring, crate::vessel::floor_beads(params, spacing))
-        .map(|_| ())
-        .map_err(|why| {
-            Error::invalid(
-                "trajectory",
-                format!("{why}: make the shape rounder there, or print the vessel bottomless (params.floor_layers = 0)"),
-            )
-        })
-}
-
 /// Where a spiral may begin on a loop whose columns' rims are `h`: just
 /// past the lowest rim (the first turn then ends where its rise is least,
 /// docs/ALGORITHMS.md §8), Ψ's start, then seven more evenly round the
@@ -562,9 +532,6 @@ fn sample_vessel(
         .unwrap_or(crate::design::DEFAULT_FLOOR_LAYERS);
     let mut v = VesselPlan::choose(&heights, &params, floor)?;
     let spacing = length / n as f64;
-    if v.floor_layers > 0 {
-        floor_fits(&columns, &params, spacing, &start, &end, v.base_mm())?;
-    }
     let starts = spiral_starts(&heights);
     // The extruder body's reach, and the clay just laid along the loop
     // that it may touch, as the checker counts them; columns where the

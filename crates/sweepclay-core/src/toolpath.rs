@@ -10,7 +10,9 @@
 //! turn. Every sample is visited exactly once.
 
 use crate::correct::Corrected;
-use crate::floor::{coverage, ring_area, spiral_floor_covering, FloorSpiral, MIN_COVER};
+use crate::floor::{
+    coverage, ring_area, spiral_floor_covering, FloorRefusal, FloorSpiral, MIN_COVER,
+};
 use crate::vessel::{floor_beads, VesselPlan};
 use serde::Serialize;
 
@@ -152,7 +154,19 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
     let s = &c.surface;
     let n = s.columns.len();
     let order = |m: usize| (v.start + m) % n;
-    let floor = (v.floor_layers > 0).then(|| vessel_floor(c, v)).flatten();
+    let laid = (v.floor_layers > 0).then(|| vessel_floor(c, v));
+    // A floor covering too little, or none, is refused by name after the
+    // path is planned (`fits`).
+    let floor_refusal = match &laid {
+        Some(Err(why)) => Some(why.to_string()),
+        Some(Ok(f)) if f.cover < MIN_COVER => Some(format!(
+            "the floor's one spiral covers only {:.1} % of the inside (at least {:.0} % is needed)",
+            100.0 * f.cover,
+            100.0 * MIN_COVER
+        )),
+        _ => None,
+    };
+    let floor = laid.and_then(|f| f.ok());
     let floor_pts = floor.as_ref().map_or(0, |f| f.pts.len());
     let total = s.samples.len() + floor_pts * v.base_layers as usize;
     let mut points = Vec::with_capacity(total);
@@ -248,6 +262,7 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
             floor_top_mm: v.base_mm(),
             turns: v.turns,
             floor_widths,
+            floor_refusal,
         }),
     }
 }
@@ -268,10 +283,10 @@ impl std::ops::Deref for LaidFloor {
 }
 
 /// The floor spiral inside the wall's first turn as corrected, from the
-/// start column on; if the corrections bent that turn past what one
-/// spiral fills, inside the turn as drawn (which sampling checked); else
-/// the best spiral inside the corrected turn, its cover reported.
-fn vessel_floor(c: &Corrected, v: &VesselPlan) -> Option<LaidFloor> {
+/// start column on; where it covers less than [`MIN_COVER`] and the
+/// corrections moved that turn, the better of it and the spiral inside
+/// the turn as drawn. Why no spiral can be laid, if none can.
+fn vessel_floor(c: &Corrected, v: &VesselPlan) -> Result<LaidFloor, FloorRefusal> {
     let s = &c.surface;
     let n = s.columns.len();
     let beads = floor_beads(&s.params, s.spacing);
@@ -290,20 +305,26 @@ fn vessel_floor(c: &Corrected, v: &VesselPlan) -> Option<LaidFloor> {
             [q[0], q[1]]
         })
         .collect();
-    let rings = [
-        (corrected.clone(), MIN_COVER),
-        (drawn, MIN_COVER),
-        (corrected, 0.0),
-    ];
-    rings.into_iter().find_map(|(ring, min_cover)| {
-        let spiral = spiral_floor_covering(&ring, beads, min_cover).ok()?;
-        let cover = coverage(&ring, &spiral, 1.0);
-        Some(LaidFloor {
+    let lay = |ring: Vec<[f64; 2]>| {
+        spiral_floor_covering(&ring, beads, 0.0).map(|spiral| LaidFloor {
+            cover: coverage(&ring, &spiral, 1.0),
             ring,
             spiral,
-            cover,
         })
-    })
+    };
+    let same = corrected
+        .iter()
+        .zip(&drawn)
+        .all(|(a, b)| (a[0] - b[0]).abs() + (a[1] - b[1]).abs() < 1e-9);
+    let first = lay(corrected);
+    if same || first.as_ref().is_ok_and(|f| f.cover >= MIN_COVER) {
+        return first;
+    }
+    match (first, lay(drawn)) {
+        (Ok(a), Ok(b)) => Ok(if b.cover > a.cover { b } else { a }),
+        (Ok(a), Err(_)) => Ok(a),
+        (Err(_), b) => b,
+    }
 }
 
 /// What the path of a vessel holds beyond its points.
@@ -325,6 +346,9 @@ pub struct VesselPath {
     /// Every floor point (in order) and its bead width (mm): as wide as
     /// its neighbouring turns' distance needs ([`crate::floor`]).
     pub floor_widths: Vec<(u32, f64)>,
+    /// Why the floor asked for cannot be laid as one spiral covering the
+    /// inside, if so: `finish` refuses the design with it.
+    pub floor_refusal: Option<String>,
 }
 
 #[cfg(test)]

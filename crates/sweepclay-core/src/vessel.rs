@@ -397,9 +397,9 @@ mod tests {
         // 40 mm: 2 floor layers of 1.25 mm, the first turn a layer above
         // them, then 1.25 mm a turn: (40 − 2.5 − 1.25) / 1.25 = 29 turns.
         assert_eq!((v.floor_layers, v.turns), (2, 29));
-        // Turns 2.55 mm apart from half of one outside the first turn to
-        // half of one from the centre: 30 / 2.55 → 11.
-        assert_eq!(v.floor_turns, 11);
+        // Offsets 2.55 mm apart from half of one outside the first turn
+        // in: (30 + 1.275) / 2.55 = 12.3, the last winding to the centre.
+        assert_eq!(v.floor_turns, 12);
         let wall: Vec<&PathPoint> = t
             .points
             .iter()
