@@ -282,9 +282,12 @@ fn offset_spiral(outer: &[[f64; 2]], beads: FloorBeads) -> Option<Measured> {
     for k in 0..turns {
         let ring = rotated(&rings[k], entry);
         let next = rings.get(k + 1);
-        // The next offset lies a pitch away: cells of 3/4 of one, searched
-        // 1.3 pitches round.
-        let target = next.map(|r| SegmentIndex::new(r, 0.75 * pitch));
+        // Walking along the next offset as this one is walked: the
+        // nearest point moves on monotonically, a few segments a point.
+        let mut walker = next.map(|r| Walker {
+            at: nearest_on(r, ring[0]).0,
+            ring: r,
+        });
         let c = centroid(&ring);
         let total = perimeter(&ring);
         let mut acc = 0.0;
@@ -293,9 +296,9 @@ fn offset_spiral(outer: &[[f64; 2]], beads: FloorBeads) -> Option<Measured> {
                 acc += dist(a, ring[j - 1]);
             }
             let sigma = acc / total;
-            let goal = match (&target, next) {
-                (Some(t), Some(r)) => t.nearest(r, a),
-                _ => {
+            let goal = match walker.as_mut() {
+                Some(w) => w.nearest(a),
+                None => {
                     let d = dist(a, c);
                     let step = pitch.min(d);
                     [
@@ -310,8 +313,8 @@ fn offset_spiral(outer: &[[f64; 2]], beads: FloorBeads) -> Option<Measured> {
             ]);
             turn_of.push(k as u32);
         }
-        if let (Some(t), Some(r)) = (&target, next) {
-            entry = t.nearest(r, ring[0]);
+        if let Some(r) = next {
+            entry = nearest_on(r, ring[0]).1;
         }
     }
     thin(&mut pts, &mut turn_of, 0.6 * beads.spacing);
@@ -413,46 +416,32 @@ fn nearest_on(ring: &[[f64; 2]], p: [f64; 2]) -> (usize, [f64; 2]) {
     (best.0, best.1)
 }
 
-/// The segments of a closed ring in a grid, for nearest-point look-ups.
-struct SegmentIndex {
-    grid: Grid2,
-    cell: f64,
+/// The nearest point of a closed ring to points that move along beside
+/// it: each look-up searches a window of segments from the last one.
+struct Walker<'a> {
+    ring: &'a [[f64; 2]],
+    at: usize,
 }
 
-impl SegmentIndex {
-    fn new(ring: &[[f64; 2]], cell: f64) -> SegmentIndex {
-        let mut grid = Grid2::new(cell);
-        let n = ring.len();
-        for i in 0..n {
-            grid.insert_segment(ring[i], ring[(i + 1) % n], i as u32);
-        }
-        SegmentIndex { grid, cell }
-    }
+impl Walker<'_> {
+    /// Segments searched ahead of the last nearest one (and a few behind):
+    /// more than a bevel of an offset spans for one point of the ring
+    /// outside it.
+    const AHEAD: usize = 64;
 
-    /// The point of `ring` (the one indexed) nearest `p`.
-    fn nearest(&self, ring: &[[f64; 2]], p: [f64; 2]) -> [f64; 2] {
-        let n = ring.len();
-        let mut pad = 1.7 * self.cell;
-        loop {
-            let mut best = (f64::INFINITY, p);
-            self.grid.for_each_near_segment(p, p, pad, |i| {
-                let i = i as usize;
-                let q = project(p, ring[i], ring[(i + 1) % n]);
-                let d = dist(p, q);
-                if d < best.0 {
-                    best = (d, q);
-                }
-            });
-            // Anything nearer than the pad searched is the nearest.
-            if best.0 <= pad || pad > 1e4 {
-                return if best.0.is_finite() {
-                    best.1
-                } else {
-                    nearest_on(ring, p).1
-                };
+    fn nearest(&mut self, p: [f64; 2]) -> [f64; 2] {
+        let n = self.ring.len();
+        let mut best = (f64::INFINITY, self.at, p);
+        for k in 0..Self::AHEAD.min(n) {
+            let i = (self.at + n + k - 4.min(n)) % n;
+            let q = project(p, self.ring[i], self.ring[(i + 1) % n]);
+            let d = dist(p, q);
+            if d < best.0 {
+                best = (d, i, q);
             }
-            pad *= 4.0;
         }
+        self.at = best.1;
+        best.2
     }
 }
 
@@ -779,38 +768,53 @@ fn measure_path(
         let b = pts[(i + 1).min(pts.len() - 1)];
         let t = [b[0] - a[0], b[1] - a[1]];
         let tl = norm(t[0], t[1]).max(1e-12);
-        let mut side = [f64::INFINITY; 2];
-        let mut inward = f64::INFINITY;
-        grid.for_each_near_segment(p, p, reach, |j| {
-            let j = j as usize;
-            if (arc[j] - arc[i]).abs() < local {
-                return;
-            }
-            let q = pts[j];
-            let d = [q[0] - p[0], q[1] - p[1]];
-            let dist = norm(d[0], d[1]);
-            if turn_of[j] == turn_of[i] + 1 {
-                inward = inward.min(dist);
-            }
-            // Only what lies across the path, not ahead or behind.
-            let along = (d[0] * t[0] + d[1] * t[1]) / tl;
-            if along.abs() > 0.7 * dist {
-                return;
-            }
-            let left = usize::from(t[0] * d[1] - t[1] * d[0] > 0.0);
-            side[left] = side[left].min(dist);
-        });
-        // The neighbouring path segments are closer than their points.
-        let gaps: Vec<f64> = side.iter().copied().filter(|g| g.is_finite()).collect();
-        for &g in &gaps {
+        // Squared distances: each side's nearest and the next turn's.
+        let scan = |pad: f64| {
+            let mut side = [f64::INFINITY; 2];
+            let mut inward = f64::INFINITY;
+            grid.for_each_near_segment(p, p, pad, |j| {
+                let j = j as usize;
+                if (arc[j] - arc[i]).abs() < local {
+                    return;
+                }
+                let q = pts[j];
+                let d = [q[0] - p[0], q[1] - p[1]];
+                let d2 = d[0] * d[0] + d[1] * d[1];
+                if turn_of[j] == turn_of[i] + 1 {
+                    inward = inward.min(d2);
+                }
+                // Only what lies across the path, not ahead or behind.
+                let along = (d[0] * t[0] + d[1] * t[1]) / tl;
+                if along * along > 0.49 * d2 {
+                    return;
+                }
+                let left = usize::from(t[0] * d[1] - t[1] * d[0] > 0.0);
+                side[left] = side[left].min(d2);
+            });
+            (side.map(f64::sqrt), inward.sqrt())
+        };
+        // Most points have both neighbouring turns within a pitch and a
+        // half: look farther only where one is missing.
+        let near = 1.5 * pitch;
+        let (mut side, mut inward) = scan(near);
+        let innermost = turn_of[i] as usize + 1 >= turns;
+        if side.iter().any(|g| !g.is_finite()) || (!inward.is_finite() && !innermost) {
+            (side, inward) = scan(reach);
+        }
+        let mut gaps = [0.0; 2];
+        let mut found = 0;
+        for g in side.into_iter().filter(|g| g.is_finite()) {
+            gaps[found] = g;
+            found += 1;
             if g < closest.1 {
                 closest = (p, g);
             }
         }
+        let gaps = &gaps[..found];
         // How far the next turn in lies, measured once for each pair of
         // neighbouring turns (the outermost turn has nothing outside it,
         // the innermost the spine's far side).
-        if inward.is_finite() && inward > farthest.1 && (turn_of[i] as usize) + 1 < turns {
+        if inward.is_finite() && inward > farthest.1 && !innermost {
             farthest = (p, inward);
         }
         let gap = match gaps.len() {
@@ -844,32 +848,50 @@ pub fn coverage(outer: &[[f64; 2]], spiral: &FloorSpiral, cell: f64) -> f64 {
         y0 = y0.min(p[1]);
         y1 = y1.max(p[1]);
     }
-    let widest = spiral.widths.iter().copied().fold(0.0, f64::max);
-    let mut grid = Grid2::new(0.5 * widest.max(cell));
-    for i in 1..spiral.pts.len() {
-        grid.insert_segment(spiral.pts[i - 1], spiral.pts[i], i as u32);
-    }
-    let (mut inside, mut covered) = (0usize, 0usize);
-    let mut y = y0 + 0.5 * cell;
-    while y < y1 {
-        let mut x = x0 + 0.5 * cell;
-        while x < x1 {
-            let p = [x, y];
-            if contains(outer, p) {
-                inside += 1;
-                let mut hit = false;
-                grid.for_each_near_segment(p, p, 0.5 * widest, |i| {
-                    let i = i as usize;
-                    if !hit {
-                        let w = 0.5 * (spiral.widths[i - 1] + spiral.widths[i]);
-                        hit = segment_distance(p, spiral.pts[i - 1], spiral.pts[i]) <= 0.5 * w;
-                    }
-                });
-                covered += usize::from(hit);
+    let nx = (((x1 - x0) / cell).ceil() as usize).clamp(1, 1 << 14);
+    let ny = (((y1 - y0) / cell).ceil() as usize).clamp(1, 1 << 14);
+    let centre = |i: usize, j: usize| [x0 + (i as f64 + 0.5) * cell, y0 + (j as f64 + 0.5) * cell];
+    // Each bead marks the cells whose centres it covers: linear in the
+    // path, where asking every cell for its beads was not.
+    let mut under = vec![false; nx * ny];
+    for k in 1..spiral.pts.len() {
+        let (a, b) = (spiral.pts[k - 1], spiral.pts[k]);
+        let half = 0.25 * (spiral.widths[k - 1] + spiral.widths[k]);
+        let cells = |lo: f64, hi: f64, o: f64, n: usize| {
+            let first = (((lo - half - o) / cell - 0.5).ceil().max(0.0)) as usize;
+            let last = (((hi + half - o) / cell - 0.5).floor().max(-1.0) + 1.0) as usize;
+            first..last.min(n)
+        };
+        for j in cells(a[1].min(b[1]), a[1].max(b[1]), y0, ny) {
+            for i in cells(a[0].min(b[0]), a[0].max(b[0]), x0, nx) {
+                if !under[j * nx + i] && segment_distance(centre(i, j), a, b) <= half {
+                    under[j * nx + i] = true;
+                }
             }
-            x += cell;
         }
-        y += cell;
+    }
+    // The cells inside, row by row from where the outline crosses it.
+    let (mut inside, mut covered) = (0usize, 0usize);
+    let n = outer.len();
+    let mut xs = Vec::new();
+    for j in 0..ny {
+        let y = centre(0, j)[1];
+        xs.clear();
+        for e in 0..n {
+            let (a, b) = (outer[e], outer[(e + 1) % n]);
+            if (a[1] > y) != (b[1] > y) {
+                xs.push(a[0] + (y - a[1]) / (b[1] - a[1]) * (b[0] - a[0]));
+            }
+        }
+        xs.sort_by(f64::total_cmp);
+        for span in xs.chunks_exact(2) {
+            let first = ((span[0] - x0) / cell - 0.5).ceil().max(0.0) as usize;
+            let last = (((span[1] - x0) / cell - 0.5).floor() + 1.0).max(0.0) as usize;
+            for i in first..last.min(nx) {
+                inside += 1;
+                covered += usize::from(under[j * nx + i]);
+            }
+        }
     }
     covered as f64 / inside.max(1) as f64
 }
