@@ -222,14 +222,17 @@ pub const MIN_COVER: f64 = 0.97;
 fn offset_spiral(outer: &[[f64; 2]], beads: FloorBeads) -> Option<Measured> {
     let pitch = beads.pitch();
     let ccw = signed_area2(outer) > 0.0;
-    let mut base = outer.to_vec();
+    // Points closer than 0.45 of the floor's spacing add offsetting work,
+    // not shape.
+    let thin_to = (0.45 * beads.spacing).max(0.3);
+    let mut base = spaced(outer, thin_to);
     if !ccw {
         base.reverse();
     }
     let fine = (0.4 * beads.spacing).max(0.2);
     let mut rings: Vec<Vec<[f64; 2]>> = Vec::new();
     // Each offset from the one before, a pitch in (i_overlay's cost grows
-    // with the depth), that one thinned to points 0.3 mm apart: offsets
+    // with the depth), that one thinned like the outline: offsets
     // of offsets gain points at every concave turn, doubling each time
     // (a kidney's 13th had 29,000 and took 9 s).
     let mut last = base.clone();
@@ -264,7 +267,7 @@ fn offset_spiral(outer: &[[f64; 2]], beads: FloorBeads) -> Option<Measured> {
             ring.reverse();
         }
         if k > 0 {
-            last = spaced(&ring, 0.3);
+            last = spaced(&ring, thin_to);
         }
         // Against the outline's order, as the ray spiral runs.
         if ccw {
