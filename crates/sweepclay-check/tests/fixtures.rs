@@ -1142,3 +1142,40 @@ fn a_helix_of_layers_taller_than_its_beads_are_wide_fails() {
     let r = verdict(&helix(2.5, 3.0, 8).out);
     assert!(r.printable, "{}", r.render());
 }
+
+/// `G92` declares where the nozzle already is (docs/CHECKER.md,
+/// "Firmwares"): Cura's Eazao end code lifts 10 mm as `G92 Z0`, then
+/// `G1 Z10`, and homes X over the piece; read as a plunge 30 mm into the
+/// pot it was refused. A file that homes and then declares Z20 lays every
+/// bead 20 mm lower than it says: into the bed.
+#[test]
+fn g92_moves_the_files_coordinates_not_the_nozzle() {
+    let mut g = wall(20);
+    g.line("G92 Z0 E0");
+    g.line("G1 F1500 E-2");
+    g.line("G1 F1500 Z10");
+    g.line("G28 X0 ;move X Y to min endstops");
+    g.line("M84");
+    let r = verdict(&g.out);
+    assert!(r.printable, "{}", r.render());
+    assert_eq!(
+        r.findings[Finding::NozzleCollision].count,
+        0,
+        "{}",
+        r.render()
+    );
+    // Declared 20 mm higher than it is: every bead into the bed.
+    let text = wall(5).out.replacen("G28\n", "G28\nG92 Z20\n", 1);
+    let r = verdict(&text);
+    assert!(!r.printable, "{}", r.render());
+    assert!(r.findings[Finding::IntoBed].count > 0, "{}", r.render());
+    // A mid-print `G92 X10` at x = 50, and the file goes on in its old
+    // coordinates: the next layer, written from 50 to 90, is laid from 90
+    // to 130, beyond the wall, on nothing.
+    let mut g = wall(6);
+    g.line("G92 X10");
+    let at = g.at;
+    g.run([90.0, 50.0, at[2] + LAYER], W, LAYER);
+    let r = verdict(&g.out);
+    assert!(!r.printable, "{}", r.render());
+}

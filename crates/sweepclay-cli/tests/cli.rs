@@ -651,7 +651,8 @@ fn presets_from_published_definitions_print_lift_clear_and_keep_their_mode() {
             "source: Cura resources/definitions/eazao_zero.def.json",
         ));
     // An Eazao Potter prints the vase; the G-code lifts 10 mm before the
-    // end code, and the checker passes it.
+    // definition's own end code (a lift written as `G92 Z0`, `G1 Z10`),
+    // and the checker passes it.
     sweepclay(tmp.path())
         .args([
             "slice",
@@ -665,11 +666,14 @@ fn presets_from_published_definitions_print_lift_clear_and_keep_their_mode() {
         .success()
         .stdout(predicate::str::contains("check              printable"));
     let g = std::fs::read_to_string(tmp.path().join("potter.gcode")).unwrap();
-    let tail: Vec<&str> = g.lines().rev().take(4).collect();
+    let tail: Vec<&str> = g.lines().rev().take(7).collect();
     assert_eq!(
         tail,
         [
-            "M84 ; steppers off",
+            "M84 ;steppers off",
+            "M82",
+            "G1 F1500 Z10 E-2",
+            "G92 Z0 E0",
             "G90 ; absolute",
             "G1 Z10 F300 ; lift clear of the piece",
             "G91 ; relative"

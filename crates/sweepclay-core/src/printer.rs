@@ -145,9 +145,19 @@ pub fn extrusion_mode(start: &str) -> Option<bool> {
     mode
 }
 
-/// The Eazao presets' end code: their definitions lift 10 mm, as every
-/// G-code now does before its end code, then free the steppers.
-const EAZAO_END: &str = "M84 ; steppers off\n";
+/// The Eazao presets' end codes, as their Cura definitions give them: a
+/// 10 mm lift written as a new origin (`G92 Z0`, then `G1 Z10`), which
+/// firmware and `sweepclay check` read as a lift (docs/CHECKER.md,
+/// "Firmwares"), after the writer's own 10 mm lift.
+const EAZAO_ZERO_END: &str = "G92 Z0 E0\nG1 F1500 E-2\nG1 F1500 Z10\nG28 X0;move X Y to min endstops\nM82\nM84 ;steppers off\n";
+/// [`EAZAO_ZERO_END`]'s kin for the Potter.
+const EAZAO_POTTER_END: &str = "G92 Z0 E0\nG1 F1500 Z10 E-2\nM82\nM84 ;steppers off\n";
+/// [`EAZAO_ZERO_END`]'s kin for the M500.
+const EAZAO_M500_END: &str =
+    "G92 Z0\nG1 F1500 Z10\nG28 X0 Y300 ;move X Y to min endstops\nM82\nM84 ;steppers off\n";
+/// [`EAZAO_ZERO_END`]'s kin for the M600.
+const EAZAO_M600_END: &str =
+    "G92 Z0\nG1 F1500 Z10\nG28 X0 Y400 ;move X Y to min endstops\nM82\nM84 ;steppers off\n";
 
 /// E per mm³ of a machine whose firmware counts E as millimetres of
 /// filament of diameter `d` mm, as Cura writes it: 1 / (π d² / 4).
@@ -247,37 +257,35 @@ impl Printer {
                 start_gcode: "G21 ; set units to millimeters\nG90 ; use absolute coordinates\nM82 ; use absolute distances for extrusion\nG28 ; home all axes\nG0 F6200 X0 Y0\nG92 E0\nG1 Z1.0 F3000 ; move z up little to prevent scratching of surface\nG1 X20 Y10 Z0.3 F5000.0 ; move to start-line position\nG1 X150 Y10 Z0.3 F1500.0 E15 ; draw 1st line\nG1 X150 Y10 Z0.3 F5000.0 ; move to side a little\nG1 X20 Y10.3 Z0.3 F1500.0 E30 ; draw 2nd line\nG92 E0 ; reset extruder\n".into(),
                 ..base
             }),
-            // Start code as the definitions give it. Their end code lifts
-            // 10 mm by resetting z (`G92 Z0`, then `G1 Z10`) and homes x
-            // (and y) over the piece: the writer's own 10 mm lift takes
-            // its place, then the steppers are freed (docs/FORMATS.md).
+            // Start and end code as the definitions give them (docs/
+            // FORMATS.md).
             "eazao-zero" => Some(eazao(
                 name,
                 [150.0, 150.0, 240.0],
                 25.0,
                 "G21\nG90 ;absolute positioning\nM82 ;set extruder to absolute mode\nG28 ;Home\nG1 Z15.0 F1500 ;move the platform down 15mm\nG92 E0\nG1 F1500 E2\nG92 E0\nM302\nM163 S0 P0.8 ;Set Mix Factor\nM163 S1 P0.2 ;Set Mix Factor\nM164 S0\n",
-                EAZAO_END,
+                EAZAO_ZERO_END,
             )),
             "eazao-potter" => Some(eazao(
                 name,
                 [167.0, 167.0, 280.0],
                 25.0,
                 "G21 ;set units to millimeters\nG90 ;absolute positioning\nM82 ;set extruder to absolute mode\nG28 ;Home\nG1 Z25.0 F1500 ;move the platform down 25mm\nG92 E0 ;extruder reset\nG1 F1500 E2\nG92 E0\nM302\nM163 S0 P0.85 ;Set Mix Factor\nM163 S1 P0.15 ;Set Mix Factor\nM164 S0\n",
-                EAZAO_END,
+                EAZAO_POTTER_END,
             )),
             "eazao-m500" => Some(eazao(
                 name,
                 [320.0, 320.0, 520.0],
                 20.0,
                 "G21 ;set units to millimeters\nG90 ;absolute positioning\nM82 ;set extruder to absolute mode\nG28 ;Home\nG1 Z25.0 F1500\nG92 E0 ;extruder reset\nG1 F300 E5\nG92 E0\nM302\nM163 S0 P0.85 ;Set Mix Factor\nM163 S1 P0.15 ;Set Mix Factor\nM164 S0\n",
-                EAZAO_END,
+                EAZAO_M500_END,
             )),
             "eazao-m600" => Some(eazao(
                 name,
                 [420.0, 420.0, 620.0],
                 20.0,
                 "G21 ;set units to millimeters\nG90 ;absolute positioning\nM82 ;set extruder to absolute mode\nG28 ;Home\nG1 Z25.0 F1500\nG92 E0 ;extruder reset\nG1 F300 E5\nG92 E0\nM302\nM163 S0 P0.87 ;Set Mix Factor\nM163 S1 P0.13 ;Set Mix Factor\nM164 S0\n",
-                EAZAO_END,
+                EAZAO_M600_END,
             )),
             _ => None,
         }
