@@ -329,9 +329,13 @@ struct Checker<'a> {
     /// Consecutive beads under the least overlap, and over a layer gap,
     /// not yet recorded.
     weak: [Weak; 2],
-    /// Under-extruded moves since the last full bead (line, width): a
-    /// failure once a bead follows them, the final taper if none does.
-    under: Vec<(usize, f64)>,
+    /// Under-extruded moves since the last full bead (line, width, plan
+    /// length): a failure once a bead follows them, the final taper if
+    /// none does and they are no longer than two widest beads.
+    under: Vec<(usize, f64, f64)>,
+    /// The feedrate of the last move (mm/min): how long a dwell is
+    /// against the bead it holds up.
+    last_feed: f64,
     /// The gap under the beads judged for it so far, a running mean
     /// (mm; 0 before the first): the layers the print lays.
     typical_gap: f64,
@@ -401,6 +405,7 @@ impl<'a> Checker<'a> {
             prev_overlap: 0.0,
             weak: Default::default(),
             under: Vec::new(),
+            last_feed: 0.0,
             typical_gap: 0.0,
             beads: Vec::new(),
             bent_before: vec![0],
@@ -492,6 +497,20 @@ impl<'a> Checker<'a> {
                 self.pending.push(((Finding::Pause), line, 0.0));
                 self.in_run = false;
             }
+            // A dwell is a pause when clay pools in it: longer than laying
+            // a narrowest bead's length of clay takes at the feed in force
+            // (docs/CHECKER.md, "Firmwares").
+            Some(Event::Dwell(line, seconds)) => {
+                let feed_mm_s = (self.last_feed / 60.0).max(1.0);
+                if seconds > self.cfg.width_min / feed_mm_s {
+                    self.pending.push(((Finding::Pause), line, seconds));
+                    self.in_run = false;
+                }
+            }
+            Some(Event::Retract(line)) => {
+                self.pending.push(((Finding::Retraction), line, 0.0));
+                self.in_run = false;
+            }
             Some(Event::Move(m)) => {
                 self.framed(m);
                 // The rest of an arc's segments.
@@ -506,6 +525,9 @@ impl<'a> Checker<'a> {
     /// A move into the box's own frame (its lowest corner at 0), then
     /// judged.
     fn framed(&mut self, mut m: crate::replay::Move) {
+        if m.feed > 0.0 {
+            self.last_feed = m.feed;
+        }
         let b = self.cfg.bed_min;
         if b != [0.0; 3] {
             for p in [&mut m.from, &mut m.to] {
@@ -1229,9 +1251,9 @@ impl<'a> Checker<'a> {
         // more of them follows (the final taper).
         if !step && width.is_finite() {
             if width < crate::report::UNDER_EXTRUDED * cfg.width_min {
-                self.under.push((m.line, width));
+                self.under.push((m.line, width, len));
             } else if !self.under.is_empty() {
-                for (line, w) in std::mem::take(&mut self.under) {
+                for (line, w, _) in std::mem::take(&mut self.under) {
                     self.record(Finding::UnderExtruded, line, w, false);
                 }
             }
@@ -1259,6 +1281,14 @@ impl<'a> Checker<'a> {
 
     fn finish(mut self) -> Report {
         self.close_stretch(None);
+        // A taper at the rim is a few millimetres; a whole layer or more
+        // of too little clay at the end is under-extruded all the same.
+        let tail: f64 = self.under.iter().map(|u| u.2).sum();
+        if tail > 2.0 * self.cfg.width_max {
+            for (line, w, _) in std::mem::take(&mut self.under) {
+                self.record(Finding::UnderExtruded, line, w, false);
+            }
+        }
         for k in 0..WEAK_KINDS.len() {
             self.flush_weak(k);
         }

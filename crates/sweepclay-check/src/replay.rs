@@ -1,8 +1,11 @@
 //! Replays parsed G-code into a list of moves in absolute millimetres and
 //! absolute E: G0/G1 with any subset of X Y Z E F, G2/G3 arcs in the XY
 //! plane (`I J` or `R`, split into segments of at most 1 mm as Marlin and
-//! Klipper do), G90/G91, M82/M83, G92, G20/G21, G28; G4, M0, M1 and M600
-//! are pauses; unknown commands are reported, not fatal. An arc this does
+//! Klipper do), G90/G91, M82/M83, G92 (the machine's position kept apart
+//! from the file's), G20/G21, G28; M0, M1 and M600 are pauses, G4 a dwell
+//! of its length, a bare G10 a firmware retraction, M221 a flow factor;
+//! M200 D and M92 make the file one it cannot judge; unknown commands are
+//! reported, not fatal. An arc this does
 //! not replay as firmware would (another plane, no centre, a radius too
 //! short for its chord) makes the file one it cannot judge.
 
@@ -47,8 +50,13 @@ fn sub(a: [f64; 3], b: [f64; 3]) -> [f64; 3] {
 pub enum Event {
     /// A move.
     Move(Move),
-    /// A pause (G4, M0, M1, M600) at a line.
+    /// A pause (M0, M1, M600) at a line.
     Pause(usize),
+    /// A dwell (`G4`) at a line, of so many seconds: a pause if clay
+    /// pools in it (the checker judges its length).
+    Dwell(usize, f64),
+    /// A firmware retraction (a bare `G10`, Marlin's `G10 S1`) at a line.
+    Retract(usize),
 }
 
 /// Replays the lines. Returns the events; diagnostics are appended.
@@ -96,6 +104,8 @@ pub struct Replayer {
     pub delta_home: Option<[f64; 3]>,
     /// The lines of the first 64 `G28` moves.
     pub homing_lines: Vec<usize>,
+    /// The flow override `M221 S` sets, as a factor on every E (1: none).
+    flow: f64,
 }
 
 /// Longest segment an arc is split into (mm): Marlin's
@@ -119,6 +129,7 @@ impl Default for Replayer {
             cannot_judge: None,
             delta_home: None,
             homing_lines: Vec::new(),
+            flow: 1.0,
         }
     }
 }
@@ -162,6 +173,8 @@ impl Replayer {
             de = if self.abs_e { v - self.e } else { v };
             self.e += de;
         }
+        // `M221 S50` halves the clay of every E that follows.
+        de *= self.flow;
         if let Some(f) = l.get('F') {
             self.feed = f * self.scale;
         }
@@ -306,9 +319,52 @@ impl Replayer {
             ('G', 17.0) => self.plane = 17,
             ('G', 18.0) => self.plane = 18,
             ('G', 19.0) => self.plane = 19,
-            ('G', 4.0) | ('M', 0.0) | ('M', 1.0) | ('M', 600.0) => {
-                return Some(Event::Pause(l.line))
+            ('M', 0.0) | ('M', 1.0) | ('M', 600.0) => return Some(Event::Pause(l.line)),
+            // A dwell: `P` milliseconds, `S` seconds (all three firmwares);
+            // none, a wait for the moves to finish.
+            ('G', 4.0) => {
+                let s = l.get('S').unwrap_or(0.0) + l.get('P').unwrap_or(0.0) / 1000.0;
+                return Some(Event::Dwell(l.line, s.max(0.0)));
             }
+            // Firmware retraction (Marlin's FWRETRACT, Klipper's
+            // `[firmware_retraction]`, RepRapFirmware): a bare `G10`
+            // retracts, `G11` primes again. With parameters `G10` sets tool
+            // offsets and temperatures in RepRapFirmware; Marlin's `S1` is a
+            // swap retraction; anything else is read by no firmware the
+            // same way.
+            ('G', 10.0) => {
+                let bare = l.params.is_empty();
+                let swap = l.get('S') == Some(1.0) && l.params.len() == 1;
+                match self.firmware {
+                    _ if bare => return Some(Event::Retract(l.line)),
+                    crate::Firmware::Marlin if swap => return Some(Event::Retract(l.line)),
+                    crate::Firmware::Reprap => {}
+                    _ => self.cannot(
+                        l.line,
+                        "G10 with parameters: a tool offset or temperature to RepRapFirmware, no firmware retraction elsewhere (give --firmware reprap if the file is for it)".into(),
+                    ),
+                }
+            }
+            ('G', 11.0) => {}
+            // Flow overrides: the clay of every E after them.
+            ('M', 221.0) => {
+                if let Some(s) = l.get('S') {
+                    self.flow = (s / 100.0).max(0.0);
+                }
+            }
+            ('M', 200.0) => {
+                if l.get('D').is_some_and(|d| d != 0.0) {
+                    self.cannot(
+                        l.line,
+                        "M200 D switches E to cubic millimetres of a filament's diameter: E per mm³ is no longer the printer's".into(),
+                    );
+                }
+            }
+            ('M', 92.0) if !l.params.is_empty() => self.cannot(
+                l.line,
+                "M92 changes the steps per millimetre: the moves and E after it are not the file's"
+                    .into(),
+            ),
             ('G', 20.0) => self.scale = 25.4,
             ('G', 21.0) => self.scale = 1.0,
             ('G', 28.0) => {
@@ -382,9 +438,8 @@ impl Replayer {
             // Known commands with no effect on the deposition.
             ('M', c)
                 if [
-                    17.0, 18.0, 84.0, 104.0, 105.0, 106.0, 107.0, 109.0, 110.0, 114.0, 115.0,
-                    117.0, 140.0, 190.0, 201.0, 203.0, 204.0, 205.0, 220.0, 221.0, 400.0, 73.0,
-                    107.0,
+                    17.0, 18.0, 84.0, 92.0, 104.0, 105.0, 106.0, 107.0, 109.0, 110.0, 114.0, 115.0,
+                    117.0, 140.0, 190.0, 201.0, 203.0, 204.0, 205.0, 220.0, 400.0, 73.0, 107.0,
                 ]
                 .contains(&c) => {}
             ('G', c) if [29.0, 80.0].contains(&c) => {}
@@ -416,7 +471,7 @@ mod tests {
             .into_iter()
             .filter_map(|e| match e {
                 Event::Move(m) => Some(m),
-                Event::Pause(_) => None,
+                _ => None,
             })
             .collect()
     }
@@ -442,7 +497,7 @@ mod tests {
             let ev: Vec<_> = lines.iter().filter_map(|l| r.feed(l, &mut d)).collect();
             match ev[1] {
                 Event::Move(m) => (m.to[0], m.de),
-                Event::Pause(_) => unreachable!(),
+                _ => unreachable!(),
             }
         };
         // Marlin: G91 makes E relative too (E1 is one more); Klipper and
@@ -463,10 +518,26 @@ mod tests {
     fn pauses_and_unknowns() {
         let mut d = vec![];
         let ev = replay(&parse("G4 P100\nM600\nM999\nG1 X1\n", &mut d), &mut d);
-        assert!(matches!(ev[0], Event::Pause(1)));
+        assert_eq!(ev[0], Event::Dwell(1, 0.1));
         assert!(matches!(ev[1], Event::Pause(2)));
         assert_eq!(d.len(), 1);
         assert_eq!(d[0].line, 3);
+    }
+
+    #[test]
+    fn g92_keeps_the_machine_where_it_is() {
+        // 30 mm up, then `G92 Z0` and `G1 Z10`: the nozzle ends at 40.
+        let m = moves("G1 Z30\nG92 Z0\nG1 Z10\nG28 Z\nG1 Z5\n");
+        assert_eq!(m[1].from[2], 30.0);
+        assert_eq!(m[1].to[2], 40.0);
+        // Homing clears the shift: Z5 is 5 mm above the bed again.
+        assert_eq!(m[3].to[2], 5.0);
+    }
+
+    #[test]
+    fn flow_overrides_scale_e() {
+        let m = moves("M83\nG1 X1 E1\nM221 S50\nG1 X2 E1\n");
+        assert_eq!((m[0].de, m[1].de), (1.0, 0.5));
     }
 
     #[test]

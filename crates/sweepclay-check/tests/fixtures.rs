@@ -1179,3 +1179,64 @@ fn g92_moves_the_files_coordinates_not_the_nozzle() {
     let r = verdict(&g.out);
     assert!(!r.printable, "{}", r.render());
 }
+
+/// Commands read as the firmware reads them (docs/CHECKER.md,
+/// "Firmwares"): a dwell is a pause only when clay pools in it; a bare
+/// `G10` is a firmware retraction; `G10` with parameters is RepRapFirmware's
+/// tool setting or cannot be judged; flow overrides change the clay.
+#[test]
+fn dwells_firmware_retraction_and_flow_overrides_are_read_as_firmware_does() {
+    let with_mid = |line: &str| {
+        let mut g = wall(4);
+        g.line(line);
+        let at = g.at;
+        g.bead([at[0], at[1], at[2] + LAYER], W, LAYER);
+        g.run([90.0, 50.0, at[2] + LAYER], W, LAYER);
+        g
+    };
+    // G4 P0 syncs the planner: no pause. G4 S5 is one.
+    let r = verdict(&with_mid("G4 P0").out);
+    assert!(r.printable, "{}", r.render());
+    let r = verdict(&with_mid("G4").out);
+    assert!(r.printable, "{}", r.render());
+    fails_for(
+        &verdict(&with_mid("G4 S5").out),
+        "pause",
+        &["extrusion runs"],
+    );
+    // 0.05 s at 30 mm/s is under a 3 mm bead's 0.1 s: no pooling.
+    let r = verdict(&with_mid("G4 P50").out);
+    assert!(r.printable, "{}", r.render());
+    // A bare G10 mid-print retracts; G11 primes again.
+    let mut g = wall(4);
+    g.line("G10");
+    g.line("G11");
+    let at = g.at;
+    g.bead([at[0], at[1], at[2] + LAYER], W, LAYER);
+    g.run([90.0, 50.0, at[2] + LAYER], W, LAYER);
+    fails_for(&verdict(&g.out), "retraction", &["extrusion runs"]);
+    // G10 P0 S200 sets a tool's temperature in RepRapFirmware; elsewhere
+    // no firmware reads it so: cannot judge, never a verdict.
+    let g = with_mid("G10 P0 S200");
+    let reprap = CheckConfig {
+        firmware: sweepclay_check::Firmware::Reprap,
+        ..CheckConfig::default()
+    };
+    let r = check(&g.out, &reprap);
+    assert!(r.printable, "{}", r.render());
+    let r = verdict(&g.out);
+    assert!(r.cannot_judge.is_some(), "{}", r.render());
+    assert!(!r.printable, "{}", r.render());
+    // M221 S10: every bead after it carries a tenth of its clay.
+    let r = verdict(&with_mid("M221 S10").out);
+    assert!(!r.printable, "{}", r.render());
+    // M221 S100 before the print changes nothing.
+    let text = wall(6).out.replacen("G28\n", "G28\nM221 S100\n", 1);
+    assert!(verdict(&text).printable);
+    // M200 D (volumetric E) and M92 (steps) mid-print: cannot judge.
+    for line in ["M200 D1.75", "M92 E400"] {
+        let r = verdict(&with_mid(line).out);
+        assert!(r.cannot_judge.is_some(), "{line}: {}", r.render());
+        assert!(!r.printable, "{line}");
+    }
+}

@@ -170,7 +170,11 @@ pub fn spiral_floor_covering(
     // the offsets split. Then the rays to each candidate spine, nearest
     // and along the normals: a region that pinches at a waist.
     if let Some(m) = offset_spiral(outer, beads) {
-        if consider(m, &mut best) {
+        // An offset spiral ends round its last offset: a thin lens there
+        // (an oval's) stays bare, a hole under 1 % of the floor. Where it
+        // covers less than all, the rays, which close over their spine,
+        // are tried too.
+        if consider(m, &mut best) && best.as_ref().is_some_and(|(c, _)| *c >= WHOLE) {
             return Ok(best.expect("just kept").1.spiral);
         }
     }
@@ -193,7 +197,7 @@ pub fn spiral_floor_covering(
                 }
                 break m;
             };
-            if consider(m, &mut best) {
+            if consider(m, &mut best) && best.as_ref().is_some_and(|(c, _)| *c >= WHOLE) {
                 return Ok(best.expect("just kept").1.spiral);
             }
         }
@@ -211,6 +215,10 @@ pub fn spiral_floor_covering(
 
 /// The least share of the floor a spiral must cover.
 pub const MIN_COVER: f64 = 0.97;
+
+/// A share of the floor that counts as all of it (on the 1 mm grid the
+/// cover is measured on): a spiral that covers it ends the search.
+const WHOLE: f64 = 0.999;
 
 /// The spiral that blends each inward offset of `outer` into the next
 /// along the turn (Held & Spielberger): offsets at depths (k − 0.6)
@@ -692,7 +700,8 @@ struct Measured {
 /// the outer turn's spacing, its gaps and widths measured.
 fn measure(spine: [[f64; 2]; 2], rays: &[Ray], turns: usize, beads: FloorBeads) -> Measured {
     let (pts, turn_of) = ray_spiral(rays, turns, beads);
-    measure_path(pts, turn_of, turns, spine, beads)
+    // The closing half turn counts as the innermost.
+    measure_path(pts, turn_of, turns + 1, spine, beads)
 }
 
 /// The points of the spiral of `turns` turns along `rays`, thinned to
@@ -728,6 +737,27 @@ fn ray_spiral(rays: &[Ray], turns: usize, beads: FloorBeads) -> (Vec<[f64; 2]>, 
             pts.push(p);
             turn_of.push(k as u32);
         }
+    }
+    // The last turn lies a turn's share farther from the spine where it
+    // began than where it ends: along a spine (an oval's, a peanut's) its
+    // two sides were a pitch and a turn apart, a slit no bead covers.
+    // Half a pitch from the spine, the path goes on round until it would
+    // come near the last turn.
+    let before = pts.len();
+    for j in 1..n {
+        let r = &rays[(n - j) % n];
+        let s = r.len - 0.5 * pitch;
+        let p = [r.from[0] + s * r.dir[0], r.from[1] + s * r.dir[1]];
+        if pts
+            .last()
+            .is_none_or(|q| norm(p[0] - q[0], p[1] - q[1]) >= keep)
+        {
+            pts.push(p);
+            turn_of.push(turns as u32);
+        }
+    }
+    if pts.len() > before {
+        truncate_where_close(&mut pts, &mut turn_of, MIN_GAP * pitch, 2.5 * pitch);
     }
     (pts, turn_of)
 }
