@@ -195,17 +195,18 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
         }
     }
     if let (Some(last), Some(_)) = (points.last().copied(), &floor) {
-        // The floor ends just outside the wall's start: the path steps
-        // straight up there to the wall's first height, then lays its
-        // first bead on the floor's edge (a step up a slope would be read
-        // as a thin bead under the wall's first).
+        // The floor ends half a pitch outside the wall's start: its last
+        // bead runs on, on its own layer, to under the wall's first point,
+        // and the path steps straight up from there (a bead from the
+        // floor's end in to the wall, a layer up, leaned 58° over the
+        // floor's edge; a step up that slope was read as a thin bead).
         let first = s.position(order(0), s.columns[order(0)].first as usize);
-        below.push(Some(points.len() as u32 - 1));
+        let end = points.len() - 1;
+        below.push(below[end]);
+        floor_widths.push((points.len() as u32, s.params.width_min));
         points.push(PathPoint {
-            pos: [last.pos[0], last.pos[1], first[2]],
-            column: order(0) as u32,
-            pass: v.base_layers,
-            kind: PointKind::Floor,
+            pos: [first[0], first[1], last.pos[2]],
+            ..last
         });
     }
     let mut path_of = vec![u32::MAX; s.samples.len()];
