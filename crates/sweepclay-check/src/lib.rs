@@ -54,6 +54,7 @@ pub use checker::{check_exhaustive, check_pruned};
 pub use parse::Diagnostic;
 pub use report::{
     Count, Finding, Findings, Report, Segment, SupportStats, OVERFLOW_SECTIONS, TURN_FACTOR,
+    UNDER_EXTRUDED,
 };
 
 /// One xorshift step: the unit tests' reproducible random numbers.
