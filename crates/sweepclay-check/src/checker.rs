@@ -797,6 +797,13 @@ impl<'a> Checker<'a> {
         self.weak[k].pending = pending;
     }
 
+    /// The share of a stretch's clay on clay at its own height that may have
+    /// no room before it fails: half. A bead under the nozzle a gap g above
+    /// clay is at most 1.25 w_max wide (the widths' tolerance), so it holds
+    /// 1.25 w_max g a millimetre; past twice that, more clay is pushed out
+    /// than the bead keeps (docs/CHECKER.md, "Clay on clay").
+    const SQUISH_EXCESS: f64 = 0.5;
+
     /// Ends a stretch of beads on clay at their own height: a failure if
     /// most of its clay had no room, it is at least 3/4 `w_min` long (more
     /// than a seam's last bead) and its excess is a bead's clay (more
@@ -827,7 +834,10 @@ impl<'a> Checker<'a> {
         // Either way its excess must be a bead's clay: a move with next
         // to no clay is judged as under-extruded, not here.
         let bead = cfg.width_min * cfg.min_layer_mm * st.length.max(cfg.width_min);
-        if st.excess > 0.75 * st.volume && st.excess > bead && st.length >= 0.75 * cfg.width_min {
+        if st.excess > Self::SQUISH_EXCESS * st.volume
+            && st.excess > bead
+            && st.length >= 0.75 * cfg.width_min
+        {
             self.record(Finding::DoubleDeposition, st.first_line, st.excess, false);
         }
     }
@@ -997,7 +1007,7 @@ impl<'a> Checker<'a> {
                 on_clay = true;
                 r.support.on_clay += 1;
                 let gap = (mid[2] - z_own).max(0.0);
-                let room = len * gap * 2.0 * cfg.width_max;
+                let room = len * gap * (1.0 + WIDTH_TOLERANCE) * cfg.width_max;
                 if stretch.length == 0.0 {
                     stretch.first_line = m.line;
                     stretch.first_gap = gap;

@@ -1240,3 +1240,22 @@ fn dwells_firmware_retraction_and_flow_overrides_are_read_as_firmware_does() {
         assert!(!r.printable, "{line}");
     }
 }
+
+/// A turn laid 0.2 mm above the one below at full flow (a layer of
+/// 1.25 mm's clay in a 0.2 mm gap): most of its clay has no room and is
+/// pushed out sideways and up into the nozzle's path (docs/CHECKER.md,
+/// "Clay on clay"). It used to pass with a warning.
+#[test]
+fn a_turn_squashed_into_a_fifth_of_its_layer_fails() {
+    let mut g = wall(6);
+    let at = g.at;
+    let z = at[2] + 0.2;
+    g.bead([at[0], at[1], z], W, LAYER);
+    let x1 = if at[0] < 70.0 { 90.0 } else { 50.0 };
+    g.run([x1, 50.0, z], W, LAYER);
+    let z2 = z + LAYER;
+    g.bead([x1, 50.0, z2], W, LAYER);
+    g.run([at[0], 50.0, z2], W, LAYER);
+    let r = verdict(&g.out);
+    assert!(!r.printable, "{}", r.render());
+}
