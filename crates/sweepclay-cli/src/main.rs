@@ -87,8 +87,9 @@ struct ServeArgs {
     /// address (repeatable): what keeps other sites' pages out.
     #[arg(long = "allow-host", value_name = "NAME")]
     allow_hosts: Vec<String>,
-    /// A secret the page must carry to use the API; with --host 0.0.0.0
-    /// one is made up and printed in the link unless given.
+    /// A secret the page must carry to use the API; on any address but
+    /// loopback (0.0.0.0, or one LAN address) one is made up and printed
+    /// in the link unless given.
     #[arg(long)]
     token: Option<String>,
 }
@@ -341,6 +342,16 @@ fn load_printer(spec: &str) -> Result<Printer> {
 /// reading it whole.
 fn read_capped(path: &Path, cap: usize) -> std::result::Result<Vec<u8>, String> {
     use std::io::Read;
+    // A FIFO or a device would block or never end: only regular files.
+    match std::fs::metadata(path) {
+        Ok(m) if !m.is_file() => {
+            return Err(format!(
+                "{}: not a regular file (a directory, device or FIFO)",
+                path.display()
+            ))
+        }
+        _ => {}
+    }
     let f = std::fs::File::open(path).map_err(|e| format!("{}: {e}", path.display()))?;
     let mut bytes = Vec::new();
     f.take(cap as u64 + 1)
@@ -374,11 +385,20 @@ fn slice(a: SliceArgs) -> Result<i32> {
         .parent()
         .map(Path::to_path_buf)
         .unwrap_or_default();
+    // Every file read, so that no output replaces one of them.
+    let mut inputs: Vec<PathBuf> = std::fs::canonicalize(&a.design).into_iter().collect();
     design
-        .load_images(|p| read_capped(&folder.join(p), sweepclay_core::texture::MAX_IMAGE_BYTES))
+        .load_images(|p| {
+            let path = folder.join(p);
+            inputs.extend(std::fs::canonicalize(&path));
+            read_capped(&path, sweepclay_core::texture::MAX_IMAGE_BYTES)
+        })
         .with_context(|| source.clone())?;
     if let Some(p) = &a.printer {
         design.printer = PrinterRef::Inline(Box::new(load_printer(p)?));
+        if Printer::preset(p).is_none() {
+            inputs.extend(std::fs::canonicalize(p));
+        }
     }
     for s in &a.sets {
         let (k, v) = s
@@ -405,12 +425,17 @@ fn slice(a: SliceArgs) -> Result<i32> {
     // correction loop; it becomes the output only if it passes (or with
     // --force).
     let out = output_target(&out)?;
-    // `slice t4.json -o t4.json` would replace the design by its G-code.
-    if let Ok(input) = std::fs::canonicalize(&a.design) {
-        if input == out {
+    let preview = a.preview.as_deref().map(output_target).transpose()?;
+    // `slice t4.json -o t4.json` would replace the design by its G-code,
+    // `--preview d.json` by an SVG, `-o pic.png` a texture's picture.
+    for (flag, target) in [("-o", Some(&out)), ("--preview", preview.as_ref())] {
+        let Some(target) = target else { continue };
+        let resolved = std::fs::canonicalize(target).unwrap_or_else(|_| target.clone());
+        if let Some(input) = inputs.iter().find(|i| **i == resolved) {
             bail!(
-                "-o {}: that is the design file itself; refusing to write the G-code over it",
-                out.display()
+                "{flag} {}: that is an input ({}); refusing to write over it",
+                target.display(),
+                input.display()
             );
         }
     }
@@ -583,7 +608,10 @@ fn serve(a: ServeArgs) -> Result<i32> {
             addr.ip().to_string()
         };
         let lan = addr.ip().is_unspecified();
-        let token = a.token.clone().or_else(|| lan.then(random_token));
+        let token = a
+            .token
+            .clone()
+            .or_else(|| token_required(addr.ip()).then(random_token));
         if token.as_ref().is_some_and(|t| {
             t.is_empty()
                 || !t
@@ -632,6 +660,14 @@ fn serve(a: ServeArgs) -> Result<i32> {
         sweepclay_web::run(listener, limits).await?;
         Ok(0)
     })
+}
+
+/// Whether a server bound to `ip` must want a token: any address other
+/// machines can reach — every interface, or one LAN address such as
+/// `192.168.1.20` (it let the whole network in without one) — not
+/// loopback.
+fn token_required(ip: std::net::IpAddr) -> bool {
+    !ip.is_loopback()
 }
 
 fn check_cmd(a: CheckArgs) -> Result<i32> {
@@ -804,4 +840,26 @@ fn write_atomic(path: &Path, bytes: &[u8]) -> Result<()> {
     let mut tmp = temp_beside(&path)?;
     tmp.write_all(bytes)?;
     persist(tmp, &path)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::token_required;
+
+    #[test]
+    fn every_bind_but_loopback_wants_a_token() {
+        for ip in [
+            "192.168.1.20",
+            "10.0.0.7",
+            "0.0.0.0",
+            "::",
+            "fe80::1",
+            "203.0.113.9",
+        ] {
+            assert!(token_required(ip.parse().unwrap()), "{ip}");
+        }
+        for ip in ["127.0.0.1", "127.0.0.2", "::1"] {
+            assert!(!token_required(ip.parse().unwrap()), "{ip}");
+        }
+    }
 }

@@ -740,12 +740,67 @@ fn outputs_keep_the_design_the_mode_and_no_leftovers() {
         .args(["slice", "ex/t4.json", "-o", "ex/t4.json"])
         .assert()
         .failure()
-        .stderr(predicate::str::contains("the design file itself"));
+        .stderr(predicate::str::contains("that is an input"));
+    // Nor the preview over the design.
+    sweepclay(tmp.path())
+        .args(["slice", "ex/t4.json", "--preview", "ex/t4.json"])
+        .assert()
+        .failure()
+        .stderr(
+            predicate::str::contains("--preview").and(predicate::str::contains("that is an input")),
+        );
     assert_eq!(
         std::fs::read(&design).unwrap(),
         before,
         "the design was overwritten"
     );
+    // Nor the G-code over a texture's picture; a texture path that is a
+    // FIFO is refused, not read forever.
+    let png = tmp.path().join("pic.png");
+    let pixels = [0u8, 255, 128, 64];
+    let mut bytes = Vec::new();
+    {
+        let mut enc = png::Encoder::new(&mut bytes, 2, 2);
+        enc.set_color(png::ColorType::Grayscale);
+        enc.set_depth(png::BitDepth::Eight);
+        enc.write_header()
+            .unwrap()
+            .write_image_data(&pixels)
+            .unwrap();
+    }
+    std::fs::write(&png, &bytes).unwrap();
+    let textured = |path: &str| {
+        let mut d: serde_json::Value = serde_json::from_str(
+            &std::fs::read_to_string(tmp.path().join("ex/vase.json")).unwrap(),
+        )
+        .unwrap();
+        d["texture"] = serde_json::json!([{ "kind": "image", "path": path, "amplitude": 0.5 }]);
+        d.to_string()
+    };
+    std::fs::write(tmp.path().join("tex.json"), textured("pic.png")).unwrap();
+    sweepclay(tmp.path())
+        .args(["slice", "tex.json", "-o", "pic.png"])
+        .assert()
+        .failure()
+        .stderr(predicate::str::contains("that is an input"));
+    assert_eq!(
+        std::fs::read(&png).unwrap(),
+        bytes,
+        "the picture was overwritten"
+    );
+    let fifo = tmp.path().join("fifo.png");
+    let made = std::process::Command::new("mkfifo")
+        .arg(&fifo)
+        .status()
+        .unwrap();
+    assert!(made.success());
+    std::fs::write(tmp.path().join("fifo.json"), textured("fifo.png")).unwrap();
+    sweepclay(tmp.path())
+        .args(["slice", "fifo.json", "-o", "fifo.gcode"])
+        .timeout(std::time::Duration::from_secs(20))
+        .assert()
+        .failure()
+        .stderr(predicate::str::contains("not a regular file"));
     for mode in [0o600, 0o444] {
         let out = tmp.path().join(format!("t4-{mode:o}.gcode"));
         std::fs::write(&out, "old").unwrap();
