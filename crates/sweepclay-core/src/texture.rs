@@ -306,6 +306,44 @@ impl TextureSpec {
         Ok(())
     }
 
+    /// Refuses, by name, a key this kind of texture does not read
+    /// (`count` on a ripple, a picture on a flute): it was ignored, and a
+    /// picture on any kind was decoded.
+    pub fn check_keys(&self, key: &str) -> Result<()> {
+        let given = [
+            ("period", self.period.is_some()),
+            ("count", self.count.is_some()),
+            ("pitch", self.pitch.is_some()),
+            ("deg_per_mm", self.deg_per_mm.is_some()),
+            ("path", self.path.is_some()),
+            ("png_base64", self.png_base64.is_some()),
+        ];
+        let reads: &[&str] = match self.kind {
+            Kind::Ripple => &["period"],
+            Kind::Flute => &["count", "period"],
+            Kind::Spiral => &["count", "pitch", "deg_per_mm"],
+            Kind::Image => &["path", "png_base64"],
+        };
+        match given
+            .iter()
+            .find(|(name, set)| *set && !reads.contains(name))
+        {
+            Some((name, _)) => Err(Error::invalid(
+                format!("{key}.{name}"),
+                format!(
+                    "a {} texture does not read `{name}` (it reads {})",
+                    self.kind.name(),
+                    reads
+                        .iter()
+                        .map(|r| format!("`{r}`"))
+                        .collect::<Vec<_>>()
+                        .join(", ")
+                ),
+            )),
+            None => Ok(()),
+        }
+    }
+
     /// Decodes `png_base64` into [`TextureSpec::image`] (if given and not
     /// yet decoded).
     pub fn load(&mut self, key: &str) -> Result<()> {
@@ -787,5 +825,56 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("texture[0]"));
+    }
+}
+
+#[cfg(test)]
+mod key_tests {
+    #[test]
+    fn a_key_the_kind_does_not_read_is_refused_before_any_picture_is_decoded() {
+        let design = |texture: &str| {
+            format!(
+                r#"{{"sweepclay":1,"profile_start":{{"control_points":[[0,0],[0,40]]}},
+                    "trajectory":{{"control_points":[[30,0],[0,30],[-30,0],[0,-30]],"closed":true}},
+                    "texture":[{texture}]}}"#
+            )
+        };
+        // `count` on a ripple was ignored; a picture on one was decoded
+        // (this one is no base64 at all: refused for the key, not for
+        // its bytes).
+        for (texture, key) in [
+            (
+                r#"{"kind":"ripple","amplitude":1,"period":10,"count":5}"#,
+                "texture[0].count",
+            ),
+            (
+                r#"{"kind":"ripple","amplitude":1,"period":10,"png_base64":"!!"}"#,
+                "texture[0].png_base64",
+            ),
+            (
+                r#"{"kind":"flute","amplitude":1,"count":8,"deg_per_mm":2}"#,
+                "texture[0].deg_per_mm",
+            ),
+            (
+                r#"{"kind":"image","amplitude":1,"path":"a.png","period":3}"#,
+                "texture[0].period",
+            ),
+        ] {
+            let e = crate::Design::from_json(&design(texture)).unwrap_err();
+            match e {
+                crate::Error::Invalid { key: k, reason } => {
+                    assert_eq!(k, key, "{reason}");
+                    assert!(reason.contains("does not read"), "{reason}");
+                }
+                e => panic!("{e}"),
+            }
+        }
+        // 17 entries are refused by the cap before any is decoded.
+        let many =
+            vec![r#"{"kind":"ripple","amplitude":1,"period":10,"png_base64":"!!"}"#; 17].join(",");
+        let e = crate::Design::from_json(&design(&many))
+            .unwrap_err()
+            .to_string();
+        assert!(e.contains("at most 16"), "{e}");
     }
 }
