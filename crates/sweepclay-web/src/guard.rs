@@ -239,13 +239,38 @@ impl Pool {
     }
 }
 
-/// The host part of a `Host` header value (`[::1]:8080` → `[::1]`).
-fn host_name(v: &str) -> &str {
-    if let Some(end) = v.find(']') {
-        &v[..=end]
+/// The host part of a `Host` header value (`[::1]:8080` → `[::1]`), if
+/// it is one: a name of letters, digits, dots and hyphens or a bracketed
+/// IPv6 address, then at most a `:` and a port of digits. Anything else
+/// (`[::1]evil.example`, `localhost:80@evil`) is no host.
+fn host_name(v: &str) -> Option<&str> {
+    let (name, port) = if v.starts_with('[') {
+        let end = v.find(']')?;
+        (&v[..=end], &v[end + 1..])
     } else {
-        v.split(':').next().unwrap_or(v)
-    }
+        match v.find(':') {
+            Some(i) => (&v[..i], &v[i..]),
+            None => (v, ""),
+        }
+    };
+    let port_ok = port.is_empty()
+        || (port.len() > 1
+            && port.starts_with(':')
+            && port[1..].bytes().all(|b| b.is_ascii_digit()));
+    let name_ok = match name.strip_prefix('[') {
+        Some(inner) => inner.strip_suffix(']').is_some_and(|a| {
+            !a.is_empty()
+                && a.bytes()
+                    .all(|b| b.is_ascii_hexdigit() || b == b':' || b == b'.')
+        }),
+        None => {
+            !name.is_empty()
+                && name
+                    .bytes()
+                    .all(|b| b.is_ascii_alphanumeric() || b == b'.' || b == b'-')
+        }
+    };
+    (port_ok && name_ok).then_some(name)
 }
 
 /// Refuses requests that are not from the page's own origin (above), and
@@ -377,8 +402,23 @@ fn refusal(who: &Admission, body_limit: usize, req: &Request) -> Option<ApiError
     let hosts = &who.hosts;
     let h = req.headers();
     let text = |name| h.get(name).and_then(|v: &HeaderValue| v.to_str().ok());
+    // Two Host or Origin headers: which one a proxy or the server reads
+    // is anyone's guess, so neither is trusted.
+    for (name, what) in [(header::HOST, "Host"), (header::ORIGIN, "Origin")] {
+        if h.get_all(name).iter().count() > 1 {
+            return Some(ApiError::new(
+                400,
+                format!("the request carries more than one {what} header; refused"),
+            ));
+        }
+    }
     let host = text(header::HOST).unwrap_or("");
-    let name = host_name(host);
+    let Some(name) = host_name(host).or(hosts.is_empty().then_some(host)) else {
+        return Some(ApiError::new(
+            400,
+            format!("Host `{host}` is no host name (letters, digits, dots, hyphens or [an IPv6 address], then a port)"),
+        ));
+    };
     let known = hosts.iter().any(|a| a.eq_ignore_ascii_case(name)) || (who.lan && is_ip(name));
     if !hosts.is_empty() && !known {
         return Some(ApiError::new(
@@ -453,9 +493,20 @@ mod tests {
 
     #[test]
     fn host_names_without_ports() {
-        assert_eq!(host_name("127.0.0.1:8080"), "127.0.0.1");
-        assert_eq!(host_name("localhost"), "localhost");
-        assert_eq!(host_name("[::1]:80"), "[::1]");
-        assert_eq!(host_name("evil.example:8080"), "evil.example");
+        assert_eq!(host_name("127.0.0.1:8080"), Some("127.0.0.1"));
+        assert_eq!(host_name("localhost"), Some("localhost"));
+        assert_eq!(host_name("[::1]:80"), Some("[::1]"));
+        assert_eq!(host_name("evil.example:8080"), Some("evil.example"));
+        // Not host names: each was read as an allowed one.
+        for bad in [
+            "[::1]evil.example",
+            "localhost:80@evil",
+            "localhost:",
+            "local host",
+            "[::1",
+            "",
+        ] {
+            assert_eq!(host_name(bad), None, "{bad}");
+        }
     }
 }

@@ -682,3 +682,40 @@ async fn stalled_uploads_hold_no_more_than_the_body_budget() {
     .await;
     assert_eq!(r.status(), 200);
 }
+
+/// A Host that is no host name, or two Host or Origin headers, are
+/// refused: each let a stranger's name through (the first header was the
+/// only one checked; `[::1]evil.example` passed as `[::1]`).
+#[tokio::test]
+async fn ambiguous_hosts_and_origins_are_refused() {
+    let base = server(Limits::default()).await;
+    let addr = base.trim_start_matches("http://").to_string();
+    let port = addr.rsplit(':').next().unwrap().to_string();
+    for host in ["[::1]evil.example", "localhost:80@evil", "127.0.0.1:x"] {
+        let r = raw(
+            &base,
+            &format!("GET /api/meta HTTP/1.1\r\nHost: {host}\r\nConnection: close\r\n\r\n"),
+        )
+        .await;
+        assert!(r.starts_with("HTTP/1.1 400"), "{host}: {r}");
+    }
+    let r = raw(
+        &base,
+        &format!("GET /api/meta HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nHost: evil.example\r\nConnection: close\r\n\r\n"),
+    )
+    .await;
+    assert!(r.starts_with("HTTP/1.1 400"), "{r}");
+    let r = raw(
+        &base,
+        &format!("GET /api/meta HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nOrigin: http://127.0.0.1:{port}\r\nOrigin: http://evil.example\r\nConnection: close\r\n\r\n"),
+    )
+    .await;
+    assert!(r.starts_with("HTTP/1.1 400"), "{r}");
+    // The page's own requests still pass.
+    let r = raw(
+        &base,
+        &format!("GET /api/meta HTTP/1.1\r\nHost: 127.0.0.1:{port}\r\nOrigin: http://127.0.0.1:{port}\r\nConnection: close\r\n\r\n"),
+    )
+    .await;
+    assert!(r.starts_with("HTTP/1.1 200"), "{r}");
+}
