@@ -970,14 +970,8 @@ fn find_fold(s: &Surface) -> Option<(u32, u32, [f64; 3])> {
 
 /// Squared distance from a point to a segment in the plane.
 fn point_segment2(p: [f64; 2], s: [[f64; 2]; 2]) -> f64 {
-    let (dx, dy) = (s[1][0] - s[0][0], s[1][1] - s[0][1]);
-    let l2 = dx * dx + dy * dy;
-    let t = if l2 > 0.0 {
-        (((p[0] - s[0][0]) * dx + (p[1] - s[0][1]) * dy) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    (p[0] - s[0][0] - t * dx).powi(2) + (p[1] - s[0][1] - t * dy).powi(2)
+    let q = crate::plane::closest_on_segment(p, s[0], s[1]);
+    (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2)
 }
 
 /// Distance between two segments in the plane.

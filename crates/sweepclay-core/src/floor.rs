@@ -31,7 +31,7 @@
 //! widest part is refused rather than filled by connected Fermat spirals.
 
 use crate::grid::Grid2;
-use crate::plane::signed_area2;
+use crate::plane::{closest_on_segment as project, signed_area2};
 
 pub use crate::design::FLOOR_OVERLAP;
 
@@ -83,8 +83,6 @@ pub struct FloorSpiral {
     pub widths: Vec<f64>,
     /// Turns round the spine.
     pub turns: u32,
-    /// The spine's two ends (equal for a round region).
-    pub spine: [[f64; 2]; 2],
     /// Closest (mm) any two neighbouring turns come.
     pub min_gap: f64,
     /// Farthest (mm) any two neighbouring turns part.
@@ -190,7 +188,7 @@ pub fn spiral_floor_covering(
             // The most turns whose closest neighbours keep MIN_GAP pitches.
             let mut turns = ((short / pitch).floor() as usize).clamp(1, MAX_FLOOR_TURNS);
             let m = loop {
-                let m = measure(spine, &rays, turns, beads);
+                let m = measure(&rays, turns, beads);
                 if m.closest.1 < MIN_GAP * pitch && turns > 1 {
                     turns -= 1;
                     continue;
@@ -333,13 +331,7 @@ fn offset_spiral(outer: &[[f64; 2]], beads: FloorBeads) -> Option<Measured> {
     if pts.len() < 2 {
         return None;
     }
-    Some(measure_path(
-        pts,
-        turn_of,
-        turns,
-        [centroid(outer); 2],
-        beads,
-    ))
+    Some(measure_path(pts, turn_of, turns, beads))
 }
 
 /// The contours of a counter-clockwise closed contour offset inward by
@@ -508,18 +500,6 @@ fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
     norm(a[0] - b[0], a[1] - b[1])
 }
 
-/// The point of segment `a`–`b` nearest `p`.
-fn project(p: [f64; 2], a: [f64; 2], b: [f64; 2]) -> [f64; 2] {
-    let ab = [b[0] - a[0], b[1] - a[1]];
-    let l2 = ab[0] * ab[0] + ab[1] * ab[1];
-    let t = if l2 > 0.0 {
-        (((p[0] - a[0]) * ab[0] + (p[1] - a[1]) * ab[1]) / l2).clamp(0.0, 1.0)
-    } else {
-        0.0
-    };
-    [a[0] + t * ab[0], a[1] + t * ab[1]]
-}
-
 fn perimeter(ring: &[[f64; 2]]) -> f64 {
     ring.windows(2)
         .map(|w| dist(w[0], w[1]))
@@ -599,40 +579,54 @@ fn spines(outer: &[[f64; 2]]) -> Vec<[[f64; 2]; 2]> {
     scored.into_iter().map(|(_, s)| s).collect()
 }
 
+/// The unit inward normal of closed polygon `outer` at point `i`, from
+/// its neighbours' chord (`sign`: 1 counter-clockwise, −1 clockwise).
+fn inward_normal(outer: &[[f64; 2]], i: usize, sign: f64) -> [f64; 2] {
+    let n = outer.len();
+    let (a, b) = (outer[(i + n - 1) % n], outer[(i + 1) % n]);
+    let t = [b[0] - a[0], b[1] - a[1]];
+    let tl = norm(t[0], t[1]).max(1e-12);
+    [-t[1] * sign / tl, t[0] * sign / tl]
+}
+
+/// The orientation sign [`inward_normal`] takes.
+fn turning(outer: &[[f64; 2]]) -> f64 {
+    if signed_area2(outer) > 0.0 {
+        1.0
+    } else {
+        -1.0
+    }
+}
+
+/// A ray from `from` to `foot`, its cosine with the inward `normal`.
+fn ray(from: [f64; 2], foot: [f64; 2], normal: [f64; 2]) -> Ray {
+    let d = [foot[0] - from[0], foot[1] - from[1]];
+    let len = norm(d[0], d[1]);
+    let dir = if len > 0.0 {
+        [d[0] / len, d[1] / len]
+    } else {
+        [0.0, 0.0]
+    };
+    Ray {
+        from,
+        dir,
+        len,
+        cos: (dir[0] * normal[0] + dir[1] * normal[1]).max(0.3),
+    }
+}
+
 /// The rays from each polygon point to its nearest point on the spine.
 fn rays_to(outer: &[[f64; 2]], spine: [[f64; 2]; 2]) -> Vec<Ray> {
-    let sign = if signed_area2(outer) > 0.0 { 1.0 } else { -1.0 };
-    let [a, b] = spine;
+    let sign = turning(outer);
     outer
         .iter()
-        .map(|&p| {
-            let foot = project(p, a, b);
-            let d = [foot[0] - p[0], foot[1] - p[1]];
-            let len = norm(d[0], d[1]);
-            let dir = if len > 0.0 {
-                [d[0] / len, d[1] / len]
-            } else {
-                [0.0, 0.0]
-            };
-            Ray {
-                from: p,
-                dir,
-                len,
-                cos: 1.0,
-            }
-        })
-        .collect::<Vec<Ray>>()
-        .into_iter()
         .enumerate()
-        .map(|(i, mut r)| {
-            // The inward normal from the neighbours' chord.
-            let n = outer.len();
-            let (a, b) = (outer[(i + n - 1) % n], outer[(i + 1) % n]);
-            let t = [b[0] - a[0], b[1] - a[1]];
-            let tl = norm(t[0], t[1]).max(1e-12);
-            let normal = [-t[1] * sign / tl, t[0] * sign / tl];
-            r.cos = (r.dir[0] * normal[0] + r.dir[1] * normal[1]).max(0.3);
-            r
+        .map(|(i, &p)| {
+            ray(
+                p,
+                project(p, spine[0], spine[1]),
+                inward_normal(outer, i, sign),
+            )
         })
         .collect()
 }
@@ -644,47 +638,30 @@ fn rays_to(outer: &[[f64; 2]], spine: [[f64; 2]; 2]) -> Vec<Ray> {
 /// where a region pinches at a waist, where rays to the nearest point of
 /// the spine slant across the turns.
 fn normal_rays_to(outer: &[[f64; 2]], spine: [[f64; 2]; 2]) -> Vec<Ray> {
-    let nearest = rays_to(outer, spine);
-    let n = outer.len();
-    let sign = if signed_area2(outer) > 0.0 { 1.0 } else { -1.0 };
+    let sign = turning(outer);
     let [a, b] = spine;
     let e = [b[0] - a[0], b[1] - a[1]];
     let el = norm(e[0], e[1]);
-    (0..n)
-        .map(|i| {
-            let p = outer[i];
-            let (u, v) = (outer[(i + n - 1) % n], outer[(i + 1) % n]);
-            let t = [v[0] - u[0], v[1] - u[1]];
-            let tl = norm(t[0], t[1]).max(1e-12);
-            let normal = [-t[1] * sign / tl, t[0] * sign / tl];
-            if el < 1e-9 {
-                return nearest[i];
-            }
-            // p + s·normal = a + w·e, for s and w.
+    outer
+        .iter()
+        .enumerate()
+        .map(|(i, &p)| {
+            let normal = inward_normal(outer, i, sign);
+            // p + s·normal = a + w·e, for s and w; the nearest point where
+            // the spine is a point, or the normal runs along it or away.
             let det = normal[0] * (-e[1]) - normal[1] * (-e[0]);
-            if det.abs() < 1e-9 * el {
-                return nearest[i];
-            }
             let d = [a[0] - p[0], a[1] - p[1]];
-            let s_along = (d[0] * (-e[1]) - d[1] * (-e[0])) / det;
-            let w = (normal[0] * d[1] - normal[1] * d[0]) / det;
-            if s_along <= 0.0 {
-                return nearest[i];
+            let along = (d[0] * (-e[1]) - d[1] * (-e[0])) / det;
+            let foot = if el < 1e-9 || det.abs() < 1e-9 * el || along <= 0.0 {
+                project(p, a, b)
+            } else {
+                let w = ((normal[0] * d[1] - normal[1] * d[0]) / det).clamp(0.0, 1.0);
+                [a[0] + w * e[0], a[1] + w * e[1]]
+            };
+            if dist(p, foot) < 1e-9 {
+                return ray(p, project(p, a, b), normal);
             }
-            let w = w.clamp(0.0, 1.0);
-            let foot = [a[0] + w * e[0], a[1] + w * e[1]];
-            let dd = [foot[0] - p[0], foot[1] - p[1]];
-            let len = norm(dd[0], dd[1]);
-            if len < 1e-9 {
-                return nearest[i];
-            }
-            let dir = [dd[0] / len, dd[1] / len];
-            Ray {
-                from: p,
-                dir,
-                len,
-                cos: (dir[0] * normal[0] + dir[1] * normal[1]).max(0.3),
-            }
+            ray(p, foot, normal)
         })
         .collect()
 }
@@ -698,10 +675,10 @@ struct Measured {
 
 /// The spiral of `turns` turns along `rays`, its points thinned to about
 /// the outer turn's spacing, its gaps and widths measured.
-fn measure(spine: [[f64; 2]; 2], rays: &[Ray], turns: usize, beads: FloorBeads) -> Measured {
+fn measure(rays: &[Ray], turns: usize, beads: FloorBeads) -> Measured {
     let (pts, turn_of) = ray_spiral(rays, turns, beads);
     // The closing half turn counts as the innermost.
-    measure_path(pts, turn_of, turns + 1, spine, beads)
+    measure_path(pts, turn_of, turns + 1, beads)
 }
 
 /// The points of the spiral of `turns` turns along `rays`, thinned to
@@ -768,7 +745,6 @@ fn measure_path(
     pts: Vec<[f64; 2]>,
     turn_of: Vec<u32>,
     turns: usize,
-    spine: [[f64; 2]; 2],
     beads: FloorBeads,
 ) -> Measured {
     let pitch = beads.pitch();
@@ -862,7 +838,6 @@ fn measure_path(
             pts,
             widths,
             turns: turns as u32,
-            spine,
             min_gap: closest.1,
             max_gap: farthest.1,
         },
@@ -927,22 +902,6 @@ pub fn coverage(outer: &[[f64; 2]], spiral: &FloorSpiral, cell: f64) -> f64 {
         }
     }
     covered as f64 / inside.max(1) as f64
-}
-
-/// Whether `p` lies inside the closed polygon `poly` (even-odd rule).
-pub fn contains(poly: &[[f64; 2]], p: [f64; 2]) -> bool {
-    let mut inside = false;
-    let n = poly.len();
-    for i in 0..n {
-        let (a, b) = (poly[i], poly[(i + 1) % n]);
-        if (a[1] > p[1]) != (b[1] > p[1]) {
-            let x = a[0] + (p[1] - a[1]) / (b[1] - a[1]) * (b[0] - a[0]);
-            if x > p[0] {
-                inside = !inside;
-            }
-        }
-    }
-    inside
 }
 
 /// Distance from `p` to the segment `a`–`b`.

@@ -167,13 +167,13 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
         _ => None,
     };
     let floor = laid.and_then(|f| f.ok());
-    let floor_pts = floor.as_ref().map_or(0, |f| f.pts.len());
+    let floor_pts = floor.as_ref().map_or(0, |f| f.spiral.pts.len());
     let total = s.samples.len() + floor_pts * v.base_layers as usize;
     let mut points = Vec::with_capacity(total);
     let mut below: Vec<Option<u32>> = Vec::with_capacity(total);
     let mut floor_widths = Vec::with_capacity(floor_pts * v.base_layers as usize);
     if let Some(f) = &floor {
-        let m = f.pts.len();
+        let m = f.spiral.pts.len();
         for layer in 1..=v.base_layers {
             let z = f64::from(layer) * v.base_layer_mm;
             // The last floor layer runs outward, ending at the wall's
@@ -184,9 +184,9 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
                 let j = if outward { m - 1 - step } else { step };
                 // The layer below ran the same points the other way.
                 below.push((layer > 1).then(|| first - 1 - step as u32));
-                floor_widths.push((points.len() as u32, f.widths[j]));
+                floor_widths.push((points.len() as u32, f.spiral.widths[j]));
                 points.push(PathPoint {
-                    pos: [f.pts[j][0], f.pts[j][1], z],
+                    pos: [f.spiral.pts[j][0], f.spiral.pts[j][1], z],
                     column: order(0) as u32,
                     pass: layer,
                     kind: PointKind::Floor,
@@ -276,13 +276,6 @@ struct LaidFloor {
     cover: f64,
 }
 
-impl std::ops::Deref for LaidFloor {
-    type Target = FloorSpiral;
-    fn deref(&self) -> &FloorSpiral {
-        &self.spiral
-    }
-}
-
 /// The floor spiral inside the wall's first turn as corrected, from the
 /// start column on; where it covers less than [`MIN_COVER`] and the
 /// corrections moved that turn, the better of it and the spiral inside
@@ -298,14 +291,6 @@ fn vessel_floor(c: &Corrected, v: &VesselPlan) -> Result<LaidFloor, FloorRefusal
             [p[0], p[1]]
         })
         .collect();
-    let drawn: Vec<[f64; 2]> = (0..n)
-        .map(|m| {
-            let col = &s.columns[(v.start + m) % n];
-            let z = s.samples[col.first as usize].z;
-            let q = col.point(s.design_offset(col, z, 1.0), 0.0);
-            [q[0], q[1]]
-        })
-        .collect();
     // The cover reported and judged is measured on a 0.5 mm grid (the
     // spiral was chosen on a 1 mm one).
     let lay = |ring: Vec<[f64; 2]>| {
@@ -315,12 +300,26 @@ fn vessel_floor(c: &Corrected, v: &VesselPlan) -> Result<LaidFloor, FloorRefusal
             spiral,
         })
     };
-    let same = corrected
-        .iter()
-        .zip(&drawn)
-        .all(|(a, b)| (a[0] - b[0]).abs() + (a[1] - b[1]).abs() < 1e-9);
     let first = lay(corrected);
-    if same || first.as_ref().is_ok_and(|f| f.cover >= MIN_COVER) {
+    if first.as_ref().is_ok_and(|f| f.cover >= MIN_COVER) {
+        return first;
+    }
+    // Only then the turn as drawn, if the corrections moved it.
+    let drawn: Vec<[f64; 2]> = (0..n)
+        .map(|m| {
+            let col = &s.columns[(v.start + m) % n];
+            let z = s.samples[col.first as usize].z;
+            let q = col.point(s.design_offset(col, z, 1.0), 0.0);
+            [q[0], q[1]]
+        })
+        .collect();
+    let moved = first.as_ref().map_or(true, |f| {
+        f.ring
+            .iter()
+            .zip(&drawn)
+            .any(|(a, b)| (a[0] - b[0]).abs() + (a[1] - b[1]).abs() >= 1e-9)
+    });
+    if !moved {
         return first;
     }
     match (first, lay(drawn)) {
