@@ -270,6 +270,48 @@ fn failing_check_writes_nothing_unless_forced() {
 }
 
 #[test]
+fn a_rim_too_uneven_for_one_spiral_is_refused_where_the_body_meets_it() {
+    // A round pot leaning in 16°, one profile 58.3 mm tall and the other
+    // 40: the replay of its path finds the extruder body in the clay where
+    // the rim falls; the refusal says where and how close the heights
+    // must come, and --force writes the G-code to look at.
+    let tmp = tempfile::tempdir().unwrap();
+    let lean = |h: f64| {
+        let x = -h * 0.2867;
+        serde_json::json!({ "control_points": [[0.0, 0.0], [x / 2.0, h / 2.0], [x, h]] })
+    };
+    let cp: Vec<[f64; 2]> = (0..8)
+        .map(|i| {
+            let a = std::f64::consts::TAU * f64::from(i) / 8.0;
+            [37.8 * a.cos(), 37.8 * a.sin()]
+        })
+        .collect();
+    let d = serde_json::json!({
+        "sweepclay": 1,
+        "profile_start": lean(58.3), "profile_end": lean(40.0),
+        "trajectory": { "control_points": cp, "closed": true },
+        "printer": "cerambot-plus",
+    });
+    std::fs::write(tmp.path().join("pot.json"), d.to_string()).unwrap();
+    sweepclay(tmp.path())
+        .args(["slice", "pot.json", "-o", "pot.gcode"])
+        .assert()
+        .code(1)
+        .stdout(predicate::str::contains("nozzle collision"))
+        .stderr(
+            predicate::str::is_match(r"the rim rises or falls too steeply round the loop for one spiral \(first near \(-?\d+, -?\d+\) mm\); bring the rim's heights within \d+\.\d mm of each other \(now 18\.3 mm apart\)")
+                .unwrap(),
+        );
+    assert!(!tmp.path().join("pot.gcode").exists());
+    sweepclay(tmp.path())
+        .args(["slice", "pot.json", "-o", "pot.gcode", "--force"])
+        .assert()
+        .code(1)
+        .stderr(predicate::str::contains("FAILS"));
+    assert!(tmp.path().join("pot.gcode").exists());
+}
+
+#[test]
 fn check_reports_and_exit_codes() {
     let tmp = tempfile::tempdir().unwrap();
     std::fs::write(

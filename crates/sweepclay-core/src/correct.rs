@@ -858,7 +858,7 @@ fn find_twisted_contact(s: &Surface, w: f64, far: usize) -> Option<(u32, u32, [f
                         continue;
                     }
                     let q = at[j as usize];
-                    if (q[2] - p[2]).abs() > dz {
+                    if (q[2] - p[2]).abs() >= 0.5 * dz {
                         continue;
                     }
                     let d2 = (p[0] - q[0]).powi(2) + (p[1] - q[1]).powi(2) + (p[2] - q[2]).powi(2);
@@ -960,7 +960,10 @@ fn find_fold(s: &Surface) -> Option<(u32, u32, [f64; 3])> {
                 .max_by(|x, y| x.xi.total_cmp(&y.xi)),
         ) {
             let (p, q) = (w[0].point(smp.xi, smp.z), w[1].point(smp.xi, smp.z));
-            if (q[0] - p[0]) * step[0] + (q[1] - p[1]) * step[1] <= 0.0 {
+            // A twisted layer is turned whole: Ψ's step turns with it.
+            let (sn, cs) = w[0].turn(smp.z).sin_cos();
+            let along = [cs * step[0] - sn * step[1], sn * step[0] + cs * step[1]];
+            if (q[0] - p[0]) * along[0] + (q[1] - p[1]) * along[1] <= 0.0 {
                 return Some((a as u32, ((a + 1) % n) as u32, p));
             }
         }

@@ -51,6 +51,26 @@ pub struct VesselPlan {
     pub start: usize,
     /// The columns' rims h_i (mm).
     pub heights: Vec<f64>,
+    /// Where, by the sampling's estimate, no layering keeps the extruder
+    /// body clear of a rim that rises and falls; the path is laid anyway
+    /// and its replay judges (docs/ALGORITHMS.md §8).
+    pub uneven: Option<Uneven>,
+}
+
+/// A rim whose heights vary more round the loop than the spiral's
+/// layering can keep clear of the extruder body, by the sampling's
+/// estimate: what the check's advice names.
+#[derive(Clone, Debug, PartialEq)]
+pub struct Uneven {
+    /// Where the body would first meet clay, in plan (mm).
+    pub at: [f64; 2],
+    /// How high above the nozzle (mm).
+    pub over_mm: f64,
+    /// The rim's heights' spread round the loop now (mm).
+    pub spread_mm: f64,
+    /// The largest spread (the same rim, its heights drawn together
+    /// toward the lowest) whose spiral the body clears (mm).
+    pub most_mm: f64,
 }
 
 impl VesselPlan {
@@ -114,6 +134,7 @@ impl VesselPlan {
             turn_mm: [0.0, 0.0],
             start: 0,
             heights: h.to_vec(),
+            uneven: None,
         };
         Ok(plan.with(most, 0, params))
     }
@@ -180,10 +201,10 @@ impl VesselPlan {
     /// Which columns get a rim bead: the run from the turn's start while
     /// [`VesselPlan::has_rim`] holds and the nozzle, level at the rim,
     /// clears the last turn's clay within `reach` in plan and the rim
-    /// beads laid more than `exempt` columns before (a rim that rises
+    /// beads laid more than `exempt` mm of path before (a rim that rises
     /// steeply ahead ends the run early: the rim is then level to within
     /// a layer there). `h` as for [`VesselPlan::body_violation`].
-    pub fn rim_beads(&self, near: &Neighbours, h: &[f64], exempt: usize) -> Vec<bool> {
+    pub fn rim_beads(&self, near: &Neighbours, h: &[f64], exempt: f64) -> Vec<bool> {
         let n = near.len();
         let mut rim: Vec<bool> = (0..n).map(|i| self.has_rim(i, n, h[i])).collect();
         // The rim turn is one run from the turn's start: once a bead is
@@ -201,7 +222,7 @@ impl VesselPlan {
                 let (oi, oj) = (self.order(i, n), self.order(j, n));
                 // The last turn at j, laid just before (behind the seam),
                 // is the bead just laid: the body meets the turn under it.
-                let k = if n - oj + oi <= exempt {
+                let k = if oj > oi && near.behind(j, i) <= exempt {
                     self.turns - 1
                 } else {
                     self.turns
@@ -211,7 +232,7 @@ impl VesselPlan {
                 } else {
                     self.spiral_z(k, j, n, h[j])
                 };
-                if oj < oi && oi - oj > exempt && rim[j] {
+                if oj < oi && near.behind(j, i) > exempt && rim[j] {
                     top = top.max(h[j]);
                 }
                 if top - h[i] > BODY_GRAZE_MM {
@@ -227,7 +248,7 @@ impl VesselPlan {
     /// The first column where the extruder body would meet clay already
     /// laid (docs/ALGORITHMS.md §8): for every pair of columns `i`, `j`
     /// within reach in plan (`near`), the turn below at `j` (or, more than
-    /// `exempt` columns back along the loop, this turn at `j`) must not
+    /// `exempt` mm of path back along the loop, this turn at `j`) must not
     /// stand more than [`BODY_GRAZE_MM`] above the nozzle at `i`. Checked
     /// at the turns where the difference is largest (it is linear in the
     /// turn). `h` are the columns' rims.
@@ -235,7 +256,7 @@ impl VesselPlan {
         &self,
         near: &Neighbours,
         h: &[f64],
-        exempt: usize,
+        exempt: f64,
     ) -> Option<(usize, f64)> {
         let n = near.len();
         let turns = [1.max(self.turns.min(2)), self.turns];
@@ -248,11 +269,11 @@ impl VesselPlan {
                 let (oi, oj) = (self.order(i, n), self.order(j, n));
                 for k in turns {
                     let me = self.spiral_z(k, i, n, h[i]);
-                    // The turn below at j was laid n − oj + oi columns of
+                    // The turn below at j was laid `behind(j, i)` mm of
                     // path ago: within `exempt` (just behind the seam) it is
                     // the bead just laid, as the checker counts it, and the
                     // body meets what lies under it, a turn lower.
-                    let fresh = n - oj + oi <= exempt;
+                    let fresh = oj > oi && near.behind(j, i) <= exempt;
                     let below = match k {
                         1 => self.base_mm(),
                         2 if fresh => self.base_mm(),
@@ -260,7 +281,7 @@ impl VesselPlan {
                         _ => self.spiral_z(k - 1, j, n, h[j]),
                     };
                     // This turn's clay at j, laid long enough ago to count.
-                    let same = if oj < oi && oi - oj > exempt {
+                    let same = if oj < oi && near.behind(j, i) > exempt {
                         self.spiral_z(k, j, n, h[j])
                     } else {
                         f64::MIN
@@ -277,11 +298,17 @@ impl VesselPlan {
 }
 
 /// The columns of a loop within a reach of each other in plan, found by
-/// a grid built once: what the extruder body can touch.
+/// a grid built once: what the extruder body can touch; and how much path
+/// lies between two of them, which says whether clay is the bead just
+/// laid (measured where the columns are, not along Ψ: a wall leaning in
+/// has a shorter path at its rim than at its foot).
 pub struct Neighbours<'a> {
     points: &'a [[f64; 2]],
     grid: crate::grid::Grid2,
     reach: f64,
+    /// Path length from column 0 to each column, and round the loop.
+    arc: Vec<f64>,
+    length: f64,
 }
 
 impl<'a> Neighbours<'a> {
@@ -291,10 +318,30 @@ impl<'a> Neighbours<'a> {
         for (i, p) in points.iter().enumerate() {
             grid.insert_segment(*p, *p, i as u32);
         }
+        let mut arc = Vec::with_capacity(points.len());
+        let mut s = 0.0;
+        for (i, p) in points.iter().enumerate() {
+            arc.push(s);
+            let q = points[(i + 1) % points.len()];
+            s += (q[0] - p[0]).hypot(q[1] - p[1]);
+        }
         Neighbours {
             points,
             grid,
             reach,
+            arc,
+            length: s,
+        }
+    }
+
+    /// The path from column `j` forward round the loop to column `i`
+    /// (mm; a whole loop when they are the same column).
+    pub fn behind(&self, j: usize, i: usize) -> f64 {
+        let d = (self.arc[i] - self.arc[j]).rem_euclid(self.length);
+        if i == j {
+            self.length
+        } else {
+            d
         }
     }
 
@@ -548,10 +595,8 @@ mod tests {
         let v = VesselPlan::choose(&h, &p, 2).unwrap();
         let v = v.with(v.turns, n / 4, &p);
         let near = Neighbours::new(&pts, 5.0 + 3.0);
-        let spacing = std::f64::consts::TAU * 40.0 / n as f64;
-        let exempt = ((5.0 + 6.0) / spacing) as usize;
-        assert_eq!(v.body_violation(&near, &h, exempt), None);
+        assert_eq!(v.body_violation(&near, &h, 5.0 + 6.0), None);
         // Without the exemption, the seam is refused.
-        assert!(v.body_violation(&near, &h, 0).is_some());
+        assert!(v.body_violation(&near, &h, 0.0).is_some());
     }
 }

@@ -136,6 +136,12 @@ impl<W> Checked<W> {
         let p = &s.corrected.surface.params;
         let r = s.corrected.surface.printer.nozzle_radius;
         let rounds = s.corrected.report.rounds;
+        let uneven = s
+            .corrected
+            .surface
+            .vessel
+            .as_ref()
+            .and_then(|v| v.uneven.as_ref());
         let tried = if rounds > 0 {
             format!(" (after {rounds} round(s) of tightened corrections)")
         } else {
@@ -158,6 +164,13 @@ impl<W> Checked<W> {
                         "a bead overlapping the one below by too little{tried}: lean the profiles less there, or raise params.width_max ({} mm) so a wider bead reaches",
                         p.width_max
                     ),
+                    Finding::NozzleCollision if uneven.is_some() => {
+                        let u = uneven.expect("matched");
+                        format!(
+                            "the extruder body ({r} mm radius) meets clay {worst:.1} mm above the nozzle{tried}: the rim rises or falls too steeply round the loop for one spiral (first near ({:.0}, {:.0}) mm); bring the rim's heights within {:.1} mm of each other (now {:.1} mm apart)",
+                            u.at[0], u.at[1], u.most_mm, u.spread_mm
+                        )
+                    }
                     Finding::NozzleCollision => format!(
                         "the extruder body ({r} mm radius) meets clay {worst:.1} mm above the nozzle{tried}: keep that part of the wall more than {:.0} mm in plan from the rest of it, or bring the two profiles' heights closer so the passes tilt less",
                         r + p.width_max / 2.0
@@ -235,8 +248,11 @@ pub fn slice_checked<W: Write>(
     go_on(cancel)?;
     let w_max = sampled.params.width_max;
     let reach = (w_max / sampled.spacing).ceil() as usize;
-    let has_offsets = sampled.samples.iter().any(|s| s.xi.abs() > 1e-9)
-        || sampled.texture.iter().any(|d| d.abs() > 1e-9);
+    // Compressing offsets cannot help a vessel whose rim's heights are
+    // what meets the body.
+    let has_offsets = (sampled.samples.iter().any(|s| s.xi.abs() > 1e-9)
+        || sampled.texture.iter().any(|d| d.abs() > 1e-9))
+        && sampled.vessel.as_ref().is_none_or(|v| v.uneven.is_none());
     let mut tight = Tightening::default();
     // Body compression factors: the smallest known to collide, the
     // largest known to clear (with the tightening that cleared).
