@@ -106,7 +106,7 @@ function setDesign(d, { record = true, fit = false } = {}) {
   $('offset').value = d.trajectory.offset === 'normal' ? 'normal' : 'radial';
   $('closed').checked = !!d.trajectory.closed;
   updateUndo();
-  requestSlice(fit, record);
+  requestSlice(fit);
 }
 
 /**
@@ -618,7 +618,7 @@ function curveLines(d) {
   return out;
 }
 
-function requestSlice(fit, final) {
+function requestSlice(fit) {
   if (view && state.design) {
     const d = state.design;
     view.showCurves(() => curveLines(d), state.lastEdit);
@@ -630,11 +630,10 @@ function requestSlice(fit, final) {
   state.pending = { design: JSON.stringify(state.design), edit, fit: fit || state.pending?.fit, seq: state.seq };
   state.lastEdit = null;
   // A verdict belongs to one design: the last one no longer applies.
+  // The slice's answer carries the check of the very G-code it shows
+  // (one edit, one slice: docs/MODELER.md).
   cancelVerify();
   setVerdict('checking');
-  // The end of a gesture (a drag let go, a value typed) is checked at
-  // once, beside its slice: a drag's moves wait for their previews.
-  if (final) scheduleVerify(state.pending.design, state.seq);
   if (!state.inFlight) sendSlice();
 }
 
@@ -752,7 +751,16 @@ function showSlice(job, res, t0) {
     if (state.roundTrips.length > 100) state.roundTrips.shift();
     showTiming();
   });
-  if (current && !body.fit_error && state.verifyFor !== job.seq) scheduleVerify(job.design, job.seq);
+  if (current && body.verdict) {
+    cancelVerify();
+    state.verifyFor = job.seq;
+    setVerdict(body.verdict);
+    // For the speed budget (docs/MODELER.md): last edit → its verdict.
+    if (state.lastEditAt != null) state.verdictTimes.push(performance.now() - state.lastEditAt);
+    if (state.verdictTimes.length > 100) state.verdictTimes.shift();
+  } else if (current && !body.fit_error && state.verifyFor !== job.seq) {
+    scheduleVerify(job.design, job.seq);
+  }
 }
 
 function render(data, fit) {

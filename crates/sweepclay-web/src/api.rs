@@ -5,7 +5,7 @@
 pub use crate::error::ApiError;
 use crate::guard::Cancel;
 pub use crate::guard::Limits;
-use crate::verify::{slice_checked, Unchecked, Verified};
+use crate::verify::{slice_checked, slice_checked_drawn, Unchecked, Verified};
 use serde::Serialize;
 use sweepclay_core::mesh;
 use sweepclay_core::toolpath::PointKind;
@@ -116,6 +116,10 @@ pub struct SliceView {
     /// The curves as printed, where the corrections moved them: the
     /// editors draw them beside the drawn ones.
     pub printed: PrintedCurves,
+    /// The check of the G-code this preview is (none for a print that
+    /// leaves the build volume).
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub verdict: Option<Verdict>,
 }
 
 /// The design's curves as the corrections left them (design units: the
@@ -191,6 +195,7 @@ impl SliceView {
             "printer": self.printer,
             "fit_error": self.fit_error,
             "printed": self.printed,
+            "verdict": self.verdict,
         }))
         .expect("plain data serialises");
         while !json.len().is_multiple_of(4) {
@@ -243,24 +248,51 @@ fn round2(x: f64) -> f32 {
     ((x * 100.0).round() / 100.0) as f32
 }
 
-/// Slices a design and keeps what the preview shows, including which
-/// samples the corrections moved (the stages run one by one to keep the
-/// uncorrected surface).
+/// Slices a design through the correction loop and keeps what the
+/// preview shows: the path of the last round, the one the G-code prints
+/// and the download writes (docs/MODELER.md), which samples the
+/// corrections moved from the drawing, and the check's verdict, so one
+/// edit costs one slice. A print that leaves the build volume is shown
+/// as the stages lay it, with why it cannot print and no verdict.
 pub fn slice_view(design: &Design, cancel: &Cancel) -> Result<SliceView, ApiError> {
     let t0 = std::time::Instant::now();
-    let sampled = surface::sample_surface(design)?;
-    cancel.check()?;
-    let corrected = correct::correct(&sampled)?;
-    cancel.check()?;
-    // The texture is not a correction: what the corrections moved is
-    // measured with it taken out.
+    let (checked, drawn) = match slice_checked_drawn(design, 0.5, cancel, || Ok(std::io::sink())) {
+        Ok(c) => c,
+        Err(Unchecked::Io(e)) => return Err(cancel.io_error("checking the G-code", e)),
+        Err(Unchecked::Design(e)) => return unfit_view(design, cancel, t0, e),
+    };
+    let verdict = Verdict {
+        printable: checked.report.printable,
+        failures: checked.report.failures.clone(),
+        locations: checked.locations.clone(),
+        advice: checked.advice(),
+        reshaped: checked.sliced.corrected.reshaped(),
+        min_overlap: checked.report.support.min_overlap.map(|(f, _)| f),
+        lines: checked.report.lines,
+    };
+    let (moved, printed) = moved_from(&drawn, &checked.sliced.corrected);
+    drop(drawn);
+    let slice_ms = t0.elapsed().as_secs_f64() * 1e3;
+    Ok(SliceView {
+        printed,
+        verdict: Some(verdict),
+        ..view(&checked.sliced, moved, slice_ms, None)
+    })
+}
+
+/// The samples the corrections moved from the drawing (the texture,
+/// which is not a correction, taken out), and the curves as printed.
+fn moved_from(
+    drawn: &surface::Surface,
+    corrected: &correct::Corrected,
+) -> (Vec<u32>, PrintedCurves) {
     let mut plain = corrected.surface.clone();
     for (i, smp) in plain.samples.iter_mut().enumerate() {
-        if let (Some(k), Some(d)) = (corrected.kept.get(i), sampled.texture.get(i)) {
+        if let (Some(k), Some(d)) = (corrected.kept.get(i), drawn.texture.get(i)) {
             smp.xi -= k * d;
         }
     }
-    let moved: Vec<u32> = sampled
+    let moved: Vec<u32> = drawn
         .samples
         .iter()
         .zip(&plain.samples)
@@ -268,18 +300,37 @@ pub fn slice_view(design: &Design, cancel: &Cancel) -> Result<SliceView, ApiErro
         .filter(|(_, (a, b))| (a.xi - b.xi).abs() > 0.05)
         .map(|(i, _)| i as u32)
         .collect();
-    let printed = printed_curves(&sampled, &plain);
-    drop(plain);
+    (moved, printed_curves(drawn, &plain))
+}
+
+/// The preview of a design the loop refused with `why`: where the stages
+/// lay a print that leaves the build volume (or a floor one spiral cannot
+/// fill), it is shown with what lies outside marked and why it cannot be
+/// printed; any other refusal is the answer.
+fn unfit_view(
+    design: &Design,
+    cancel: &Cancel,
+    t0: std::time::Instant,
+    why: sweepclay_core::Error,
+) -> Result<SliceView, ApiError> {
+    let Ok(sampled) = surface::sample_surface(design) else {
+        return Err(why.into());
+    };
+    cancel.check()?;
+    let Ok(corrected) = correct::correct(&sampled) else {
+        return Err(why.into());
+    };
+    cancel.check()?;
+    let (moved, printed) = moved_from(&sampled, &corrected);
     drop(sampled);
     let sliced = sweepclay_core::finish_unchecked(corrected);
-    // A print that leaves the build volume is still shown, with what lies
-    // outside marked; the page says why it cannot be printed.
-    let fit_error = sweepclay_core::fits(&sliced).err().map(|e| {
-        let e = ApiError::from(e);
-        FitError {
-            error: e.error,
-            key: e.key,
-        }
+    let Err(unfit) = sweepclay_core::fits(&sliced) else {
+        return Err(why.into());
+    };
+    let e = ApiError::from(unfit);
+    let fit_error = Some(FitError {
+        error: e.error,
+        key: e.key,
     });
     let slice_ms = t0.elapsed().as_secs_f64() * 1e3;
     Ok(SliceView {
@@ -403,6 +454,7 @@ fn view(s: &Sliced, moved: Vec<u32>, slice_ms: f64, fit_error: Option<FitError>)
         },
         fit_error,
         printed: PrintedCurves::default(),
+        verdict: None,
     }
 }
 
@@ -800,5 +852,87 @@ mod tests {
     fn gcode_is_verified() {
         let text = gcode(&design("t5"), &Cancel::new()).unwrap();
         assert!(text.contains("G1"));
+    }
+
+    #[test]
+    fn the_preview_is_the_path_the_download_prints() {
+        // A pot on a foot 150 mm wide: its first G-code fails the check
+        // and the loop tightens the corrections, so the first round's path
+        // (what the preview showed) is not what prints. The preview is now
+        // the last round's, point for point the G-code's moves, and it
+        // carries that G-code's verdict.
+        let cp: Vec<[f64; 2]> = (0..8)
+            .map(|i| {
+                let a = std::f64::consts::TAU * f64::from(i) / 8.0;
+                [81.0 * a.cos(), 81.0 * a.sin()]
+            })
+            .collect();
+        let d = Design::from_json(
+            &serde_json::json!({
+                "sweepclay": 1,
+                "profile_start": { "control_points": [[0, 0], [-45, 20], [-45, 40], [-45, 60]] },
+                "trajectory": { "control_points": cp, "closed": true },
+                "printer": "cerambot-plus",
+            })
+            .to_string(),
+        )
+        .unwrap();
+        let v = slice_view(&d, &Cancel::new()).unwrap();
+        let verdict = v.verdict.as_ref().expect("a verdict");
+        assert!(verdict.printable, "{:?}", verdict.failures);
+        assert!(
+            v.corrections.iter().any(|c| c.contains("correction loop")),
+            "{:?}",
+            v.corrections
+        );
+        let text = gcode(&d, &Cancel::new()).unwrap();
+        assert_eq!(text.lines().count(), verdict.lines);
+        // Every move's end in the file, in order, in the design's frame.
+        let mut at = [0.0f64; 3];
+        let mut moves = Vec::new();
+        for line in text
+            .lines()
+            .filter(|l| l.starts_with("G1 ") || l.starts_with("G0 "))
+        {
+            for w in line.split_whitespace() {
+                match (w.as_bytes()[0], w[1..].parse::<f64>()) {
+                    (b'X', Ok(x)) => at[0] = x - v.origin[0],
+                    (b'Y', Ok(y)) => at[1] = y - v.origin[1],
+                    (b'Z', Ok(z)) => at[2] = z,
+                    _ => {}
+                }
+            }
+            moves.push(at);
+        }
+        let pts: Vec<[f64; 3]> = v
+            .path
+            .order
+            .iter()
+            .map(|&i| {
+                let p = &v.surface.positions[3 * i as usize..3 * i as usize + 3];
+                [f64::from(p[0]), f64::from(p[1]), f64::from(p[2])]
+            })
+            .collect();
+        // The path's points are the file's moves from where the travel to
+        // the first one lands, to the preview's 0.01 mm.
+        let off =
+            |p: &[f64; 3], m: &[f64; 3]| (0..3).map(|a| (p[a] - m[a]).abs()).fold(0.0, f64::max);
+        let first = moves
+            .iter()
+            .position(|m| off(&pts[0], m) < 0.006)
+            .expect("the path's start");
+        let tail = &moves[first..];
+        assert!(
+            tail.len() >= pts.len(),
+            "{} moves for {} points",
+            tail.len(),
+            pts.len()
+        );
+        let worst = pts
+            .iter()
+            .zip(tail)
+            .map(|(p, m)| off(p, m))
+            .fold(0.0, f64::max);
+        assert!(worst < 0.006, "preview and G-code differ by {worst} mm");
     }
 }

@@ -12,7 +12,7 @@
 //! |---|---|---|
 //! | `GET /` | | the page (assets are built into the binary) |
 //! | `GET /api/meta` | | presets, default parameters, examples, limits |
-//! | `POST /api/slice` | design JSON | [`api::SliceView`]: surface samples, path with widths, stats, corrections, warnings (`?format=binary`: [`api::SliceView::to_binary`], what the page uses) |
+//! | `POST /api/slice` | design JSON | [`api::SliceView`]: the correction loop's last round (the path the G-code prints): surface samples, path with widths, stats, corrections, warnings, the verdict (`?format=binary`: [`api::SliceView::to_binary`], what the page uses) |
 //! | `POST /api/verify` | design JSON | [`api::Verdict`]: the checker's verdict on its G-code |
 //! | `POST /api/gcode` | design JSON | the verified G-code, or 422 with the failures and where they are |
 //! | `POST /api/stl` | design JSON | binary STL of the surface thickened to the bead width |

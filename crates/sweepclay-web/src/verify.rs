@@ -242,8 +242,20 @@ pub fn slice_checked<W: Write>(
     design: &Design,
     min_overlap: f64,
     cancel: &Cancel,
-    mut out: impl FnMut() -> io::Result<W>,
+    out: impl FnMut() -> io::Result<W>,
 ) -> Result<Checked<W>, Unchecked> {
+    slice_checked_drawn(design, min_overlap, cancel, out).map(|(c, _)| c)
+}
+
+/// [`slice_checked`], with the surface as sampled for the last round
+/// (the drawing the corrections started from, its corners rounded if
+/// the loop rounded them): what the preview compares the print with.
+pub fn slice_checked_drawn<W: Write>(
+    design: &Design,
+    min_overlap: f64,
+    cancel: &Cancel,
+    mut out: impl FnMut() -> io::Result<W>,
+) -> Result<(Checked<W>, surface::Surface), Unchecked> {
     let mut sampled = surface::sample_surface(design)?;
     go_on(cancel)?;
     let w_max = sampled.params.width_max;
@@ -296,11 +308,11 @@ pub fn slice_checked<W: Write>(
         let printable = checked.report.printable;
         if printable {
             let Some(f) = tight.body else {
-                return Ok(checked);
+                return Ok((checked, sampled));
             };
             clears = Some((f, tight.clone()));
             if collides - f <= 0.02 || tight.rounds >= MAX_ROUNDS {
-                return Ok(checked);
+                return Ok((checked, sampled));
             }
         } else if let Some(f) = tight.body.filter(|_| body) {
             collides = collides.min(f);
@@ -309,8 +321,11 @@ pub fn slice_checked<W: Write>(
         if tight.rounds >= MAX_ROUNDS || (!printable && !fixable) {
             // The last printable round, if the bisection went past it.
             return match clears {
-                Some((_, t)) if !printable => Ok(round(&sampled, &t)?.0),
-                _ => Ok(checked),
+                Some((_, t)) if !printable => {
+                    let c = round(&sampled, &t)?.0;
+                    Ok((c, sampled))
+                }
+                _ => Ok((checked, sampled)),
             };
         }
         tight.rounds += 1;

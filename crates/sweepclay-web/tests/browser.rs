@@ -186,14 +186,24 @@ async fn download_gcode(c: &Client, downloads: &Path, missing: &str) -> std::pat
     }
 }
 
-/// Clicks the element with id `id`.
+/// Clicks the element with id `id`, waiting up to 5 s for it to take
+/// clicks (a panel the page is still laying out under load is "not
+/// interactable" for a moment).
 async fn click(c: &Client, id: &str) {
-    c.find(fantoccini::Locator::Id(id))
-        .await
-        .unwrap()
-        .click()
-        .await
-        .unwrap();
+    let deadline = Instant::now() + Duration::from_secs(5);
+    loop {
+        let el = c.find(fantoccini::Locator::Id(id)).await.unwrap();
+        match el.click().await {
+            Ok(_) => return,
+            Err(fantoccini::error::CmdError::Standard(e))
+                if e.error == fantoccini::error::ErrorStatus::ElementNotInteractable
+                    && Instant::now() < deadline =>
+            {
+                tokio::time::sleep(Duration::from_millis(100)).await;
+            }
+            Err(e) => panic!("clicking #{id}: {e}"),
+        }
+    }
 }
 
 /// Waits for the error above the 3D view and returns its text.
