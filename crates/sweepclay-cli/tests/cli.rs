@@ -271,26 +271,26 @@ fn failing_check_writes_nothing_unless_forced() {
 
 #[test]
 fn a_rim_too_uneven_for_one_spiral_is_refused_where_the_body_meets_it() {
-    // A round pot leaning in 16°, one profile 58.3 mm tall and the other
-    // 40: the replay of its path finds the extruder body in the clay where
-    // the rim falls; the refusal says where and how close the heights
-    // must come, and --force writes the G-code to look at.
+    // A round pot 86 mm wide whose rim waves between 60 and 71 mm with
+    // two peaks: too steep for one spiral to carry, and one continuous
+    // path can lay only one raised part as partial layers. The replay of
+    // the spiral over the whole rim finds the extruder body in the clay;
+    // the refusal names the second peak and the most it may rise, and
+    // --force writes the G-code to look at.
     let tmp = tempfile::tempdir().unwrap();
-    let lean = |h: f64| {
-        let x = -h * 0.2867;
-        serde_json::json!({ "control_points": [[0.0, 0.0], [x / 2.0, h / 2.0], [x, h]] })
-    };
     let cp: Vec<[f64; 2]> = (0..8)
         .map(|i| {
             let a = std::f64::consts::TAU * f64::from(i) / 8.0;
-            [37.8 * a.cos(), 37.8 * a.sin()]
+            [43.2 * a.cos(), 43.2 * a.sin()]
         })
         .collect();
     let d = serde_json::json!({
         "sweepclay": 1,
-        "profile_start": lean(58.3), "profile_end": lean(40.0),
+        "profile_start": { "control_points": [[0, 0], [0, 60]] },
+        "profile_end": { "control_points": [[0, 0], [0, 72]] },
+        "interpolation": { "control_points": [[0, 0], [0.125, 1], [0.25, 1], [0.375, 0], [0.5, 0], [0.625, 1], [0.75, 1], [0.875, 0], [1, 0]] },
         "trajectory": { "control_points": cp, "closed": true },
-        "printer": "cerambot-plus",
+        "printer": { "name": "wide", "build_volume": [300, 300, 250], "origin": [150, 150] },
     });
     std::fs::write(tmp.path().join("pot.json"), d.to_string()).unwrap();
     sweepclay(tmp.path())
@@ -299,7 +299,7 @@ fn a_rim_too_uneven_for_one_spiral_is_refused_where_the_body_meets_it() {
         .code(1)
         .stdout(predicate::str::contains("nozzle collision"))
         .stderr(
-            predicate::str::is_match(r"the rim rises or falls too steeply round the loop for one spiral \(first near \(-?\d+, -?\d+\) mm\); bring the rim's heights within \d+\.\d mm of each other \(now 18\.3 mm apart\)")
+            predicate::str::is_match(r"the rim rises in 2 places above the \d+\.\d mm one spiral carries round the loop, and one continuous path can print only one raised part: the second, near \(-?\d+, -?\d+\) mm, rises to \d+\.\d mm; lower it to \d+\.\d mm or less")
                 .unwrap(),
         );
     assert!(!tmp.path().join("pot.gcode").exists());

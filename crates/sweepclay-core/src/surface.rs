@@ -32,6 +32,9 @@ pub struct Column {
     pub passes: u32,
     /// A top-edge bead sample follows the pass samples.
     pub top: bool,
+    /// Samples after those: a vessel's raised arc's passes and top bead
+    /// above its rim turn ([`crate::vessel::RaisedArc`]).
+    pub extra: u32,
     /// The design's twist (radians): the cross-section at height z is
     /// turned about o by `twist · z / height` (docs/ALGORITHMS.md §11).
     pub twist: f64,
@@ -45,7 +48,7 @@ pub struct Column {
 impl Column {
     /// Number of samples of this column.
     pub fn len(&self) -> usize {
-        self.passes as usize + usize::from(self.top)
+        self.passes as usize + usize::from(self.top) + self.extra as usize
     }
 
     /// Whether the column has no samples (never for a valid surface).
@@ -405,6 +408,7 @@ fn sample_plain(design: &Design) -> Result<Surface> {
             first: 0,
             passes: 0,
             top: false,
+            extra: 0,
             twist: 0.0,
             normal: [0.0, 0.0],
             twist_from: 0.0,
@@ -535,20 +539,18 @@ fn clear_layering(
 /// first turn's inside.
 fn sample_vessel(
     design: &Design,
-    mut columns: Vec<Column>,
+    columns: Vec<Column>,
     length: f64,
     params: Params,
     printer: Printer,
     start: Profile,
     end: Profile,
 ) -> Result<Surface> {
-    let n = columns.len();
     let heights: Vec<f64> = columns.iter().map(|c| c.height).collect();
     let floor = params
         .floor_layers
         .unwrap_or(crate::design::DEFAULT_FLOOR_LAYERS);
-    let mut v = VesselPlan::choose(&heights, &params, floor)?;
-    let spacing = length / n as f64;
+    let chosen = VesselPlan::choose(&heights, &params, floor);
     let starts = spiral_starts(&heights);
     // The extruder body's reach, and the clay just laid along the loop
     // that it may touch, as the checker counts them; columns where the
@@ -570,8 +572,39 @@ fn sample_vessel(
     // The most turns (the thinnest layers) whose spiral the extruder body
     // clears, from the first start whose seam it clears; where a rim rises
     // and falls, thicker layers keep the turn below out of its way.
-    match clear_layering(&v, &starts, &near, &heights, exempt, &params) {
-        Ok(clear) => v = clear,
+    let full = chosen
+        .as_ref()
+        .ok()
+        .map(|v| clear_layering(v, &starts, &near, &heights, exempt, &params));
+    // Where no spiral carries the whole rim, the spiral carries it up to
+    // a level and the part above is laid as partial layers.
+    let mut peaks = None;
+    if !matches!(full, Some(Ok(_))) {
+        match raised_arc(&heights, &columns, floor, &near, exempt, &params) {
+            Ok(Some(v)) => {
+                return Ok(vessel_samples(
+                    design,
+                    columns,
+                    length,
+                    params,
+                    printer,
+                    (start, end),
+                    v,
+                    None,
+                ));
+            }
+            Ok(None) => {}
+            // Two raised parts: the spiral over the whole rim may still
+            // print (the replay judges); where it cannot, this says why.
+            Err(why) => peaks = Some(why),
+        }
+    }
+    if let (Err(_), Some(why)) = (&chosen, &peaks) {
+        return Err(Error::invalid("profile_end", why.clone()));
+    }
+    chosen?;
+    let v = match full.expect("a layering was chosen") {
+        Ok(clear) => clear,
         Err(None) => {
             return Err(Error::invalid(
                 "params.max_layer_height",
@@ -608,16 +641,47 @@ fn sample_vessel(
                 }
             }
             let c = &columns[i];
-            v = least;
+            let mut v = least;
             v.uneven = Some(crate::vessel::Uneven {
                 at: [c.p[0], c.p[1]],
                 over_mm: over,
                 spread_mm: hi - lo,
                 most_mm: ok * (hi - lo),
+                peaks,
             });
+            v
         }
-    }
+    };
     let rim = v.rim_beads(&near, &heights, exempt);
+    Ok(vessel_samples(
+        design,
+        columns,
+        length,
+        params,
+        printer,
+        (start, end),
+        v,
+        Some(rim),
+    ))
+}
+
+/// The surface of a vessel laid out by `v` (docs/ALGORITHMS.md §8): each
+/// column's spiral turns, its rim bead (where `rim` says, or, with a
+/// raised arc, on every column: at its rim or the arc's level, half a
+/// layer above the last turn at least), and a raised arc's passes and
+/// top beads above.
+#[allow(clippy::too_many_arguments)]
+fn vessel_samples(
+    design: &Design,
+    mut columns: Vec<Column>,
+    length: f64,
+    params: Params,
+    printer: Printer,
+    (start, end): (Profile, Profile),
+    v: VesselPlan,
+    rim: Option<Vec<bool>>,
+) -> Surface {
+    let n = columns.len();
     let layers = v.turns;
     let plan = LayerPlan {
         passes: layers + 1,
@@ -638,27 +702,191 @@ fn sample_vessel(
         start,
         end,
         trajectory_length: length,
-        spacing,
+        spacing: length / n as f64,
         params,
         printer,
         corners: Vec::new(),
         texture: Vec::new(),
         texture_label: (String::new(), 0.0),
     };
+    // Each arc column's place in the arc.
+    let mut in_arc = vec![usize::MAX; n];
+    if let Some(a) = &v.arc {
+        for (j, &c) in a.columns.iter().enumerate() {
+            in_arc[c] = j;
+        }
+    }
+    let half = 0.5 * v.base_layer_mm;
     for (i, col) in columns.iter_mut().enumerate() {
         col.first = surface.samples.len() as u32;
         col.passes = layers;
-        col.top = rim[i];
-        let spiral = (1..=v.turns).map(|k| v.spiral_z(k, i, n, col.height));
-        let rim = col.top.then_some(col.height);
-        for z in spiral.chain(rim) {
+        let h = v.heights[i];
+        let last = v.spiral_z(v.turns, i, n, h);
+        let (rim_z, arc_z): (Option<f64>, Vec<f64>) = match (&v.arc, &rim) {
+            (Some(a), _) if in_arc[i] != usize::MAX => {
+                let j = in_arc[i];
+                let passes = (1..=a.passes[j]).map(|k| a.level_mm + f64::from(k) * a.layer_mm);
+                let top = a.tops[j].then_some(col.height);
+                (Some(a.rim[j]), passes.chain(top).collect())
+            }
+            (Some(_), _) => (Some(col.height.max(last + half)), Vec::new()),
+            (None, Some(r)) => (r[i].then_some(col.height), Vec::new()),
+            (None, None) => (None, Vec::new()),
+        };
+        col.top = rim_z.is_some();
+        col.extra = arc_z.len() as u32;
+        let spiral = (1..=v.turns).map(|k| v.spiral_z(k, i, n, h));
+        for z in spiral.chain(rim_z).chain(arc_z) {
             let xi = surface.design_offset(col, z, 1.0);
             surface.samples.push(Sample { z, xi });
         }
     }
     surface.columns = columns;
     surface.vessel = Some(v);
-    Ok(surface)
+    surface
+}
+
+/// The layering of a vessel whose rim rises above what one spiral
+/// carries: the highest level H (in steps of a quarter layer, at most
+/// 200) at which the spiral over the rim cut at H clears the extruder
+/// body by the sampling's estimate and the rim above H is one raised arc
+/// ([`crate::vessel::RaisedArc`]); the spiral then starts just past the
+/// arc, so that its rim turn ends at the arc's end. `None` where no level
+/// serves; why not, where the rim rises in two or more places above
+/// every level the spiral carries (one continuous path reaches only one).
+fn raised_arc(
+    h: &[f64],
+    columns: &[Column],
+    floor: u32,
+    near: &crate::vessel::Neighbours,
+    exempt: f64,
+    params: &Params,
+) -> std::result::Result<Option<VesselPlan>, String> {
+    let n = h.len();
+    let da = params.layer_height.min(0.5 * params.max_layer_height);
+    let half = 0.5 * params.layer_height;
+    let lo = h.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = h.iter().copied().fold(0.0, f64::max);
+    if hi - lo < da {
+        return Ok(None);
+    }
+    let step = (0.25 * da).max((hi - lo) / 200.0);
+    // Why the lowest level tried does not serve, where the rim rises
+    // twice: which rise to lower, and to what.
+    let mut why: Option<String> = None;
+    let mut level = hi - 0.5 * da;
+    loop {
+        level -= step;
+        if level < lo {
+            break;
+        }
+        let runs = raised_runs(h, level + 0.5 * da);
+        if runs.is_empty() {
+            continue;
+        }
+        let hp: Vec<f64> = h.iter().map(|&x| x.min(level)).collect();
+        let Ok(w) = VesselPlan::choose(&hp, params, floor) else {
+            continue;
+        };
+        if runs.len() > 1 {
+            why = Some(several_rises(h, columns, level, da, runs));
+            continue;
+        }
+        let (a, len) = runs[0];
+        let end = (a + len - 1) % n;
+        let Ok(mut plan) = clear_layering(&w, &[(end + 1) % n], near, &hp, exempt, params) else {
+            continue;
+        };
+        let cols: Vec<usize> = (0..len).map(|j| (a + j) % n).collect();
+        let last: Vec<f64> = cols
+            .iter()
+            .map(|&i| plan.spiral_z(plan.turns, i, n, hp[i]))
+            .collect();
+        let rims: Vec<f64> = cols.iter().map(|&i| h[i]).collect();
+        let arc = match crate::vessel::RaisedArc::new(level, da, cols, &rims, &last, half) {
+            Ok(arc) => arc,
+            Err((j, most)) => {
+                let i = (a + j) % n;
+                why = Some(format!(
+                    "the rim rises twice above the {level:.1} mm one spiral carries round the loop, and one continuous path can print only one raised part: near ({:.0}, {:.0}) mm it rises again, to {:.1} mm; lower it there to {most:.1} mm or less",
+                    columns[i].p[0], columns[i].p[1], h[i]
+                ));
+                continue;
+            }
+        };
+        // The rim turn, every column's bead as `vessel_samples` lays it,
+        // must pass under no clay: a lower level flattens the rim the
+        // spiral carries.
+        let mut rim: Vec<f64> = (0..n)
+            .map(|i| h[i].max(plan.spiral_z(plan.turns, i, n, hp[i]) + half))
+            .collect();
+        for (j, &c) in arc.columns.iter().enumerate() {
+            rim[c] = arc.rim[j];
+        }
+        if !plan.rim_turn_clears(near, &hp, &rim, exempt) {
+            continue;
+        }
+        plan.arc = Some(arc);
+        return Ok(Some(plan));
+    }
+    why.map_or(Ok(None), Err)
+}
+
+/// Why a rim that rises above `level` in the `runs` of columns does not
+/// print as one raised part: the second highest, and the most it may
+/// rise (`da`: the passes' layer).
+fn several_rises(
+    h: &[f64],
+    columns: &[Column],
+    level: f64,
+    da: f64,
+    mut runs: Vec<(usize, usize)>,
+) -> String {
+    let n = h.len();
+    let peak = |&(a, len): &(usize, usize)| {
+        (0..len)
+            .map(|j| (a + j) % n)
+            .max_by(|&x, &y| h[x].total_cmp(&h[y]))
+            .unwrap_or(a)
+    };
+    runs.sort_by(|x, y| h[peak(y)].total_cmp(&h[peak(x)]));
+    let second = peak(&runs[1]);
+    let c = &columns[second];
+    format!(
+        "the rim rises in {} places above the {level:.1} mm one spiral carries round the loop, and one continuous path can print only one raised part: the second, near ({:.0}, {:.0}) mm, rises to {:.1} mm; lower it to {:.1} mm or less, or raise the rim between the raised parts above {level:.1} mm so that they become one",
+        runs.len(),
+        c.p[0],
+        c.p[1],
+        h[second],
+        level + 0.5 * da
+    )
+}
+
+/// The runs of columns (first, count) round a loop whose rims `h` stand
+/// above `above`.
+fn raised_runs(h: &[f64], above: f64) -> Vec<(usize, usize)> {
+    let n = h.len();
+    let up: Vec<bool> = h.iter().map(|&x| x > above).collect();
+    let Some(low) = up.iter().position(|&u| !u) else {
+        return vec![(0, n)];
+    };
+    let mut runs = Vec::new();
+    let mut m = 0;
+    while m < n {
+        let i = (low + m) % n;
+        if up[i] {
+            let first = i;
+            let mut len = 0;
+            while m < n && up[(low + m) % n] {
+                len += 1;
+                m += 1;
+            }
+            runs.push((first, len));
+        } else {
+            m += 1;
+        }
+    }
+    runs
 }
 
 #[cfg(test)]

@@ -241,6 +241,29 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
             visit(&mut points, i, local, rim, PointKind::Top);
         }
     }
+    let mut passes = rim;
+    let mut returning = 0;
+    if let Some(a) = &v.arc {
+        // The raised arc (docs/ALGORITHMS.md §8, "Partial layers"), its
+        // beads in the order `RaisedArc::order` gives. Sample `local` of an
+        // arc column: its turns, its rim bead, then its passes and top;
+        // its path point is numbered on from the rim as the samples lie
+        // (the mesh finds a point's sample by its pass).
+        let (order, climbs) = a.order();
+        for (j, k, top) in order {
+            let c = a.columns[j];
+            let local = s.columns[c].passes as usize + k as usize + usize::from(top);
+            visit(
+                &mut points,
+                c,
+                local,
+                base + local as u32 + 1,
+                PointKind::Pass,
+            );
+        }
+        returning = climbs;
+        passes = rim + a.most_passes() + 1;
+    }
     debug_assert!(
         path_of.iter().all(|&p| p != u32::MAX),
         "every sample is visited"
@@ -252,9 +275,9 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
     Toolpath {
         points,
         below,
-        passes: rim,
+        passes,
         stages: 1,
-        returning_points: 0,
+        returning_points: returning,
         vessel: Some(VesselPath {
             floor_layers: if floor.is_some() { v.floor_layers } else { 0 },
             floor_turns,

@@ -55,6 +55,202 @@ pub struct VesselPlan {
     /// body clear of a rim that rises and falls; the path is laid anyway
     /// and its replay judges (docs/ALGORITHMS.md §8).
     pub uneven: Option<Uneven>,
+    /// The part of the rim above what the spiral carries, laid as passes
+    /// back and forth after the rim turn (docs/ALGORITHMS.md §8,
+    /// "Partial layers").
+    pub arc: Option<RaisedArc>,
+}
+
+/// A raised part of a vessel's rim (a slanted cut, a pitcher's back): the
+/// spiral carries the rim up to a level H, its rim turn ends at the
+/// arc's last column, and the arc's columns are built above H by flat
+/// passes of δ back and forth, each turning at a returning point where
+/// a climb along the rim lays the top beads of the columns the next
+/// passes no longer reach (the paper's §5.2, Fig. 7, on an arc of the
+/// loop). The first pass runs backward (against the loop's order) from
+/// the arc's end; so the climbs at the arc's end run backward and
+/// follow forward passes, those at its start run forward and follow
+/// backward passes. A column on the start's side of the peak takes an
+/// odd number of passes (none where its rim is under a pass above H:
+/// the rim turn lays its rim), one on the end's side an even number;
+/// each ends with a top bead at its rim, 0.5 δ to 2 δ thick (none under
+/// 0.5 δ). The last pass also takes the other side's columns that reach
+/// it, and the climb after it lays all their tops over the peak.
+#[derive(Clone, Debug, PartialEq)]
+pub struct RaisedArc {
+    /// H: the level the spiral's rim turn lays the arc at (mm).
+    pub level_mm: f64,
+    /// δ: the passes' layer height (mm).
+    pub layer_mm: f64,
+    /// The arc's columns in the loop's order, its start to its end.
+    pub columns: Vec<usize>,
+    /// How many passes above the rim turn each of them gets.
+    pub passes: Vec<u32>,
+    /// Whether each gets a top bead at its rim after its last pass.
+    pub tops: Vec<bool>,
+    /// The height of each one's rim-turn bead (mm): H, or its own rim
+    /// where that is under a pass above H on the start's side; at least
+    /// half a layer above the spiral's last turn.
+    pub rim: Vec<f64>,
+    /// Where the arc is highest, in `columns`: it and those before it are
+    /// the start's side.
+    pub peak: usize,
+}
+
+impl RaisedArc {
+    /// The passes and tops of an arc at level `level` of passes `layer`
+    /// thick over `columns` (in the loop's order) whose rims are `h` and
+    /// whose spiral's last turn is at `last`, a rim-turn bead at least
+    /// `half` above it. Where a column's top would be thicker than two
+    /// passes (a second rise inside the arc: the passes on either side of
+    /// the peak only grow toward it), that column (its place in
+    /// `columns`) and the highest its rim may be.
+    pub fn new(
+        level: f64,
+        layer: f64,
+        columns: Vec<usize>,
+        h: &[f64],
+        last: &[f64],
+        half: f64,
+    ) -> Result<RaisedArc, (usize, f64)> {
+        let m = columns.len();
+        let e: Vec<f64> = h.iter().map(|&x| x - level).collect();
+        let peak = (0..m)
+            .max_by(|&a, &b| e[a].total_cmp(&e[b]))
+            .ok_or((0, level))?;
+        // Each side's passes grow toward the peak: a column takes no more
+        // than the lowest rim between it and the peak allows.
+        let mut reach = e.clone();
+        for j in (0..peak).rev() {
+            reach[j] = reach[j].min(reach[j + 1]);
+        }
+        for j in peak + 1..m {
+            reach[j] = reach[j].min(reach[j - 1]);
+        }
+        let mut passes = vec![0u32; m];
+        let mut tops = vec![false; m];
+        let mut rim = vec![0.0; m];
+        // The column rising most above what its side's passes allow.
+        let mut over: Option<(usize, f64, f64)> = None;
+        let mut note = |j: usize, most: f64| {
+            if over.is_none_or(|o| h[j] - most > o.1) {
+                over = Some((j, h[j] - most, most));
+            }
+        };
+        for j in 0..m {
+            let r = reach[j] + 1e-9;
+            let n = if j <= peak {
+                // Odd: one pass if the rim is a pass above H, then pairs.
+                if r < layer {
+                    0
+                } else {
+                    2 * ((r - layer) / (2.0 * layer)).floor() as u32 + 1
+                }
+            } else {
+                2 * (r / (2.0 * layer)).floor() as u32
+            };
+            passes[j] = n;
+            // On the start's side, the rim turn lays the rim of a column
+            // whose rim is under a pass above H, and no other's.
+            if n == 0 && j <= peak && e[j] >= layer - 1e-9 {
+                note(j, level + layer);
+            }
+            let target = if n == 0 && j <= peak { h[j] } else { level };
+            rim[j] = target.max(last[j] + half);
+            let under = if n == 0 {
+                rim[j]
+            } else {
+                level + f64::from(n) * layer
+            };
+            let t = h[j] - under;
+            if t > 2.0 * layer + 1e-6 {
+                note(j, under + 2.0 * layer);
+            }
+            // Where the rim turn lays the rim (no passes, the start's
+            // side), there is no top above it.
+            tops[j] = t >= 0.5 * layer - 1e-9 && !(n == 0 && j <= peak);
+        }
+        if let Some((j, _, most)) = over {
+            return Err((j, most));
+        }
+        // The last pass takes the other side's columns that reach it, so
+        // that one climb lays the tops round the peak, over it and down:
+        // two climbs meeting there from either side would each rise
+        // toward the other's clay.
+        let most = passes.iter().copied().max().unwrap_or(0);
+        if most > 0 {
+            for j in 0..m {
+                let other = if most % 2 == 1 { j > peak } else { j <= peak };
+                if other && passes[j] + 1 == most && reach[j] + 1e-9 >= f64::from(most) * layer {
+                    passes[j] = most;
+                    let t = h[j] - (level + f64::from(most) * layer);
+                    tops[j] = t >= 0.5 * layer - 1e-9;
+                }
+            }
+        }
+        Ok(RaisedArc {
+            level_mm: level,
+            layer_mm: layer,
+            columns,
+            passes,
+            tops,
+            rim,
+            peak,
+        })
+    }
+
+    /// The most passes any column takes.
+    pub fn most_passes(&self) -> u32 {
+        self.passes.iter().copied().max().unwrap_or(0)
+    }
+
+    /// The arc's beads in print order, each (place in `columns`, pass k,
+    /// whether it is the top bead after pass k), and how many climbs
+    /// (returning turns) there are. From the rim turn's end at the arc's
+    /// end: a climb back along the rim over the end's side's columns that
+    /// take no pass; then pass 1 backward, a climb forward at the start's
+    /// side over the columns whose last pass it was, pass 2 forward, a
+    /// climb back at the end's side, …; the last pass's climb runs over
+    /// the peak and down the other side.
+    pub fn order(&self) -> (Vec<(usize, u32, bool)>, u32) {
+        let m = self.columns.len();
+        let mut out = Vec::new();
+        let mut climbs = 0;
+        let mut climb =
+            |out: &mut Vec<(usize, u32, bool)>, js: &mut dyn Iterator<Item = usize>, k: u32| {
+                let before = out.len();
+                out.extend(
+                    js.filter(|&j| self.passes[j] == k && self.tops[j])
+                        .map(|j| (j, k, true)),
+                );
+                climbs += u32::from(out.len() > before);
+            };
+        let end_side = |j: usize| j > self.peak;
+        climb(&mut out, &mut (self.peak + 1..m).rev(), 0);
+        let most = self.most_passes();
+        for k in 1..=most {
+            let on: Vec<usize> = (0..m).filter(|&j| self.passes[j] >= k).collect();
+            let backward = k % 2 == 1;
+            if backward {
+                out.extend(on.iter().rev().map(|&j| (j, k, false)));
+            } else {
+                out.extend(on.iter().map(|&j| (j, k, false)));
+            }
+            let (first, last) = (
+                on.first().copied().unwrap_or(0),
+                on.last().copied().unwrap_or(0),
+            );
+            match (k == most, backward) {
+                (true, true) => climb(&mut out, &mut on.iter().copied(), k),
+                (true, false) => climb(&mut out, &mut on.iter().rev().copied(), k),
+                (false, true) => climb(&mut out, &mut (first..m).filter(|&j| !end_side(j)), k),
+                (false, false) => {
+                    climb(&mut out, &mut (0..=last).rev().filter(|&j| end_side(j)), k)
+                }
+            }
+        }
+        (out, climbs)
+    }
 }
 
 /// A rim whose heights vary more round the loop than the spiral's
@@ -71,6 +267,10 @@ pub struct Uneven {
     /// The largest spread (the same rim, its heights drawn together
     /// toward the lowest) whose spiral the body clears (mm).
     pub most_mm: f64,
+    /// Where the rim rises in two or more places above what the spiral
+    /// carries: which to lower, and to what (one continuous path lays
+    /// only one raised part as partial layers).
+    pub peaks: Option<String>,
 }
 
 impl VesselPlan {
@@ -135,6 +335,7 @@ impl VesselPlan {
             start: 0,
             heights: h.to_vec(),
             uneven: None,
+            arc: None,
         };
         Ok(plan.with(most, 0, params))
     }
@@ -243,6 +444,42 @@ impl VesselPlan {
             ended = !clear;
         }
         rim
+    }
+
+    /// Whether the nozzle laying a rim turn of beads at `rim` (every
+    /// column, from the start on) clears, by the sampling's estimate, the
+    /// last spiral turn ahead of it (laid a turn before) and the rim beads
+    /// behind it laid more than `exempt` mm of path before, within reach
+    /// in plan (`near`); `h` the columns' rims the spiral carries. Where
+    /// the rim rises steeply ahead, the last turn there stands above the
+    /// rim turn's nozzle.
+    pub fn rim_turn_clears(&self, near: &Neighbours, h: &[f64], rim: &[f64], exempt: f64) -> bool {
+        let n = near.len();
+        (0..n).all(|i| {
+            let mut clear = true;
+            near.each(i, |j| {
+                let (oi, oj) = (self.order(i, n), self.order(j, n));
+                // The last turn just behind the seam is the bead just
+                // laid: the body meets the turn under it.
+                let fresh = near.behind(j, i) <= exempt;
+                let top = if oj > oi && fresh {
+                    match self.turns {
+                        0 | 1 => self.base_mm(),
+                        k => self.spiral_z(k - 1, j, n, h[j]),
+                    }
+                } else if oj > oi {
+                    self.spiral_z(self.turns, j, n, h[j])
+                } else if oj < oi && near.behind(j, i) > exempt {
+                    rim[j]
+                } else {
+                    f64::MIN
+                };
+                if top - rim[i] > BODY_GRAZE_MM {
+                    clear = false;
+                }
+            });
+            clear
+        })
     }
 
     /// The first column where the extruder body would meet clay already

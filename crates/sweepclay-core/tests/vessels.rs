@@ -276,7 +276,7 @@ fn floor_coverage(s: &sweepclay_core::Sliced) -> f64 {
 }
 
 #[test]
-fn a_pot_whose_rim_dips_four_millimetres_on_one_side_prints() {
+fn a_pot_whose_rim_dips_on_one_side_prints() {
     // A 70 mm round pot whose walls lean in 16°, its two profiles 58.3 and
     // 54.3 mm tall. It was refused ("the rim rises or falls too steeply"):
     // the sampling counted the bead just laid as old clay because it
@@ -308,24 +308,29 @@ fn a_pot_whose_rim_dips_four_millimetres_on_one_side_prints() {
     assert_eq!(v.uneven, None);
     let r = common::check_full(&s);
     assert!(r.printable, "{}", r.render());
-    // Twice as steep a dip is laid, and the replay finds the body in the
-    // clay; the sampling's estimate of how far the heights must come
-    // together is below where the replay says it prints.
+    // Four times as steep a dip (18.3 mm) is more than one spiral
+    // carries: the spiral carries the rim up to a level, and the part
+    // above is laid as passes back and forth along its arc, each turning
+    // where a climb along the rim lays the tops (docs/ALGORITHMS.md §8).
     let mut steep = d.clone();
     steep.profile_end = Some(serde_json::from_value(lean(40.0)).unwrap());
     let s = slice(&steep).unwrap();
-    let u = s
-        .corrected
-        .surface
-        .vessel
-        .as_ref()
-        .unwrap()
-        .uneven
-        .clone()
-        .expect("uneven");
-    assert!(u.most_mm > 8.0 && u.most_mm < u.spread_mm, "{u:?}");
+    let v = s.corrected.surface.vessel.as_ref().unwrap();
+    let a = v.arc.as_ref().expect("a raised arc");
+    assert!(
+        a.level_mm > 40.0 && a.level_mm < 58.3 && a.most_passes() > 2,
+        "{a:?}"
+    );
     let r = common::check_full(&s);
-    assert!(!r.printable && r.findings[sweepclay_check::Finding::NozzleCollision].count > 0);
+    assert!(r.printable, "{}", r.render());
+    // The rim as drawn: the path's highest point is the pot's.
+    let top = s
+        .toolpath
+        .points
+        .iter()
+        .map(|p| p.pos[2])
+        .fold(0.0, f64::max);
+    assert!((top - 58.3).abs() < 0.01, "{top}");
 }
 
 #[test]

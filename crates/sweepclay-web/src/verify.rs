@@ -164,6 +164,10 @@ impl<W> Checked<W> {
                         "a bead overlapping the one below by too little{tried}: lean the profiles less there, or raise params.width_max ({} mm) so a wider bead reaches",
                         p.width_max
                     ),
+                    Finding::NozzleCollision if uneven.is_some_and(|u| u.peaks.is_some()) => {
+                        let why = uneven.and_then(|u| u.peaks.as_ref()).expect("matched");
+                        format!("the extruder body ({r} mm radius) meets clay {worst:.1} mm above the nozzle{tried}: {why}")
+                    }
                     Finding::NozzleCollision if uneven.is_some() => {
                         let u = uneven.expect("matched");
                         format!(

@@ -162,9 +162,7 @@ fn rim_refused(c: &sweepclay_web::verify::Checked<std::io::Sink>) -> bool {
     uneven
         && c.report.failures.len() == 1
         && c.report.findings[sweepclay_check::Finding::NozzleCollision].count > 0
-        && c.advice()
-            .iter()
-            .any(|a| a.contains("rim rises or falls too steeply"))
+        && c.advice().iter().any(|a| a.contains("the rim rises"))
 }
 
 proptest! {
