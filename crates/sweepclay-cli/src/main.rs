@@ -128,7 +128,7 @@ fn random_token() -> String {
 
 #[derive(Args, Debug)]
 struct SliceArgs {
-    /// Design file; a bundled example name (`t1` … `t6`, `vase`, `flower`, `cup`, `ripple-vase`, `fluted-cup`, `twisted-lobes`, `diamond-vase`) also works.
+    /// Design file; a bundled example name (`t1` … `t6`, `vase`, `flower`, `cup`, `slanted-vase`, `pitcher`, `ripple-vase`, `fluted-cup`, `twisted-lobes`, `diamond-vase`) also works.
     design: String,
     /// Output G-code file [default: the design's name with .gcode].
     #[arg(short, long)]
@@ -514,6 +514,15 @@ fn slice(a: SliceArgs) -> Result<i32> {
                 "  wall               {} spiral turns and a rim turn, one continuous path",
                 v.wall_turns
             );
+            if let Some(r) = &v.raised {
+                say!(
+                    "  raised rim         above {:.1} mm, {:.0} % of the way round: {} partial layers back and forth, {} returning turns",
+                    r.level_mm,
+                    r.span_pct,
+                    r.passes,
+                    r.returning
+                );
+            }
         } else {
             say!(
                 "  passes             {} ({} stage{}, {} returning turns)",

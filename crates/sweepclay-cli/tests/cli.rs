@@ -33,6 +33,8 @@ fn every_example_slices_to_gcode_that_checks() {
         "vase",
         "flower",
         "cup",
+        "slanted-vase",
+        "pitcher",
         "ripple-vase",
         "fluted-cup",
         "twisted-lobes",

@@ -1,6 +1,8 @@
 //! The bundled example designs: walls modelled on the paper's Table 1
-//! models t1–t6 (Fig. 11), three vessels (a round vase, a flower vase
-//! whose two profiles differ, a cup for the cerambot-mini) and four
+//! models t1–t6 (Fig. 11), five vessels (a round vase, a flower vase
+//! whose two profiles differ, a cup for the cerambot-mini, a vase whose
+//! rim slants and a pitcher with a raised back, both with partial layers
+//! above the spiral) and four
 //! textured ones (a rippled vase, a fluted cup, twisted lobes, a vase with
 //! an image texture; `scripts/texture-examples` writes them). `sweepclay
 //! examples DIR` writes them out.
@@ -16,6 +18,14 @@ pub const EXAMPLES: &[(&str, &str)] = &[
     ("vase.json", include_str!("../../../examples/vase.json")),
     ("flower.json", include_str!("../../../examples/flower.json")),
     ("cup.json", include_str!("../../../examples/cup.json")),
+    (
+        "slanted-vase.json",
+        include_str!("../../../examples/slanted-vase.json"),
+    ),
+    (
+        "pitcher.json",
+        include_str!("../../../examples/pitcher.json"),
+    ),
     (
         "ripple-vase.json",
         include_str!("../../../examples/ripple-vase.json"),

@@ -137,6 +137,23 @@ pub struct VesselStats {
     pub floor_cover_pct: f64,
     /// Spiral turns of the wall, the rim turn not counted.
     pub wall_turns: u32,
+    /// The part of the rim above what the spiral carries, laid as partial
+    /// layers (docs/ALGORITHMS.md §8), if any.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub raised: Option<RaisedStats>,
+}
+
+/// A vessel's raised rim: where its partial layers start and how many.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct RaisedStats {
+    /// The level the spiral carries the rim to (mm).
+    pub level_mm: f64,
+    /// The most passes back and forth above it.
+    pub passes: u32,
+    /// Returning turns: climbs along the rim between passes.
+    pub returning: u32,
+    /// How much of the loop the raised part spans (%).
+    pub span_pct: f64,
 }
 
 /// The layer heights a sliced design uses, per stage (docs/ALGORITHMS.md
@@ -287,38 +304,50 @@ pub fn trajectory_length(d: &Design) -> f64 {
 /// anything for it): columns (Ψ's length / spacing + 1) times the
 /// samples a column can get — a wall's mean height over the layer
 /// height (flat layers, the most the layering chooses), a vessel's
-/// lowest (its spiral turns) — plus a vessel's floor spirals, a pitch
-/// apart over the control polygon's area. [`estimated_samples`]
-/// narrows it for walls. Textures' finer sampling counted. NaN when a
+/// lowest (its spiral turns), its rim turn and the partial layers of a
+/// raised rim above — plus a vessel's floor spirals, a pitch apart over
+/// the control polygon's area. [`estimated_samples`] narrows it.
+/// Textures' finer sampling counted. NaN when a
 /// coordinate is not a number (slicing then names it).
 pub fn samples_bound(d: &Design) -> f64 {
     let t = &d.trajectory;
-    let pts = t.given_points();
     // The sampling a texture asks for (idempotent: `d` may be refined).
     let p = &d.texture_params();
-    let mut floor = 0.0;
-    if t.closed && pts.len() > 1 {
-        let area = 0.5 * crate::plane::signed_area2(pts).abs();
-        let pitch = p.width_min * (1.0 - crate::design::FLOOR_OVERLAP);
-        let layers = p
-            .floor_layers
-            .unwrap_or(crate::design::DEFAULT_FLOOR_LAYERS);
-        floor = 1.5 * area / (pitch * p.spacing) * f64::from(layers);
-    }
     let top =
         |c: &crate::design::CurveSpec| c.control_points.iter().map(|p| p[1]).fold(0.0, f64::max);
     let (zs, zt) = (top(&d.profile_start), top(d.end_profile()));
-    let height = if t.closed {
-        zs.min(zt)
+    let per_column = if t.closed {
+        // The spiral under the lower rim, a rim turn, and a raised arc's
+        // passes of at most min(Δz_min, Δz_max/2) and its top above
+        // (docs/ALGORITHMS.md §8).
+        let arc_layer = p.layer_height.min(0.5 * p.max_layer_height);
+        zs.min(zt) / p.layer_height + (zs - zt).abs() / arc_layer + 3.0
     } else {
         // The mean of λ(u) (0.5 for the default f(u) = u).
         let f = crate::curves::Interpolation::new(d.interpolation.as_ref());
         let mean = f.map_or(0.5, |f| {
             (0..=64).map(|k| f.eval(k as f64 / 64.0)).sum::<f64>() / 65.0
         });
-        (1.0 - mean) * zs + mean * zt
+        ((1.0 - mean) * zs + mean * zt) / p.layer_height + 1.0
     };
-    (trajectory_length(d) / p.spacing + 1.0) * (height / p.layer_height + 1.0) + floor
+    (trajectory_length(d) / p.spacing + 1.0) * per_column + floor_bound(d)
+}
+
+/// At most how many path points a vessel's floor takes: its layers of
+/// beads a pitch apart over the control polygon's area (0 for a wall).
+fn floor_bound(d: &Design) -> f64 {
+    let t = &d.trajectory;
+    let pts = t.given_points();
+    let p = &d.texture_params();
+    if !t.closed || pts.len() < 2 {
+        return 0.0;
+    }
+    let area = 0.5 * crate::plane::signed_area2(pts).abs();
+    let pitch = p.width_min * (1.0 - crate::design::FLOOR_OVERLAP);
+    let layers = p
+        .floor_layers
+        .unwrap_or(crate::design::DEFAULT_FLOOR_LAYERS);
+    1.5 * area / (pitch * p.spacing) * f64::from(layers)
 }
 
 /// Most columns the estimate samples a wall at (coarser than its spacing
@@ -333,15 +362,17 @@ const ESTIMATE_SAMPLES: f64 = 200_000.0;
 /// column gets in a sampling of at most 2,000 columns (the layering as
 /// slicing will choose it: tilted passes give every column the short
 /// end's count, flat ones each its own height's) times the columns at
-/// the design's spacing; for a vessel, or where that coarse sampling
-/// would be large or fails, [`samples_bound`].
+/// the design's spacing (a vessel's floor bounded as in
+/// [`samples_bound`]); where that coarse sampling would be large or
+/// fails, [`samples_bound`].
 pub fn estimated_samples(design: &Design) -> f64 {
     let d = design.printed();
     let bound = samples_bound(&d);
     let length = trajectory_length(&d);
     let columns = length / d.params.spacing + 1.0;
-    let per_column = bound / columns;
-    if d.trajectory.closed || !bound.is_finite() || !length.is_finite() {
+    let floor = floor_bound(&d);
+    let per_column = (bound - floor) / columns;
+    if !bound.is_finite() || !length.is_finite() {
         return bound;
     }
     let coarse_columns = ESTIMATE_COLUMNS.min(ESTIMATE_SAMPLES / per_column.max(1.0));
@@ -350,8 +381,12 @@ pub fn estimated_samples(design: &Design) -> f64 {
     }
     let mut coarse = d.clone();
     coarse.params.spacing = d.params.spacing.max(length / coarse_columns);
+    // A vessel's wall as the coarse sampling lays it (its spiral's turns
+    // and any raised arc), and its floor's bound.
     match surface::sample_surface(&coarse) {
-        Ok(s) if !s.columns.is_empty() => s.samples.len() as f64 / s.columns.len() as f64 * columns,
+        Ok(s) if !s.columns.is_empty() => {
+            s.samples.len() as f64 / s.columns.len() as f64 * columns + floor
+        }
         _ => bound,
     }
 }
@@ -529,6 +564,18 @@ fn stats(c: &Corrected, t: &Toolpath, e: &Extrusion) -> Stats {
             floor_area_cm2: v.floor_area_mm2 / 100.0,
             floor_cover_pct: 100.0 * v.floor_cover,
             wall_turns: v.turns,
+            raised: c
+                .surface
+                .vessel
+                .as_ref()
+                .and_then(|p| p.arc.as_ref())
+                .map(|a| RaisedStats {
+                    level_mm: a.level_mm,
+                    passes: a.most_passes(),
+                    returning: t.returning_points,
+                    span_pct: 100.0 * a.columns.len() as f64
+                        / c.surface.columns.len().max(1) as f64,
+                }),
         }),
     }
 }

@@ -726,7 +726,7 @@ fn vessel_samples(
             (Some(a), _) if in_arc[i] != usize::MAX => {
                 let j = in_arc[i];
                 let passes = (1..=a.passes[j]).map(|k| a.level_mm + f64::from(k) * a.layer_mm);
-                let top = a.tops[j].then_some(col.height);
+                let top = a.tops[j].then_some(a.top_z[j]);
                 (Some(a.rim[j]), passes.chain(top).collect())
             }
             (Some(_), _) => (Some(col.height.max(last + half)), Vec::new()),
@@ -823,7 +823,7 @@ fn raised_arc(
         for (j, &c) in arc.columns.iter().enumerate() {
             rim[c] = arc.rim[j];
         }
-        if !plan.rim_turn_clears(near, &hp, &rim, exempt) {
+        if !plan.rim_turn_clears(near, &hp, &rim, exempt) || !arc.body_clears(near, exempt) {
             continue;
         }
         plan.arc = Some(arc);

@@ -73,8 +73,8 @@ pub struct VesselPlan {
 /// backward passes. A column on the start's side of the peak takes an
 /// odd number of passes (none where its rim is under a pass above H:
 /// the rim turn lays its rim), one on the end's side an even number;
-/// each ends with a top bead at its rim, 0.5 δ to 2 δ thick (none under
-/// 0.5 δ). The last pass also takes the other side's columns that reach
+/// each ends with a top bead at its rim, 0.5 δ to 2 δ thick (half a layer
+/// above the drawn rim where that is less). The last pass also takes the other side's columns that reach
 /// it, and the climb after it lays all their tops over the peak.
 #[derive(Clone, Debug, PartialEq)]
 pub struct RaisedArc {
@@ -86,8 +86,12 @@ pub struct RaisedArc {
     pub columns: Vec<usize>,
     /// How many passes above the rim turn each of them gets.
     pub passes: Vec<u32>,
-    /// Whether each gets a top bead at its rim after its last pass.
+    /// Whether each gets a top bead after its last pass: all but those
+    /// whose rim the rim turn lays.
     pub tops: Vec<bool>,
+    /// The height of each one's top bead (mm): its rim, or half a layer
+    /// above its last pass where that is higher.
+    pub top_z: Vec<f64>,
     /// The height of each one's rim-turn bead (mm): H, or its own rim
     /// where that is under a pass above H on the start's side; at least
     /// half a layer above the spiral's last turn.
@@ -130,6 +134,7 @@ impl RaisedArc {
         let mut passes = vec![0u32; m];
         let mut tops = vec![false; m];
         let mut rim = vec![0.0; m];
+        let mut top_z = vec![0.0; m];
         // The column rising most above what its side's passes allow.
         let mut over: Option<(usize, f64, f64)> = None;
         let mut note = |j: usize, most: f64| {
@@ -167,8 +172,13 @@ impl RaisedArc {
                 note(j, under + 2.0 * layer);
             }
             // Where the rim turn lays the rim (no passes, the start's
-            // side), there is no top above it.
-            tops[j] = t >= 0.5 * layer - 1e-9 && !(n == 0 && j <= peak);
+            // side), there is no top above it. Every other column has one,
+            // half a layer thick at least (the rim then up to half a
+            // layer above the drawing): a climb that left a column out
+            // would run straight across to the next, off the wall where
+            // the loop curves in.
+            tops[j] = !(n == 0 && j <= peak);
+            top_z[j] = h[j].max(under + 0.5 * layer);
         }
         if let Some((j, _, most)) = over {
             return Err((j, most));
@@ -183,8 +193,8 @@ impl RaisedArc {
                 let other = if most % 2 == 1 { j > peak } else { j <= peak };
                 if other && passes[j] + 1 == most && reach[j] + 1e-9 >= f64::from(most) * layer {
                     passes[j] = most;
-                    let t = h[j] - (level + f64::from(most) * layer);
-                    tops[j] = t >= 0.5 * layer - 1e-9;
+                    tops[j] = true;
+                    top_z[j] = h[j].max(level + (f64::from(most) + 0.5) * layer);
                 }
             }
         }
@@ -194,6 +204,7 @@ impl RaisedArc {
             columns,
             passes,
             tops,
+            top_z,
             rim,
             peak,
         })
@@ -202,6 +213,69 @@ impl RaisedArc {
     /// The most passes any column takes.
     pub fn most_passes(&self) -> u32 {
         self.passes.iter().copied().max().unwrap_or(0)
+    }
+
+    /// The height of bead (place `j`, pass `k`, top) of [`RaisedArc::order`]
+    /// (mm).
+    pub fn bead_z(&self, j: usize, k: u32, top: bool) -> f64 {
+        if top {
+            self.top_z[j]
+        } else {
+            self.level_mm + f64::from(k) * self.layer_mm
+        }
+    }
+
+    /// Whether, by the sampling's estimate, the extruder body clears the
+    /// clay as the arc is laid in [`RaisedArc::order`]: no bead is laid
+    /// where clay laid more than `exempt` mm of path before stands more
+    /// than [`BODY_GRAZE_MM`] above the nozzle within reach in plan
+    /// (`near`, over all the loop's columns; the rim turn's beads count
+    /// as laid before). Where a raised part's peak is narrow, its two
+    /// sides' last climbs can each rise toward the other's clay.
+    pub fn body_clears(&self, near: &Neighbours, exempt: f64) -> bool {
+        let n = near.len();
+        let mut place = vec![usize::MAX; n];
+        for (j, &c) in self.columns.iter().enumerate() {
+            place[c] = j;
+        }
+        // Per arc column, the beads laid so far: (z, path position).
+        let mut laid: Vec<Vec<(f64, f64)>> = self
+            .rim
+            .iter()
+            .map(|&z| vec![(z, f64::NEG_INFINITY)])
+            .collect();
+        let (order, _) = self.order();
+        let mut at = 0.0;
+        let mut prev: Option<usize> = None;
+        for (j, k, top) in order {
+            let c = self.columns[j];
+            if let Some(p) = prev {
+                at += near.distance(p, c);
+            }
+            prev = Some(c);
+            let z = self.bead_z(j, k, top);
+            let mut clear = true;
+            near.each(c, |o| {
+                let q = place[o];
+                if q == usize::MAX || !clear {
+                    return;
+                }
+                // The highest bead there laid long enough ago.
+                let old = laid[q]
+                    .iter()
+                    .rev()
+                    .find(|b| b.1 <= at - exempt)
+                    .map_or(f64::MIN, |b| b.0);
+                if old - z > BODY_GRAZE_MM {
+                    clear = false;
+                }
+            });
+            if !clear {
+                return false;
+            }
+            laid[j].push((z, at));
+        }
+        true
     }
 
     /// The arc's beads in print order, each (place in `columns`, pass k,
@@ -571,6 +645,12 @@ impl<'a> Neighbours<'a> {
         }
     }
 
+    /// The distance in plan between columns `i` and `j` (mm).
+    pub fn distance(&self, i: usize, j: usize) -> f64 {
+        let (p, q) = (self.points[i], self.points[j]);
+        (p[0] - q[0]).hypot(p[1] - q[1])
+    }
+
     /// The path from column `j` forward round the loop to column `i`
     /// (mm; a whole loop when they are the same column).
     pub fn behind(&self, j: usize, i: usize) -> f64 {
@@ -813,6 +893,110 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("no whole number of spiral turns"), "{e}");
+    }
+
+    /// The rims of a raised arc of 9 columns above level 50 (mm): a hill.
+    const HILL: [f64; 9] = [0.6, 1.2, 2.5, 4.6, 5.9, 5.7, 2.1, 1.6, 0.7];
+
+    /// [`HILL`] with passes of 1 mm, the last turn at 49.4 mm.
+    fn hill() -> RaisedArc {
+        let e = HILL;
+        let h: Vec<f64> = e.iter().map(|x| 50.0 + x).collect();
+        let last = vec![49.4; 9];
+        RaisedArc::new(50.0, 1.0, (10..19).collect(), &h, &last, 0.5).unwrap()
+    }
+
+    #[test]
+    fn a_raised_arc_takes_odd_passes_before_its_peak_and_even_after() {
+        let a = hill();
+        assert_eq!(a.peak, 4);
+        // The start's side: none under a pass (the rim turn lays 50.6),
+        // then odd counts, 1 + 2 a pair: 1, 1, 3, 5. The end's side: even
+        // counts, 4 for 5.7, but it reaches the last pass (5), which takes
+        // it; then 2, 0, 0.
+        assert_eq!(a.passes, vec![0, 1, 1, 3, 5, 5, 2, 0, 0]);
+        // Tops: on every column but the first, whose rim the rim turn
+        // lays; at the rim, or half a pass above the last pass.
+        assert_eq!(
+            a.tops,
+            vec![false, true, true, true, true, true, true, true, true]
+        );
+        assert!((a.top_z[1] - 51.5).abs() < 1e-9 && (a.top_z[2] - 52.5).abs() < 1e-9);
+        // The rim turn lays H, or the rim itself where no pass goes, half
+        // a layer above the last turn at least.
+        assert_eq!(a.rim[0], 50.6);
+        assert_eq!(a.rim[8], 50.0);
+        for j in 0..9 {
+            let under = if a.passes[j] == 0 {
+                a.rim[j]
+            } else {
+                50.0 + f64::from(a.passes[j])
+            };
+            let t = 50.0 + HILL[j] - under;
+            assert!(t < 2.0 + 1e-9, "column {j}: top {t}");
+            if a.tops[j] {
+                assert!(
+                    (a.top_z[j] - (50.0 + HILL[j]).max(under + 0.5)).abs() < 1e-9,
+                    "{j}"
+                );
+            }
+        }
+    }
+
+    #[test]
+    fn a_raised_arc_is_one_path_visiting_every_bead_once_from_its_end() {
+        let a = hill();
+        let (order, climbs) = a.order();
+        // Every pass of every column and every top, once.
+        let mut want: Vec<(usize, u32, bool)> = Vec::new();
+        for j in 0..9 {
+            want.extend((1..=a.passes[j]).map(|k| (j, k, false)));
+            if a.tops[j] {
+                want.push((j, a.passes[j], true));
+            }
+        }
+        let mut got = order.clone();
+        got.sort_unstable();
+        want.sort_unstable();
+        assert_eq!(got, want);
+        // It starts at the arc's end (the rim turn ends there) and steps
+        // between neighbouring columns, or stays, never jumping.
+        assert_eq!(order[0], (8, 0, true));
+        for w in order.windows(2) {
+            assert!(w[0].0.abs_diff(w[1].0) <= 1, "{:?} to {:?}", w[0], w[1]);
+        }
+        // Each bead rests on the one below it, laid before.
+        for (i, &(j, k, top)) in order.iter().enumerate() {
+            if k > 1 || top && k > 0 {
+                let below = if top {
+                    (j, k, false)
+                } else {
+                    (j, k - 1, false)
+                };
+                assert!(
+                    order[..i].contains(&below),
+                    "{:?} before {below:?}",
+                    (j, k, top)
+                );
+            }
+        }
+        // The last climb runs over the peak (4) and ends on the far side.
+        assert_eq!(&order[order.len() - 2..], &[(4, 5, true), (5, 5, true)]);
+        assert_eq!(climbs, 5, "{order:?}");
+    }
+
+    #[test]
+    fn a_second_rise_inside_a_raised_arc_is_named_with_the_most_it_may_be() {
+        // 5 mm, down to 1 mm, up again to 4 mm: the end's side passes
+        // cannot grow again after the dip.
+        let e = [1.0, 3.0, 5.0, 3.0, 1.0, 2.5, 4.0, 2.0, 0.7];
+        let h: Vec<f64> = e.iter().map(|x| 50.0 + x).collect();
+        let (j, most) =
+            RaisedArc::new(50.0, 1.0, (0..9).collect(), &h, &[49.4; 9], 0.5).unwrap_err();
+        assert_eq!(j, 6);
+        // It takes no more passes than the dip allows (0): its rim may be
+        // two passes above the rim turn's 50 mm.
+        assert!((most - 52.0).abs() < 1e-9, "{most}");
     }
 
     #[test]

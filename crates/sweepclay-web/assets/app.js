@@ -781,6 +781,9 @@ function render(data, fit) {
           ? `${s.vessel.floor_layers} layers, each a spiral of ${s.vessel.floor_turns} turns, ${s.vessel.floor_area_cm2.toFixed(1)} cm² (${s.vessel.floor_cover_pct.toFixed(1)} % covered)`
           : 'none (bottomless)'],
         ['wall', `${s.vessel.wall_turns} spiral turns + rim`],
+        ...(s.vessel.raised
+          ? [['raised rim', `above ${s.vessel.raised.level_mm.toFixed(1)} mm: ${s.vessel.raised.passes} partial layers back and forth`]]
+          : []),
       ]
       : [
         ['passes', `${s.passes} (${s.stages} stage${s.stages > 1 ? 's' : ''})`],
