@@ -9,6 +9,7 @@
 //! overlap is still short of the target (the paper adjusts "twice"). With
 //! s ≤ w_max (1 − overlap) from the support-free correction, every bead then
 //! overlaps the one below by at least the target fraction of its width.
+//! No bead is narrower than it is tall (within w_max).
 //!
 //! The volume of a move is the cuboid L · w̄ · Δz̄ (paper Fig. 5), except
 //! a turnaround step, which climbs its own column to start the next layer:
@@ -115,6 +116,13 @@ pub fn plan_extrusion(path: &Toolpath, params: &Params, origin: [f64; 2]) -> Ext
                 width[b] = width[b].max(width[i]);
             }
         }
+    }
+    // A bead is at least as wide as it is tall (within w_max): a taller
+    // one does not stand, and the check fails clay farther below a bead
+    // than it is wide (a vessel's first turn over its floor, 3.75 mm up
+    // on 2 / 3.75 mm layers, was left 3 mm wide).
+    for (w, h) in width.iter_mut().zip(&layer_height) {
+        *w = w.max(h.min(wmax));
     }
     // A floor's beads are as wide as their neighbours in the layer need,
     // whatever lies below them (docs/ALGORITHMS.md §8).

@@ -334,6 +334,69 @@ fn a_pot_whose_rim_dips_on_one_side_prints() {
 }
 
 #[test]
+fn rims_slanted_raised_and_waved_print_as_drawn() {
+    // A cylinder 93 mm across whose rim runs 60 → 100 mm round the loop
+    // (slanted), or 60 mm with a back raised 40 mm (a pitcher): partial
+    // layers above the spiral. A 130 mm one whose rim waves in two peaks
+    // 12.5 mm above the valleys: one spiral carries it. Each passes the
+    // check, its top the drawn rim's height (half a layer above at most).
+    let circle = |r: f64| -> Vec<[f64; 2]> {
+        (0..8)
+            .map(|i| {
+                let a = std::f64::consts::TAU * f64::from(i) / 8.0;
+                [r * 1.08 * a.cos(), r * 1.08 * a.sin()]
+            })
+            .collect()
+    };
+    let pot = |r: f64, hi: f64, interp: Option<serde_json::Value>| {
+        let mut v = serde_json::json!({
+            "sweepclay": 1,
+            "profile_start": { "control_points": [[0.0, 0.0], [0.0, 60.0]] },
+            "profile_end": { "control_points": [[0.0, 0.0], [0.0, hi]] },
+            "trajectory": { "control_points": circle(r), "closed": true },
+            "printer": { "name": "wide", "build_volume": [300.0, 300.0, 250.0], "origin": [150.0, 150.0] },
+        });
+        if let Some(i) = interp {
+            v["interpolation"] = i;
+        }
+        Design::from_json(&v.to_string()).unwrap()
+    };
+    let back = serde_json::json!({ "control_points": [[0, 0], [0.3, 0], [0.42, 1], [0.5, 1], [0.58, 1], [0.7, 0], [1, 0]] });
+    let wave = serde_json::json!({ "control_points": [[0, 0], [0.125, 1], [0.25, 1], [0.375, 0], [0.5, 0], [0.625, 1], [0.75, 1], [0.875, 0], [1, 0]] });
+    for (what, d, raised) in [
+        ("slanted", pot(40.0, 100.0, None), true),
+        ("pitcher", pot(40.0, 100.0, Some(back)), true),
+        ("wave", pot(60.0, 73.0, Some(wave)), false),
+    ] {
+        let s = slice(&d).unwrap_or_else(|e| panic!("{what}: {e}"));
+        let v = s.corrected.surface.vessel.as_ref().unwrap();
+        assert_eq!(v.arc.is_some(), raised, "{what}");
+        let r = common::check_full(&s);
+        assert!(r.printable, "{what}: {}", r.render());
+        let top = s
+            .toolpath
+            .points
+            .iter()
+            .map(|p| p.pos[2])
+            .fold(0.0, f64::max);
+        let rim = s
+            .corrected
+            .surface
+            .columns
+            .iter()
+            .map(|c| c.height)
+            .fold(0.0, f64::max);
+        // A raised arc's tops reach the rim; a spiral's rim turn ends
+        // where its beads would be under half a layer (within a layer).
+        let below = if raised { 1e-6 } else { 1.25 };
+        assert!(
+            top >= rim - below && top <= rim + 0.625 + 1e-6,
+            "{what}: top {top}, rim {rim}"
+        );
+    }
+}
+
+#[test]
 fn a_round_vase_twisted_a_quarter_and_half_a_turn_prints() {
     // Refused at any twist of 90° or more: the fold test compared the
     // curves' order at the top with Ψ's unturned direction.
