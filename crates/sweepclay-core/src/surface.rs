@@ -844,6 +844,20 @@ fn raised_arc(
             Err(None) => {}
         }
     }
+    // The quarter layers under the lowest two-layer step, down to the
+    // lowest rim, where the spiral's rim is nearly level.
+    level += coarse;
+    loop {
+        level -= fine;
+        if level < lo {
+            break;
+        }
+        match attempt(level) {
+            Ok(plan) => return Ok(Some(plan)),
+            Err(Some(w)) => why = Some(w),
+            Err(None) => {}
+        }
+    }
     why.map_or(Ok(None), Err)
 }
 
