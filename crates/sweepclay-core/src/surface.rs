@@ -579,31 +579,21 @@ fn sample_vessel(
     // Where no spiral carries the whole rim, the spiral carries it up to
     // a level and the part above is laid as partial layers.
     let mut peaks = None;
-    if !matches!(full, Some(Ok(_))) {
-        match raised_arc(&heights, &columns, floor, &near, exempt, &params) {
-            Ok(Some(v)) => {
-                return Ok(vessel_samples(
-                    design,
-                    columns,
-                    length,
-                    params,
-                    printer,
-                    (start, end),
-                    v,
-                    None,
-                ));
+    let (v, rim) = 'plan: {
+        if !matches!(full, Some(Ok(_))) {
+            match raised_arc(&heights, &columns, floor, &near, exempt, &params) {
+                Ok(Some(v)) => break 'plan (v, None),
+                Ok(None) => {}
+                // Two raised parts: the spiral over the whole rim may still
+                // print (the replay judges); where it cannot, this says why.
+                Err(why) => peaks = Some(why),
             }
-            Ok(None) => {}
-            // Two raised parts: the spiral over the whole rim may still
-            // print (the replay judges); where it cannot, this says why.
-            Err(why) => peaks = Some(why),
         }
-    }
-    if let (Err(_), Some(why)) = (&chosen, &peaks) {
-        return Err(Error::invalid("profile_end", why.clone()));
-    }
-    chosen?;
-    let v = match full.expect("a layering was chosen") {
+        if let (Err(_), Some(why)) = (&chosen, &peaks) {
+            return Err(Error::invalid("profile_end", why.clone()));
+        }
+        chosen?;
+        let v = match full.expect("a layering was chosen") {
         Ok(clear) => clear,
         Err(None) => {
             return Err(Error::invalid(
@@ -652,7 +642,9 @@ fn sample_vessel(
             v
         }
     };
-    let rim = v.rim_beads(&near, &heights, exempt);
+        let rim = v.rim_beads(&near, &heights, exempt);
+        (v, Some(rim))
+    };
     Ok(vessel_samples(
         design,
         columns,
@@ -661,7 +653,7 @@ fn sample_vessel(
         printer,
         (start, end),
         v,
-        Some(rim),
+        rim,
     ))
 }
 

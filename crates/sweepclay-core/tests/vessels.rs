@@ -189,6 +189,15 @@ proptest! {
     }
 }
 
+/// The highest point of a slicing's path (mm).
+fn path_top(s: &sweepclay_core::Sliced) -> f64 {
+    s.toolpath
+        .points
+        .iter()
+        .map(|p| p.pos[2])
+        .fold(0.0, f64::max)
+}
+
 /// The share of the points of a 0.5 mm grid inside the wall's first turn
 /// that lie within half a bead of a bead of the first floor layer (each
 /// bead as wide as the path says).
@@ -324,12 +333,7 @@ fn a_pot_whose_rim_dips_on_one_side_prints() {
     let r = common::check_full(&s);
     assert!(r.printable, "{}", r.render());
     // The rim as drawn: the path's highest point is the pot's.
-    let top = s
-        .toolpath
-        .points
-        .iter()
-        .map(|p| p.pos[2])
-        .fold(0.0, f64::max);
+    let top = path_top(&s);
     assert!((top - 58.3).abs() < 0.01, "{top}");
 }
 
@@ -373,12 +377,7 @@ fn rims_slanted_raised_and_waved_print_as_drawn() {
         assert_eq!(v.arc.is_some(), raised, "{what}");
         let r = common::check_full(&s);
         assert!(r.printable, "{what}: {}", r.render());
-        let top = s
-            .toolpath
-            .points
-            .iter()
-            .map(|p| p.pos[2])
-            .fold(0.0, f64::max);
+        let top = path_top(&s);
         let rim = s
             .corrected
             .surface

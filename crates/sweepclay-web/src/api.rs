@@ -861,22 +861,9 @@ mod tests {
         // (what the preview showed) is not what prints. The preview is now
         // the last round's, point for point the G-code's moves, and it
         // carries that G-code's verdict.
-        let cp: Vec<[f64; 2]> = (0..8)
-            .map(|i| {
-                let a = std::f64::consts::TAU * f64::from(i) / 8.0;
-                [81.0 * a.cos(), 81.0 * a.sin()]
-            })
-            .collect();
-        let d = Design::from_json(
-            &serde_json::json!({
-                "sweepclay": 1,
-                "profile_start": { "control_points": [[0, 0], [-45, 20], [-45, 40], [-45, 60]] },
-                "trajectory": { "control_points": cp, "closed": true },
-                "printer": "cerambot-plus",
-            })
-            .to_string(),
-        )
-        .unwrap();
+        // "New pot" on the cerambot-plus, its base typed 150 mm wide under
+        // rows 60 mm wide.
+        let d = Design::from_json(include_str!("../tests/foot-pot.json")).unwrap();
         let v = slice_view(&d, &Cancel::new()).unwrap();
         let verdict = v.verdict.as_ref().expect("a verdict");
         assert!(verdict.printable, "{:?}", verdict.failures);

@@ -189,22 +189,7 @@ fn a_pot_on_a_wide_foot_is_corrected_round() {
     // check at a few columns; the tightening there was a box a bead wide,
     // compounded per failing column, and left a fin standing out to the
     // foot's radius (91 × 109 mm at z 30, "31.2 mm wider than drawn").
-    let cp: Vec<[f64; 2]> = (0..8)
-        .map(|i| {
-            let a = std::f64::consts::TAU * f64::from(i) / 8.0;
-            [81.0 * a.cos(), 81.0 * a.sin()]
-        })
-        .collect();
-    let d = Design::from_json(
-        &serde_json::json!({
-            "sweepclay": 1, "name": "new pot",
-            "profile_start": { "control_points": [[0, 0], [-45, 20], [-45, 40], [-45, 60]] },
-            "trajectory": { "control_points": cp, "closed": true },
-            "printer": "cerambot-plus",
-        })
-        .to_string(),
-    )
-    .unwrap();
+    let d = Design::from_json(include_str!("foot-pot.json")).unwrap();
     let c = slice_checked(&d, 0.5, &Cancel::new(), || Ok(Vec::new())).unwrap();
     assert!(c.report.printable, "{:?}", c.report.failures);
     let origin = c.sliced.corrected.surface.printer.origin;
