@@ -926,17 +926,17 @@ mod tests {
         // a layer above the last turn at least.
         assert_eq!(a.rim[0], 50.6);
         assert_eq!(a.rim[8], 50.0);
-        for j in 0..9 {
+        for (j, e) in HILL.iter().enumerate() {
             let under = if a.passes[j] == 0 {
                 a.rim[j]
             } else {
                 50.0 + f64::from(a.passes[j])
             };
-            let t = 50.0 + HILL[j] - under;
+            let t = 50.0 + e - under;
             assert!(t < 2.0 + 1e-9, "column {j}: top {t}");
             if a.tops[j] {
                 assert!(
-                    (a.top_z[j] - (50.0 + HILL[j]).max(under + 0.5)).abs() < 1e-9,
+                    (a.top_z[j] - (50.0 + e).max(under + 0.5)).abs() < 1e-9,
                     "{j}"
                 );
             }
