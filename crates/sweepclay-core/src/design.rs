@@ -45,6 +45,11 @@ pub struct Design {
     /// (degrees; positive counter-clockwise seen from above).
     #[serde(default, skip_serializing_if = "is_zero")]
     pub twist_deg: f64,
+    /// A vessel's rim shaped round the loop from its one profile (a
+    /// slant, waves, a raised arc), in place of `profile_end` and
+    /// `interpolation` (docs/FORMATS.md, "rim").
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub rim: Option<crate::rim::RimSpec>,
 }
 
 fn is_zero(v: &f64) -> bool {
@@ -426,6 +431,13 @@ impl Design {
                 format!("is {chars} characters long; at most {MAX_NAME_CHARS} (it names the G-code file and heads it)"),
             ));
         }
+        if let Some(r) = &d.rim {
+            r.check(
+                d.trajectory.closed,
+                d.profile_end.is_some(),
+                d.interpolation.is_some(),
+            )?;
+        }
         let mut d = d;
         // The cap and each entry's keys before any picture is decoded: a
         // ripple carrying a 4-megapixel PNG, 400 times over, ran a server
@@ -551,6 +563,9 @@ impl Design {
             }
         }
         d.texture = self.texture.iter().map(|t| t.scaled(kxy, kz)).collect();
+        if let Some(r) = d.rim.as_mut() {
+            r.rise *= kz;
+        }
         let t = &mut d.trajectory;
         for pts in [t.control_points.as_mut(), t.points.as_mut()]
             .into_iter()
@@ -564,9 +579,14 @@ impl Design {
     }
 
     /// C_t: `profile_end`, or `profile_start` where the design gives one
-    /// profile (the same section all round the loop or along the wall).
-    pub fn end_profile(&self) -> &CurveSpec {
-        self.profile_end.as_ref().unwrap_or(&self.profile_start)
+    /// profile (the same section all round the loop or along the wall),
+    /// stretched to the taller rim where the design shapes its `rim`.
+    pub fn end_profile(&self) -> std::borrow::Cow<'_, CurveSpec> {
+        match (&self.profile_end, &self.rim) {
+            (Some(end), _) => std::borrow::Cow::Borrowed(end),
+            (None, Some(rim)) => std::borrow::Cow::Owned(rim.end_profile(&self.profile_start)),
+            (None, None) => std::borrow::Cow::Borrowed(&self.profile_start),
+        }
     }
 
     /// The design as pretty JSON (the format [`Design::from_json`] reads).
@@ -602,7 +622,7 @@ impl Design {
             }
         }
         lo[2] = 0.0;
-        hi[2] = top(&this.profile_start).max(top(this.end_profile()));
+        hi[2] = top(&this.profile_start).max(top(&this.end_profile()));
         for a in 0..3 {
             let (min, max) = (pr.bed_min[a], pr.bed_min[a] + pr.build_volume[a]);
             if lo[a] < min - 1e-9 || hi[a] > max + 1e-9 {
@@ -699,7 +719,7 @@ mod tests {
             "profile_start": { "control_points": [[0, 0], [8, 20], [2, 40]] },
             "trajectory": { "control_points": [[40, 0], [0, 40], [-40, 0], [0, -40]], "closed": true }}"#;
         let d = Design::from_json(one).unwrap();
-        assert_eq!(d.end_profile(), &d.profile_start);
+        assert_eq!(*d.end_profile(), d.profile_start);
         // Saved as it was given: one profile stays one profile.
         assert!(!d.to_json().contains("profile_end"));
         assert_eq!(Design::from_json(&d.to_json()).unwrap(), d);

@@ -58,6 +58,7 @@ pub mod motion;
 pub mod plane;
 pub mod preview;
 pub mod printer;
+pub mod rim;
 pub mod stability;
 pub mod surface;
 pub mod texture;
@@ -315,7 +316,7 @@ pub fn samples_bound(d: &Design) -> f64 {
     let p = &d.texture_params();
     let top =
         |c: &crate::design::CurveSpec| c.control_points.iter().map(|p| p[1]).fold(0.0, f64::max);
-    let (zs, zt) = (top(&d.profile_start), top(d.end_profile()));
+    let (zs, zt) = (top(&d.profile_start), top(&d.end_profile()));
     let per_column = if t.closed {
         // The spiral under the lower rim, a rim turn, and a raised arc's
         // passes of at most min(Δz_min, Δz_max/2) and its top above

@@ -343,7 +343,7 @@ fn sample_plain(design: &Design) -> Result<Surface> {
     let params = design.params.clone();
     let printer = design.printer.resolve()?;
     let start = Profile::new("profile_start", &design.profile_start)?;
-    let end = Profile::new("profile_end", design.end_profile())?;
+    let end = Profile::new("profile_end", &design.end_profile())?;
     for (key, prof) in [("profile_start", &start), ("profile_end", &end)] {
         if prof.height < params.layer_height {
             return Err(Error::invalid(
@@ -398,7 +398,12 @@ fn sample_plain(design: &Design) -> Result<Surface> {
             }
             Offset::Normal => normal(&traj.points, i, closed).map(|v| outward * v),
         };
-        let lambda = interp.eval(u);
+        // A shaped rim says how high each column stands by its angle
+        // about o (docs/FORMATS.md, "rim").
+        let lambda = design
+            .rim
+            .as_ref()
+            .map_or_else(|| interp.eval(u), |r| r.lambda(p));
         columns.push(Column {
             p,
             dir,

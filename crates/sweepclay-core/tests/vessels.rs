@@ -396,6 +396,72 @@ fn rims_slanted_raised_and_waved_print_as_drawn() {
 }
 
 #[test]
+fn a_rim_shaped_by_its_rise_and_angle_prints_as_drawn() {
+    // One profile and a rim: slanted 30 mm toward +y, a raised back, and
+    // three waves of 6 mm on a 130 mm pot. The rim stands where the key
+    // says (the columns' heights by their angle) and the print passes.
+    let circle = |r: f64| -> Vec<[f64; 2]> {
+        (0..8)
+            .map(|i| {
+                let a = std::f64::consts::TAU * f64::from(i) / 8.0;
+                [r * 1.08 * a.cos(), r * 1.08 * a.sin()]
+            })
+            .collect()
+    };
+    for (rim, r) in [
+        (
+            serde_json::json!({ "shape": "slant", "rise": 30, "toward_deg": 90 }),
+            40.0,
+        ),
+        (
+            serde_json::json!({ "shape": "raised", "rise": 25, "toward_deg": 180, "width_deg": 100 }),
+            40.0,
+        ),
+        (
+            serde_json::json!({ "shape": "wave", "rise": 6, "peaks": 3 }),
+            60.0,
+        ),
+    ] {
+        let d = Design::from_json(
+            &serde_json::json!({
+                "sweepclay": 1,
+                "profile_start": { "control_points": [[0.0, 0.0], [6.0, 30.0], [0.0, 60.0]] },
+                "trajectory": { "control_points": circle(r), "closed": true },
+                "rim": rim,
+                "printer": { "name": "wide", "build_volume": [300.0, 300.0, 250.0], "origin": [150.0, 150.0] },
+            })
+            .to_string(),
+        )
+        .unwrap();
+        let s = slice(&d).unwrap_or_else(|e| panic!("{rim}: {e}"));
+        let spec = d.rim.as_ref().unwrap();
+        for c in &s.corrected.surface.columns {
+            let want = 60.0 + spec.rise * spec.lambda(c.p);
+            assert!(
+                (c.height - want).abs() < 1e-9,
+                "{rim}: {} against {want}",
+                c.height
+            );
+        }
+        let r = common::check_full(&s);
+        assert!(r.printable, "{rim}: {}", r.render());
+        let hi = s
+            .corrected
+            .surface
+            .columns
+            .iter()
+            .map(|c| c.height)
+            .fold(0.0, f64::max);
+        assert!(hi > 60.0 + 0.95 * spec.rise, "{rim}: {hi}");
+    }
+    // Old files read as before; a rim on a wall, or beside a second
+    // profile, is refused by name.
+    let wall = r#"{"sweepclay":1,"profile_start":{"control_points":[[0,0],[0,30]]},"trajectory":{"control_points":[[-30,10],[30,10]]},"rim":{"shape":"slant","rise":10}}"#;
+    let e = Design::from_json(wall).unwrap_err().to_string();
+    assert!(e.starts_with("rim: shapes a vessel's rim"), "{e}");
+}
+
+#[test]
 fn a_round_vase_twisted_a_quarter_and_half_a_turn_prints() {
     // Refused at any twist of 90° or more: the fold test compared the
     // curves' order at the top with Ψ's unturned direction.

@@ -363,6 +363,8 @@ function setClosed(d, closed) {
     if (ip && ip[ip.length - 1][1] !== 0) delete d.interpolation;
   } else {
     delete d.trajectory.closed;
+    // An open wall has no rim round a loop.
+    delete d.rim;
     if (ip && ip[ip.length - 1][1] !== 1) delete d.interpolation;
     if (d.params) delete d.params.floor_layers;
   }
@@ -398,6 +400,8 @@ $('one-profile').addEventListener('change', (e) => edit((d) => {
     delete d.profile_end;
     delete d.interpolation;
   } else {
+    // Two profiles shape the rim themselves.
+    delete d.rim;
     d.profile_end = clone(d.profile_start);
   }
 }, true));
@@ -418,6 +422,7 @@ function fillPot() {
   const w0 = baseWidth(d);
   const p = { ...state.meta.params, ...(d.params || {}) };
   // Rebuilt only when it shows something else: a drag repaints no table.
+  fillRim(d);
   const look = JSON.stringify([pts, w0, p.layer_height]);
   if (look === state.potLook) return;
   state.potLook = look;
@@ -516,6 +521,61 @@ function potEdit(i, what, inp) {
   }
   edit((dd) => { dd.profile_start.control_points[i][0] = +(pts[0][0] + (v - w0) / 2).toFixed(3); }, true);
 }
+
+/**
+ * The rim control (docs/MODELER.md): a vessel's rim level, slanted, raised
+ * over an arc or wavy, as the design's `rim` (docs/FORMATS.md); only the
+ * fields its shape reads are shown.
+ */
+function fillRim(d) {
+  const row = $('rim-row');
+  row.hidden = !d.trajectory.closed;
+  const r = d.rim;
+  const shape = r?.shape ?? '';
+  if (document.activeElement !== $('rim-shape')) $('rim-shape').value = shape;
+  const show = { 'rim-rise-l': !!shape, 'rim-toward-l': !!shape, 'rim-peaks-l': shape === 'wave', 'rim-width-l': shape === 'raised' };
+  for (const [id, on] of Object.entries(show)) $(id).hidden = !on;
+  const put = (id, v) => {
+    if (document.activeElement !== $(id)) $(id).value = v == null ? '' : fmtMm(v);
+  };
+  put('rim-rise', r?.rise);
+  put('rim-toward', r ? r.toward_deg ?? 0 : null);
+  put('rim-peaks', r?.peaks);
+  put('rim-width', r ? r.width_deg ?? 120 : null);
+}
+
+// A shape's starting values: a rim 20 mm higher at the back.
+const RIM_START = { rise: 20, toward_deg: 90 };
+
+$('rim-shape').addEventListener('change', (e) => edit((d) => {
+  const shape = e.target.value;
+  if (!shape) {
+    delete d.rim;
+    return;
+  }
+  const old = d.rim || RIM_START;
+  d.rim = { shape, rise: old.rise, toward_deg: old.toward_deg ?? 90 };
+  if (shape === 'wave') d.rim.peaks = old.peaks ?? 3;
+  if (shape === 'raised') d.rim.width_deg = old.width_deg ?? 120;
+}, true));
+
+/** A rim field typed in, within its range, or a message beside it. */
+function rimEdit(id, key, what, lo, hi, whole) {
+  const inp = $(id);
+  inp.classList.remove('bad');
+  $('pot-error').textContent = '';
+  const v = potNumber(inp, what);
+  if (v == null) return;
+  if (!(v >= lo && v <= hi) || (whole && !Number.isInteger(v))) {
+    potError(inp, `${what} ${fmtMm(v)}: must be ${whole ? 'a whole number ' : ''}from ${lo} to ${hi}`);
+    return;
+  }
+  edit((d) => { if (d.rim) d.rim[key] = v; }, true);
+}
+$('rim-rise').addEventListener('change', () => rimEdit('rim-rise', 'rise', 'rim rise (mm)', 0, 1000, false));
+$('rim-toward').addEventListener('change', () => rimEdit('rim-toward', 'toward_deg', 'rim highest toward (°)', -360, 360, false));
+$('rim-peaks').addEventListener('change', () => rimEdit('rim-peaks', 'peaks', 'rim crests', 1, 12, true));
+$('rim-width').addEventListener('change', () => rimEdit('rim-width', 'width_deg', 'raised part (°)', 1, 360, false));
 
 $('pot-add').addEventListener('click', () => edit((d) => {
   const p = d.profile_start.control_points;

@@ -1846,3 +1846,114 @@ async fn a_texture_and_a_twist_are_added_and_their_gcode_prints() {
     assert_eq!(js(&c, "return window.sweepclayErrors").await, json!([]));
     c.close().await.unwrap();
 }
+
+/// The pot panel's rim control (docs/MODELER.md): a new pot's rim raised
+/// 30 mm at the back becomes the design's `rim`, prints (the raised part as
+/// partial layers, which the statistics say), and the G-code downloaded
+/// stands 30 mm taller at the back than at the front.
+#[tokio::test(flavor = "multi_thread")]
+async fn a_pot_gets_a_raised_back_from_the_rim_control() {
+    let Some(Session {
+        tmp: _tmp,
+        downloads,
+        driver: _driver,
+        c,
+        base,
+    }) = Session::start().await
+    else {
+        return;
+    };
+    c.goto(&format!("{base}/?example=vase")).await.unwrap();
+    close_guide(&c).await;
+    wait_js(&c, PRINTABLE, "the vase").await;
+    click(&c, "new-pot").await;
+    wait_js(
+        &c,
+        &format!(
+            "return {IDLE} && !window.sweepclay.design.profile_end && {}",
+            &PRINTABLE[7..]
+        ),
+        "a new pot",
+    )
+    .await;
+    // Only a shape's own fields show.
+    assert_eq!(
+        js(&c, "return ['rim-rise-l', 'rim-peaks-l', 'rim-width-l'].map((id) => document.getElementById(id).hidden)").await,
+        json!([true, true, true])
+    );
+    set_value(&c, "rim-shape", "raised").await;
+    wait_js(
+        &c,
+        &format!(
+            "return {IDLE} && window.sweepclay.design.rim?.shape === 'raised' && {}",
+            &PRINTABLE[7..]
+        ),
+        "the raised rim",
+    )
+    .await;
+    assert_eq!(
+        js(&c, "return ['rim-rise-l', 'rim-peaks-l', 'rim-width-l'].map((id) => document.getElementById(id).hidden)").await,
+        json!([false, true, false])
+    );
+    // A value out of its range is refused beside the field, never changed.
+    set_value(&c, "rim-width", "500").await;
+    let said = wait_js(
+        &c,
+        "return document.getElementById('pot-error').textContent || null",
+        "the width refused",
+    )
+    .await;
+    assert!(said.as_str().unwrap().contains("from 1 to 360"), "{said}");
+    assert_eq!(
+        js(&c, "return window.sweepclay.design.rim.width_deg").await,
+        json!(120)
+    );
+    set_value(&c, "rim-rise", "30").await;
+    let stats = wait_js(
+        &c,
+        &format!(
+            "return {IDLE} && window.sweepclay.design.rim.rise === 30 && {} && document.getElementById('stats').textContent.includes('raised rim') ? document.getElementById('stats').textContent : null",
+            &PRINTABLE[7..]
+        ),
+        "the rim 30 mm higher at the back, printable",
+    )
+    .await;
+    assert!(
+        stats.as_str().unwrap().contains("partial layers"),
+        "{stats}"
+    );
+    if let Ok(path) = std::env::var("SWEEPCLAY_RIM_SCREENSHOT") {
+        std::fs::write(&path, c.screenshot().await.unwrap()).unwrap();
+    }
+    let file = download_gcode(&c, &downloads, "no G-code of the raised rim was downloaded").await;
+    let text = std::fs::read_to_string(&file).unwrap();
+    let printer = js(&c, "return window.sweepclay.design.printer").await;
+    let printer = sweepclay_core::Printer::preset(printer.as_str().unwrap()).unwrap();
+    let report = sweepclay_check::check(&text, &sweepclay_web::verify::printer_check(&printer));
+    assert!(report.printable, "{:?}", report.failures);
+    // The highest clay at the back (+y) and at the front (−y).
+    let (mut back, mut front) = (0.0f64, 0.0f64);
+    let mut z = 0.0;
+    for line in text.lines().filter(|l| l.starts_with("G1 ")) {
+        let word = |c: char| {
+            line.split_whitespace()
+                .find(|w| w.starts_with(c))
+                .and_then(|w| w[1..].parse::<f64>().ok())
+        };
+        z = word('Z').unwrap_or(z);
+        if let Some(y) = word('Y') {
+            let y = y - printer.origin[1];
+            if y > 20.0 {
+                back = back.max(z);
+            } else if y < -20.0 {
+                front = front.max(z);
+            }
+        }
+    }
+    assert!(
+        (back - front - 30.0).abs() < 1.5,
+        "back {back}, front {front}"
+    );
+    assert_eq!(js(&c, "return window.sweepclayErrors").await, json!([]));
+    c.close().await.unwrap();
+}
