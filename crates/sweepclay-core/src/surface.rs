@@ -597,6 +597,23 @@ fn sample_vessel(
         if let (Err(_), Some(why)) = (&chosen, &peaks) {
             return Err(Error::invalid("profile_end", why.clone()));
         }
+        // Where the rim is highest and lowest, for a refusal of its spread.
+        let places = || {
+            let at = |best: fn(f64, f64) -> bool| {
+                let i = (0..heights.len())
+                    .reduce(|a, b| if best(heights[b], heights[a]) { b } else { a })
+                    .unwrap_or(0);
+                columns[i].p
+            };
+            let (hi, lo) = (at(|a, b| a > b), at(|a, b| a < b));
+            format!(
+                " (the rim is highest near ({:.0}, {:.0}) mm and lowest near ({:.0}, {:.0}) mm; no level of it leaves one raised part above what one spiral carries)",
+                hi[0], hi[1], lo[0], lo[1]
+            )
+        };
+        if let Err(Error::Invalid { key, reason }) = &chosen {
+            return Err(Error::invalid(key.clone(), format!("{reason}{}", places())));
+        }
         chosen?;
         let v = match full.expect("a layering was chosen") {
         Ok(clear) => clear,
@@ -604,10 +621,11 @@ fn sample_vessel(
             return Err(Error::invalid(
                 "params.max_layer_height",
                 format!(
-                    "the rim's height varies from {:.1} to {:.1} mm round the loop: the wall's first turn, starting a layer above the floor, would end more than {} mm above it wherever it starts; raise params.max_layer_height or bring the profiles' heights closer",
+                    "the rim's height varies from {:.1} to {:.1} mm round the loop: the wall's first turn, starting a layer above the floor, would end more than {} mm above it wherever it starts; raise params.max_layer_height or bring the profiles' heights closer{}",
                     heights.iter().copied().fold(f64::INFINITY, f64::min),
                     heights.iter().copied().fold(0.0, f64::max),
-                    params.max_layer_height
+                    params.max_layer_height,
+                    places()
                 ),
             ))
         }
