@@ -1061,7 +1061,7 @@ impl<'a> Checker<'a> {
                     // A thin bead (a floor's narrowed tail between its
                     // neighbours) fails only over a gap well beyond the
                     // layers laid so far: clay two layers down.
-                    if xy >= 0.25 * cfg.width_min && rise < cfg.min_layer_mm {
+                    if rise < cfg.min_layer_mm {
                         let thin = width < cfg.width_min * (1.0 - WIDTH_TOLERANCE);
                         let deep = *typical_gap == 0.0 || dz > DEEP_GAP * *typical_gap;
                         let over = dz > gap_limit
