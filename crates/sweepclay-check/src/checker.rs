@@ -1232,9 +1232,16 @@ impl<'a> Checker<'a> {
         }
         bent_before.push(bent_before.last().copied().unwrap_or(0) + u32::from(bead.bent));
         beads.push(bead);
-        if !on_clay && !step {
-            let climbs_out = matches!(rest, Some(Rest::Bead(_))).then_some(rest_gap);
-            self.close_stretch(climbs_out);
+        // A stub (under a quarter of the narrowest bead in plan: where a
+        // move was cut a hair from its end, its middle lies between two
+        // beads below) ends a stretch only by climbing out of it onto a
+        // bead a thinnest layer or more below: a ramp cut so was read as
+        // three short stretches, none rising half a layer
+        // (docs/CHECKER.md, "Cutting").
+        let on_bead = matches!(rest, Some(Rest::Bead(_)));
+        let stub = xy < 0.25 * cfg.width_min && !(on_bead && rest_gap >= cfg.min_layer_mm);
+        if !on_clay && !step && !stub {
+            self.close_stretch(on_bead.then_some(rest_gap));
         }
         for &(kind, v) in &held[..n_held] {
             self.record(kind, m.line, v, false);
