@@ -455,8 +455,9 @@ impl Design {
         for (k, t) in d.texture.iter().enumerate() {
             t.check_keys(&format!("texture[{k}]"))?;
         }
+        let mut budget = crate::texture::MAX_DESIGN_PIXELS;
         for (k, t) in d.texture.iter_mut().enumerate() {
-            t.load(&format!("texture[{k}]"))?;
+            t.load(&format!("texture[{k}]"), &mut budget)?;
         }
         Ok(d)
     }
@@ -468,6 +469,14 @@ impl Design {
         &mut self,
         mut read: impl FnMut(&str) -> std::result::Result<Vec<u8>, String>,
     ) -> Result<()> {
+        // What the pictures decoded with the design file left.
+        let used: usize = self
+            .texture
+            .iter()
+            .filter_map(|t| t.image.as_ref())
+            .map(|g| g.width * g.height)
+            .sum();
+        let mut budget = crate::texture::MAX_DESIGN_PIXELS.saturating_sub(used);
         for (k, t) in self.texture.iter_mut().enumerate() {
             if t.image.is_some() || t.kind != crate::texture::Kind::Image {
                 continue;
@@ -475,7 +484,11 @@ impl Design {
             if let Some(path) = &t.path {
                 let key = format!("texture[{k}].path");
                 let bytes = read(path).map_err(|e| Error::invalid(&key, e))?;
-                t.image = Some(crate::texture::Grey::from_png(&bytes, &key)?);
+                t.image = Some(crate::texture::Grey::from_png_within(
+                    &bytes,
+                    &key,
+                    &mut budget,
+                )?);
             }
         }
         Ok(())

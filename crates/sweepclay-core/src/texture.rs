@@ -36,6 +36,11 @@ pub const MAX_IMAGE_PIXELS: usize = 4_000_000;
 /// Largest image file, encoded (bytes).
 pub const MAX_IMAGE_BYTES: usize = 8 << 20;
 
+/// Most pixels a design's pictures may decode to in all: two pictures of
+/// [`MAX_IMAGE_PIXELS`] (32 MB of grey). Sixteen textures of 4 megapixels
+/// each, from 566-byte files, held 256 MB a request.
+pub const MAX_DESIGN_PIXELS: usize = 2 * MAX_IMAGE_PIXELS;
+
 /// The kinds of texture.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
 #[serde(rename_all = "lowercase")]
@@ -124,6 +129,14 @@ impl Grey {
     /// [`MAX_IMAGE_BYTES`] and images over [`MAX_IMAGE_PIXELS`] before
     /// allocating for their pixels.
     pub fn from_png(bytes: &[u8], key: &str) -> Result<Grey> {
+        let mut budget = MAX_IMAGE_PIXELS;
+        Grey::from_png_within(bytes, key, &mut budget)
+    }
+
+    /// [`Grey::from_png`], counting the image's pixels against `budget`
+    /// (what is left of the design's [`MAX_DESIGN_PIXELS`]) before any is
+    /// decoded, and refusing it by name where they do not fit.
+    pub fn from_png_within(bytes: &[u8], key: &str, budget: &mut usize) -> Result<Grey> {
         if bytes.len() > MAX_IMAGE_BYTES {
             return Err(Error::invalid(
                 key,
@@ -146,6 +159,16 @@ impl Grey {
                 ),
             ));
         }
+        if w * h > *budget {
+            return Err(Error::invalid(
+                key,
+                format!(
+                    "the image is {w} × {h} pixels, and the design's pictures may come to {MAX_DESIGN_PIXELS} pixels in all ({} left); use smaller pictures (a texture keeps at most a few hundred pixels across)",
+                    *budget
+                ),
+            ));
+        }
+        *budget -= w * h;
         let mut reader = dec.read_info().map_err(|e| bad(&e))?;
         let mut buf = vec![0; reader.output_buffer_size()];
         let info = reader.next_frame(&mut buf).map_err(|e| bad(&e))?;
@@ -345,8 +368,9 @@ impl TextureSpec {
     }
 
     /// Decodes `png_base64` into [`TextureSpec::image`] (if given and not
-    /// yet decoded).
-    pub fn load(&mut self, key: &str) -> Result<()> {
+    /// yet decoded), its pixels counted against `budget`
+    /// ([`Grey::from_png_within`]).
+    pub fn load(&mut self, key: &str, budget: &mut usize) -> Result<()> {
         use base64::Engine as _;
         if self.image.is_some() {
             return Ok(());
@@ -365,7 +389,11 @@ impl TextureSpec {
         let bytes = base64::engine::general_purpose::STANDARD
             .decode(data.trim())
             .map_err(|e| Error::invalid(format!("{key}.png_base64"), format!("not base64: {e}")))?;
-        self.image = Some(Grey::from_png(&bytes, &format!("{key}.png_base64"))?);
+        self.image = Some(Grey::from_png_within(
+            &bytes,
+            &format!("{key}.png_base64"),
+            budget,
+        )?);
         Ok(())
     }
 
@@ -825,6 +853,49 @@ mod tests {
             .unwrap_err()
             .to_string()
             .contains("texture[0]"));
+    }
+}
+
+#[cfg(test)]
+mod budget_tests {
+    use super::*;
+
+    #[test]
+    fn a_designs_pictures_are_counted_against_one_budget_before_decoding() {
+        // Three pictures of 2000 × 2000 (4 megapixels, a few kB each as
+        // PNG): two fit the design's 8 megapixels, the third is refused by
+        // name before its pixels are decoded.
+        use base64::Engine as _;
+        let mut bytes = Vec::new();
+        {
+            let mut enc = png::Encoder::new(&mut bytes, 2000, 2000);
+            enc.set_color(png::ColorType::Grayscale);
+            enc.set_depth(png::BitDepth::Eight);
+            let mut w = enc.write_header().unwrap();
+            w.write_image_data(&vec![128u8; 2000 * 2000]).unwrap();
+        }
+        assert!(bytes.len() < 100_000, "{}", bytes.len());
+        let b64 = base64::engine::general_purpose::STANDARD.encode(&bytes);
+        let texture = format!(r#"{{"kind":"image","amplitude":1,"png_base64":"{b64}"}}"#);
+        let design = |n: usize| {
+            format!(
+                r#"{{"sweepclay":1,"profile_start":{{"control_points":[[0,0],[0,40]]}},
+                    "trajectory":{{"control_points":[[30,0],[0,30],[-30,0],[0,-30]],"closed":true}},
+                    "texture":[{}]}}"#,
+                vec![texture.as_str(); n].join(",")
+            )
+        };
+        assert!(crate::Design::from_json(&design(2)).is_ok());
+        match crate::Design::from_json(&design(3)).unwrap_err() {
+            crate::Error::Invalid { key, reason } => {
+                assert_eq!(key, "texture[2].png_base64");
+                assert!(
+                    reason.contains("8000000 pixels in all (0 left)"),
+                    "{reason}"
+                );
+            }
+            other => panic!("{other}"),
+        }
     }
 }
 

@@ -78,7 +78,8 @@ fn profile(h: f64, lean: f64) -> serde_json::Value {
 fn kept_where_not_reported(d: &Design) -> Result<(), TestCaseError> {
     let mut sd = d.clone();
     for t in &mut sd.texture {
-        t.load("texture").unwrap();
+        let mut budget = sweepclay_core::texture::MAX_DESIGN_PIXELS;
+        t.load("texture", &mut budget).unwrap();
     }
     let s = surface::sample_surface(&sd).unwrap();
     let textured = correct::correct(&s).unwrap();
