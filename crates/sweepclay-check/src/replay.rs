@@ -106,7 +106,15 @@ pub struct Replayer {
     pub homing_lines: Vec<usize>,
     /// The flow override `M221 S` sets, as a factor on every E (1: none).
     flow: f64,
+    /// Segments the arcs so far split into.
+    arc_segments: usize,
 }
+
+/// Most segments a file's arcs may split into in all: 10 km of arcs in
+/// 1 mm segments. Each arc is capped at 65,536; 709 KB of arcs 20 m
+/// across split into 1.25 billion and took 65 s (docs/CHECKER.md,
+/// "Bounded cost").
+pub const MAX_ARC_SEGMENTS: usize = 10_000_000;
 
 /// Longest segment an arc is split into (mm): Marlin's
 /// `MM_PER_ARC_SEGMENT` and about Klipper's `resolution`.
@@ -130,6 +138,7 @@ impl Default for Replayer {
             delta_home: None,
             homing_lines: Vec::new(),
             flow: 1.0,
+            arc_segments: 0,
         }
     }
 }
@@ -256,6 +265,16 @@ impl Replayer {
         }
         // Firmware moves the last segment to the target itself.
         let n = ((length / ARC_SEGMENT_MM).ceil() as usize).clamp(1, 1 << 16);
+        self.arc_segments += n;
+        if self.arc_segments > MAX_ARC_SEGMENTS {
+            self.cannot(
+                l.line,
+                format!(
+                    "arcs that split into more than {MAX_ARC_SEGMENTS} segments of {ARC_SEGMENT_MM} mm in all (the cap on the work one file may ask)"
+                ),
+            );
+            return None;
+        }
         let start = self.pos;
         let a0 = rq.atan2(rp);
         let at = |k: usize| -> [f64; 3] {
@@ -562,6 +581,34 @@ mod tests {
         let len: f64 = m[1..].iter().map(Move::length).sum();
         assert!((len - 10.0 * std::f64::consts::PI).abs() < 0.05, "{len}");
         assert!(m[1..].iter().all(|m| m.to[1] <= 1e-9), "{:?}", m[5].to);
+    }
+
+    #[test]
+    fn arcs_past_the_total_cap_are_not_judged_and_say_so() {
+        // 200 full circles 20 m across: 62,832 segments of 1 mm each, 12.6
+        // million in all; the 160th passes the 10 million a file may ask.
+        let mut text = String::from("G1 X0 Y0 Z1\n");
+        for _ in 0..200 {
+            text.push_str("G2 X0 Y0 I10000 J0 E1\n");
+        }
+        let mut r = Replayer::default();
+        let mut d = Vec::new();
+        let mut segments = 0usize;
+        for l in parse(&text, &mut d) {
+            if r.feed(&l, &mut d).is_some() {
+                segments += 1;
+                while r.next_segment().is_some() {
+                    segments += 1;
+                }
+            }
+            if r.cannot_judge.is_some() {
+                break;
+            }
+        }
+        let (line, msg) = r.cannot_judge.expect("the cap");
+        assert!(msg.contains("10000000 segments"), "{msg}");
+        assert_eq!(line, 161, "the arc that passes the cap");
+        assert!(segments <= MAX_ARC_SEGMENTS + 1, "{segments}");
     }
 
     #[test]

@@ -858,8 +858,6 @@ mod tests {
 
 #[cfg(test)]
 mod budget_tests {
-    use super::*;
-
     #[test]
     fn a_designs_pictures_are_counted_against_one_budget_before_decoding() {
         // Three pictures of 2000 × 2000 (4 megapixels, a few kB each as
