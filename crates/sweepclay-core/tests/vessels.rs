@@ -189,6 +189,17 @@ proptest! {
     }
 }
 
+/// The control points of a round loop about o whose B-spline is about
+/// `r` across its radius (an 8-point loop lies inside its polygon).
+fn round_loop(r: f64) -> Vec<[f64; 2]> {
+    (0..8)
+        .map(|i| {
+            let a = std::f64::consts::TAU * f64::from(i) / 8.0;
+            [r * 1.08 * a.cos(), r * 1.08 * a.sin()]
+        })
+        .collect()
+}
+
 /// The highest point of a slicing's path (mm).
 fn path_top(s: &sweepclay_core::Sliced) -> f64 {
     s.toolpath
@@ -344,20 +355,12 @@ fn rims_slanted_raised_and_waved_print_as_drawn() {
     // layers above the spiral. A 130 mm one whose rim waves in two peaks
     // 12.5 mm above the valleys: one spiral carries it. Each passes the
     // check, its top the drawn rim's height (half a layer above at most).
-    let circle = |r: f64| -> Vec<[f64; 2]> {
-        (0..8)
-            .map(|i| {
-                let a = std::f64::consts::TAU * f64::from(i) / 8.0;
-                [r * 1.08 * a.cos(), r * 1.08 * a.sin()]
-            })
-            .collect()
-    };
     let pot = |r: f64, hi: f64, interp: Option<serde_json::Value>| {
         let mut v = serde_json::json!({
             "sweepclay": 1,
             "profile_start": { "control_points": [[0.0, 0.0], [0.0, 60.0]] },
             "profile_end": { "control_points": [[0.0, 0.0], [0.0, hi]] },
-            "trajectory": { "control_points": circle(r), "closed": true },
+            "trajectory": { "control_points": round_loop(r), "closed": true },
             "printer": { "name": "wide", "build_volume": [300.0, 300.0, 250.0], "origin": [150.0, 150.0] },
         });
         if let Some(i) = interp {
@@ -400,14 +403,6 @@ fn a_rim_shaped_by_its_rise_and_angle_prints_as_drawn() {
     // One profile and a rim: slanted 30 mm toward +y, a raised back, and
     // three waves of 6 mm on a 130 mm pot. The rim stands where the key
     // says (the columns' heights by their angle) and the print passes.
-    let circle = |r: f64| -> Vec<[f64; 2]> {
-        (0..8)
-            .map(|i| {
-                let a = std::f64::consts::TAU * f64::from(i) / 8.0;
-                [r * 1.08 * a.cos(), r * 1.08 * a.sin()]
-            })
-            .collect()
-    };
     for (rim, r) in [
         (
             serde_json::json!({ "shape": "slant", "rise": 30, "toward_deg": 90 }),
@@ -426,7 +421,7 @@ fn a_rim_shaped_by_its_rise_and_angle_prints_as_drawn() {
             &serde_json::json!({
                 "sweepclay": 1,
                 "profile_start": { "control_points": [[0.0, 0.0], [6.0, 30.0], [0.0, 60.0]] },
-                "trajectory": { "control_points": circle(r), "closed": true },
+                "trajectory": { "control_points": round_loop(r), "closed": true },
                 "rim": rim,
                 "printer": { "name": "wide", "build_volume": [300.0, 300.0, 250.0], "origin": [150.0, 150.0] },
             })

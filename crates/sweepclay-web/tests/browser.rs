@@ -186,6 +186,23 @@ async fn download_gcode(c: &Client, downloads: &Path, missing: &str) -> std::pat
     }
 }
 
+/// Downloads the page's G-code (`missing` says what failed if none
+/// comes) and asserts the checker passes it for the design's printer
+/// preset; its text and that printer.
+async fn download_printable(
+    c: &Client,
+    downloads: &Path,
+    missing: &str,
+) -> (String, sweepclay_core::Printer) {
+    let file = download_gcode(c, downloads, missing).await;
+    let text = std::fs::read_to_string(&file).unwrap();
+    let printer = js(c, "return window.sweepclay.design.printer").await;
+    let printer = sweepclay_core::Printer::preset(printer.as_str().unwrap()).unwrap();
+    let report = sweepclay_check::check(&text, &sweepclay_web::verify::printer_check(&printer));
+    assert!(report.printable, "{:?}", report.failures);
+    (text, printer)
+}
+
 /// Clicks the element with id `id`, waiting up to 5 s for it to take
 /// clicks (a panel the page is still laying out under load is "not
 /// interactable" for a moment).
@@ -1827,12 +1844,7 @@ async fn a_texture_and_a_twist_are_added_and_their_gcode_prints() {
     if let Ok(path) = std::env::var("SWEEPCLAY_TEXTURE_SCREENSHOT") {
         std::fs::write(&path, c.screenshot().await.unwrap()).unwrap();
     }
-    let file = download_gcode(&c, &downloads, "no textured G-code was downloaded").await;
-    let text = std::fs::read_to_string(&file).unwrap();
-    let printer = js(&c, "return window.sweepclay.design.printer").await;
-    let printer = sweepclay_core::Printer::preset(printer.as_str().unwrap()).unwrap();
-    let report = sweepclay_check::check(&text, &sweepclay_web::verify::printer_check(&printer));
-    assert!(report.printable, "{:?}", report.failures);
+    download_printable(&c, &downloads, "no textured G-code was downloaded").await;
     // The ripple is in the file: the wall's distance from the axis at one
     // angle goes in and out with height, many times over.
     let design = js(&c, "return JSON.stringify(window.sweepclay.design)").await;
@@ -1925,12 +1937,8 @@ async fn a_pot_gets_a_raised_back_from_the_rim_control() {
     if let Ok(path) = std::env::var("SWEEPCLAY_RIM_SCREENSHOT") {
         std::fs::write(&path, c.screenshot().await.unwrap()).unwrap();
     }
-    let file = download_gcode(&c, &downloads, "no G-code of the raised rim was downloaded").await;
-    let text = std::fs::read_to_string(&file).unwrap();
-    let printer = js(&c, "return window.sweepclay.design.printer").await;
-    let printer = sweepclay_core::Printer::preset(printer.as_str().unwrap()).unwrap();
-    let report = sweepclay_check::check(&text, &sweepclay_web::verify::printer_check(&printer));
-    assert!(report.printable, "{:?}", report.failures);
+    let (text, printer) =
+        download_printable(&c, &downloads, "no G-code of the raised rim was downloaded").await;
     // The highest clay at the back (+y) and at the front (−y).
     let (mut back, mut front) = (0.0f64, 0.0f64);
     let mut z = 0.0;
