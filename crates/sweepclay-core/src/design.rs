@@ -224,6 +224,16 @@ impl Params {
         )?;
         range("params.spacing", self.spacing, MIN_SPACING, 50.0)?;
         let h_min = self.max_layer_height + self.layer_height + COLLISION_MARGIN_MM;
+        if self.nozzle_height > crate::printer::MAX_MACHINE_MM {
+            return Err(Error::invalid(
+                "params.nozzle_height",
+                format!(
+                    "must be at most {} mm (got {}): no extruder body is that tall, and `check` would refuse to read its G-code",
+                    crate::printer::MAX_MACHINE_MM,
+                    self.nozzle_height
+                ),
+            ));
+        }
         if !(self.nozzle_height.is_finite() && self.nozzle_height > h_min) {
             return Err(Error::invalid(
                 "params.nozzle_height",

@@ -377,9 +377,41 @@ impl Printer {
                 format!("must be ≥ 0 mm (got {})", self.nozzle_radius),
             ));
         }
+        // The checker's ranges (docs/CHECKER.md, "Bounded cost"): a
+        // printer it would refuse to read is refused here, by name.
+        let most = |v: &[f64]| v.iter().fold(0.0f64, |m, x| m.max(x.abs()));
+        for (field, v, hi) in [
+            ("build_volume", most(&self.build_volume), MAX_MACHINE_MM),
+            ("bed_min", most(&self.bed_min), MAX_MACHINE_MM),
+            ("origin", most(&self.origin), MAX_MACHINE_MM),
+            (
+                "bed_diameter",
+                self.bed_diameter.unwrap_or(0.0),
+                MAX_MACHINE_MM,
+            ),
+            ("e_per_mm3", self.e_per_mm3, MAX_E_PER_MM3),
+            ("nozzle_radius", self.nozzle_radius, MAX_NOZZLE_RADIUS_MM),
+        ] {
+            if v > hi {
+                return Err(Error::invalid(
+                    format!("{key}.{field}"),
+                    format!("must be at most {hi} (got {v}): no clay printer is that large, and `check` would refuse to read its G-code"),
+                ));
+            }
+        }
         Ok(())
     }
 }
+
+/// The largest machine dimension a printer may name (mm): 100 m, as
+/// `check` reads a G-code header.
+pub const MAX_MACHINE_MM: f64 = 100_000.0;
+
+/// The most E per mm³ of clay a printer may name, as `check` reads it.
+pub const MAX_E_PER_MM3: f64 = 10_000.0;
+
+/// The widest extruder body a printer may name (mm), as `check` reads it.
+pub const MAX_NOZZLE_RADIUS_MM: f64 = 1_000.0;
 
 /// The `printer` key: a preset name or an inline profile.
 #[derive(Clone, Debug, PartialEq)]
@@ -450,6 +482,40 @@ fn positive(key: &str, v: f64) -> Result<()> {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_printer_check_would_not_read_is_refused_by_name() {
+        // A build volume of 1e6 mm sliced, and `check` then refused the
+        // file (exit 2: header limit 100 m). One limit for both.
+        let mut p = Printer::preset("generic").unwrap();
+        p.build_volume[2] = 1e6;
+        let e = p.validate("printer").unwrap_err().to_string();
+        assert!(
+            e.starts_with("printer.build_volume: must be at most 100000"),
+            "{e}"
+        );
+        let mut p = Printer::preset("generic").unwrap();
+        p.nozzle_radius = 2000.0;
+        let e = p.validate("printer").unwrap_err().to_string();
+        assert!(
+            e.starts_with("printer.nozzle_radius: must be at most 1000"),
+            "{e}"
+        );
+        let d = crate::Design::from_json(
+            r#"{"sweepclay":1,"profile_start":{"control_points":[[0,0],[0,20]]},
+                "trajectory":{"control_points":[[-30,10],[30,10]]},
+                "params":{"nozzle_height":1e308}}"#,
+        )
+        .unwrap();
+        let e = d.params.validate().unwrap_err().to_string();
+        assert!(
+            e.starts_with("params.nozzle_height: must be at most 100000"),
+            "{e}"
+        );
+        // What `check` reads, the pipeline writes: the largest allowed is
+        // within the checker's range.
+        assert_eq!(MAX_MACHINE_MM, sweepclay_check::MAX_MACHINE_MM);
+    }
 
     #[test]
     fn presets_have_the_papers_build_volumes() {
