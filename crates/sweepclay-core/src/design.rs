@@ -607,7 +607,9 @@ impl Design {
     pub fn end_profile(&self) -> std::borrow::Cow<'_, CurveSpec> {
         match (&self.profile_end, &self.rim) {
             (Some(end), _) => std::borrow::Cow::Borrowed(end),
-            (None, Some(rim)) => std::borrow::Cow::Owned(rim.end_profile(&self.profile_start)),
+            (None, Some(rim)) => std::borrow::Cow::Owned(CurveSpec {
+                control_points: rim.stretched(&self.profile_start.control_points),
+            }),
             (None, None) => std::borrow::Cow::Borrowed(&self.profile_start),
         }
     }

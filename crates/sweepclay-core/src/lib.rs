@@ -331,15 +331,15 @@ pub fn samples_bound(d: &Design) -> f64 {
         });
         ((1.0 - mean) * zs + mean * zt) / p.layer_height + 1.0
     };
-    (trajectory_length(d) / p.spacing + 1.0) * per_column + floor_bound(d)
+    (trajectory_length(d) / p.spacing + 1.0) * per_column + floor_bound(d, p)
 }
 
-/// At most how many path points a vessel's floor takes: its layers of
-/// beads a pitch apart over the control polygon's area (0 for a wall).
-fn floor_bound(d: &Design) -> f64 {
+/// At most how many path points a vessel's floor takes at the sampling
+/// `p`: its layers of beads a pitch apart over the control polygon's
+/// area (0 for a wall).
+fn floor_bound(d: &Design, p: &Params) -> f64 {
     let t = &d.trajectory;
     let pts = t.given_points();
-    let p = &d.texture_params();
     if !t.closed || pts.len() < 2 {
         return 0.0;
     }
@@ -371,7 +371,8 @@ pub fn estimated_samples(design: &Design) -> f64 {
     let bound = samples_bound(&d);
     let length = trajectory_length(&d);
     let columns = length / d.params.spacing + 1.0;
-    let floor = floor_bound(&d);
+    // `printed` has the textures' sampling already.
+    let floor = floor_bound(&d, &d.params);
     let per_column = (bound - floor) / columns;
     if !bound.is_finite() || !length.is_finite() {
         return bound;

@@ -7,7 +7,6 @@
 //! `rise` mm more and, for each column, how far toward that it is by the
 //! column's angle about o.
 
-use crate::design::CurveSpec;
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
 
@@ -137,27 +136,18 @@ impl RimSpec {
         }
     }
 
-    /// The profile where the rim is highest: `start` stretched in height
-    /// by its top's (h + rise) / h, so the wall keeps its shape at the
-    /// same share of its height.
-    pub fn end_profile(&self, start: &CurveSpec) -> CurveSpec {
-        let top = start
-            .control_points
-            .iter()
-            .map(|p| p[1])
-            .fold(0.0, f64::max);
+    /// The control points of the profile where the rim is highest: the
+    /// profile's `points` (`[x, z]`) stretched in height by its top's
+    /// (h + rise) / h, so the wall keeps its shape at the same share of
+    /// its height.
+    pub fn stretched(&self, points: &[[f64; 2]]) -> Vec<[f64; 2]> {
+        let top = points.iter().map(|p| p[1]).fold(0.0, f64::max);
         let k = if top > 0.0 {
             (top + self.rise) / top
         } else {
             1.0
         };
-        CurveSpec {
-            control_points: start
-                .control_points
-                .iter()
-                .map(|p| [p[0], p[1] * k])
-                .collect(),
-        }
+        points.iter().map(|p| [p[0], p[1] * k]).collect()
     }
 }
 
@@ -218,14 +208,9 @@ mod tests {
 
     #[test]
     fn the_profile_is_stretched_to_the_taller_rim() {
-        let start = CurveSpec {
-            control_points: vec![[0.0, 0.0], [8.0, 30.0], [2.0, 60.0]],
-        };
-        let end = rim(RimShape::Slant, 0.0).end_profile(&start);
-        assert_eq!(
-            end.control_points,
-            vec![[0.0, 0.0], [8.0, 40.0], [2.0, 80.0]]
-        );
+        let start = [[0.0, 0.0], [8.0, 30.0], [2.0, 60.0]];
+        let end = rim(RimShape::Slant, 0.0).stretched(&start);
+        assert_eq!(end, vec![[0.0, 0.0], [8.0, 40.0], [2.0, 80.0]]);
     }
 
     #[test]

@@ -741,7 +741,7 @@ fn vessel_samples(
             (Some(a), _) if in_arc[i] != usize::MAX => {
                 let j = in_arc[i];
                 let passes = (1..=a.passes[j]).map(|k| a.level_mm + f64::from(k) * a.layer_mm);
-                let top = a.tops[j].then_some(a.top_z[j]);
+                let top = a.has_top(j).then_some(a.top_z[j]);
                 (Some(a.rim[j]), passes.chain(top).collect())
             }
             (Some(_), _) => (Some(col.height.max(last + half)), Vec::new()),

@@ -86,9 +86,6 @@ pub struct RaisedArc {
     pub columns: Vec<usize>,
     /// How many passes above the rim turn each of them gets.
     pub passes: Vec<u32>,
-    /// Whether each gets a top bead after its last pass: all but those
-    /// whose rim the rim turn lays.
-    pub tops: Vec<bool>,
     /// The height of each one's top bead (mm): its rim, or half a layer
     /// above its last pass where that is higher.
     pub top_z: Vec<f64>,
@@ -132,7 +129,6 @@ impl RaisedArc {
             reach[j] = reach[j].min(reach[j - 1]);
         }
         let mut passes = vec![0u32; m];
-        let mut tops = vec![false; m];
         let mut rim = vec![0.0; m];
         let mut top_z = vec![0.0; m];
         // The column rising most above what its side's passes allow.
@@ -171,13 +167,11 @@ impl RaisedArc {
             if t > 2.0 * layer + 1e-6 {
                 note(j, under + 2.0 * layer);
             }
-            // Where the rim turn lays the rim (no passes, the start's
-            // side), there is no top above it. Every other column has one,
+            // Every column whose rim the rim turn does not lay has a top,
             // half a layer thick at least (the rim then up to half a
             // layer above the drawing): a climb that left a column out
             // would run straight across to the next, off the wall where
-            // the loop curves in.
-            tops[j] = !(n == 0 && j <= peak);
+            // the loop curves in (`RaisedArc::has_top`).
             top_z[j] = h[j].max(under + 0.5 * layer);
         }
         if let Some((j, _, most)) = over {
@@ -193,7 +187,6 @@ impl RaisedArc {
                 let other = if most % 2 == 1 { j > peak } else { j <= peak };
                 if other && passes[j] + 1 == most && reach[j] + 1e-9 >= f64::from(most) * layer {
                     passes[j] = most;
-                    tops[j] = true;
                     top_z[j] = h[j].max(level + (f64::from(most) + 0.5) * layer);
                 }
             }
@@ -203,11 +196,17 @@ impl RaisedArc {
             layer_mm: layer,
             columns,
             passes,
-            tops,
             top_z,
             rim,
             peak,
         })
+    }
+
+    /// Whether the column at place `j` gets a top bead after its last
+    /// pass: all but those on the start's side that take no pass, whose
+    /// rim the rim turn lays.
+    pub fn has_top(&self, j: usize) -> bool {
+        !(self.passes[j] == 0 && j <= self.peak)
     }
 
     /// The most passes any column takes.
@@ -294,7 +293,7 @@ impl RaisedArc {
             |out: &mut Vec<(usize, u32, bool)>, js: &mut dyn Iterator<Item = usize>, k: u32| {
                 let before = out.len();
                 out.extend(
-                    js.filter(|&j| self.passes[j] == k && self.tops[j])
+                    js.filter(|&j| self.passes[j] == k && self.has_top(j))
                         .map(|j| (j, k, true)),
                 );
                 climbs += u32::from(out.len() > before);
@@ -918,7 +917,7 @@ mod tests {
         // Tops: on every column but the first, whose rim the rim turn
         // lays; at the rim, or half a pass above the last pass.
         assert_eq!(
-            a.tops,
+            (0..9).map(|j| a.has_top(j)).collect::<Vec<_>>(),
             vec![false, true, true, true, true, true, true, true, true]
         );
         assert!((a.top_z[1] - 51.5).abs() < 1e-9 && (a.top_z[2] - 52.5).abs() < 1e-9);
@@ -934,7 +933,7 @@ mod tests {
             };
             let t = 50.0 + e - under;
             assert!(t < 2.0 + 1e-9, "column {j}: top {t}");
-            if a.tops[j] {
+            if a.has_top(j) {
                 assert!(
                     (a.top_z[j] - (50.0 + e).max(under + 0.5)).abs() < 1e-9,
                     "{j}"
@@ -951,7 +950,7 @@ mod tests {
         let mut want: Vec<(usize, u32, bool)> = Vec::new();
         for j in 0..9 {
             want.extend((1..=a.passes[j]).map(|k| (j, k, false)));
-            if a.tops[j] {
+            if a.has_top(j) {
                 want.push((j, a.passes[j], true));
             }
         }
