@@ -127,6 +127,7 @@ mod tests {
             stages: 1,
             returning_points: 0,
             vessel: None,
+            twisted: false,
         }
     }
 

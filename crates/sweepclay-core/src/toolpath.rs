@@ -59,6 +59,9 @@ pub struct Toolpath {
     pub returning_points: u32,
     /// A vessel's floor and turns (closed Ψ), else `None`.
     pub vessel: Option<VesselPath>,
+    /// Whether the surface turns as it rises (a twist): the point below
+    /// a point then lies partly along its bead, not only across it.
+    pub twisted: bool,
 }
 
 /// Orders the samples of a corrected surface into one continuous path.
@@ -140,6 +143,7 @@ pub fn plan_path(c: &Corrected) -> Toolpath {
         stages: if s.plan.two_stage() { 2 } else { 1 },
         returning_points: returning,
         vessel: None,
+        twisted: s.columns.iter().any(|c| c.twist != 0.0),
     }
 }
 
@@ -288,6 +292,7 @@ pub fn plan_vessel_path(c: &Corrected, v: &VesselPlan) -> Toolpath {
             floor_widths,
             floor_refusal,
         }),
+        twisted: s.columns.iter().any(|c| c.twist != 0.0),
     }
 }
 
