@@ -9,6 +9,6 @@ set -euo pipefail
 cd "$(dirname "$0")/.."
 max="${MAX:-10000000}"
 SWEEPCLAY_BENCH_MAX="$max" cargo bench -p sweepclay-core --bench pipeline
-SWEEPCLAY_BENCH_MAX="$max" cargo bench -p sweepclay-web --bench verified
+SWEEPCLAY_BENCH_MAX="$max" cargo bench -p sweepclay-plan --bench verified
 cargo bench -p sweepclay-check --bench check
 cargo run --release -p sweepclay-perf -- "$max"

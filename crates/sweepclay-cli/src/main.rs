@@ -7,8 +7,7 @@ use std::io::Write;
 use std::path::{Path, PathBuf};
 use sweepclay_check::{check_reader, CheckConfig};
 use sweepclay_core::{examples, printer::PRESETS, Design, Printer, PrinterRef};
-use sweepclay_web::guard::Cancel;
-use sweepclay_web::verify::{printer_check, slice_checked, Checked, Unchecked};
+use sweepclay_plan::{plan, printer_check, Cancel, Checked, Job, Unchecked};
 
 /// mimalloc keeps freed pages for reuse; glibc's allocator returns large
 /// blocks to the system and faults them in again, which cost a third of
@@ -17,7 +16,7 @@ use sweepclay_web::verify::{printer_check, slice_checked, Checked, Unchecked};
 static ALLOC: mimalloc::MiMalloc = mimalloc::MiMalloc;
 
 /// The most surface samples `slice` and `serve` take by default.
-const DEFAULT_MAX_SAMPLES: u64 = 1_500_000;
+const DEFAULT_MAX_SAMPLES: u64 = sweepclay_plan::job::DEFAULT_MAX_SAMPLES;
 
 /// The version and the commit the binary was built from (`build.rs`).
 const VERSION: &str = concat!(
@@ -411,8 +410,13 @@ fn slice(a: SliceArgs) -> Result<i32> {
             .with_context(|| format!("--set {k}: `{v}` is not a number"))?;
         design.params.set(k, v)?;
     }
-    // Refused before anything is sampled, as the server refuses it.
-    sweepclay_core::check_size(&design, a.max_samples as f64).with_context(|| source.clone())?;
+    // Validated once, before anything is sampled, as the server does.
+    let limits = sweepclay_plan::Limits {
+        min_overlap: a.min_overlap,
+        max_samples: a.max_samples as f64,
+        must_fit: true,
+    };
+    let job = Job::new(design, &limits).with_context(|| source.clone())?;
     let out = a.output.clone().unwrap_or_else(|| {
         let stem = Path::new(&a.design)
             .file_stem()
@@ -443,14 +447,14 @@ fn slice(a: SliceArgs) -> Result<i32> {
     let file = tmp
         .reopen()
         .with_context(|| format!("opening {}", tmp.path().display()))?;
-    let checked = match slice_checked(&design, a.min_overlap, &Cancel::new(), || {
+    let checked = match plan(&job, &Cancel::new(), || {
         use std::io::{Seek, SeekFrom};
         let mut f = &file;
         f.set_len(0)?;
         f.seek(SeekFrom::Start(0))?;
         Ok(std::io::BufWriter::with_capacity(1 << 16, f))
     }) {
-        Ok(c) => c,
+        Ok(p) => p.checked,
         Err(Unchecked::Design(e)) => return Err(e).with_context(|| source.clone()),
         Err(Unchecked::Io(e)) => {
             return Err(e).with_context(|| format!("writing {}", tmp.path().display()))

@@ -65,7 +65,7 @@ fn main() -> Result<()> {
         drop(sliced);
         let (printable, verified_peak) = peak_of(|| {
             let s = sweepclay_core::slice(&d).expect("it sliced a moment ago");
-            sweepclay_web::verify::verify_into(&s, 0.5, std::io::sink())
+            sweepclay_plan::verify_into(&s, 0.5, std::io::sink())
                 .expect("a sink takes any amount")
                 .0
                 .printable

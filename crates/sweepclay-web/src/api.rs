@@ -1,23 +1,45 @@
 //! What the modeler's JSON API computes, without the HTTP: design text in,
-//! plain serialisable answers out. Every function is a thin composition of
-//! the library's stages (`sweepclay-core`) and the checker.
+//! plain serialisable answers out. Design text becomes a validated
+//! [`Job`] once; every answer that slices comes from the one plan
+//! (`sweepclay_plan::plan`), so the preview, the verdict, the G-code and
+//! the STL are of the same path.
 
 pub use crate::error::ApiError;
-use crate::guard::Cancel;
 pub use crate::guard::Limits;
-use crate::verify::{slice_checked, slice_checked_drawn, Unchecked, Verified};
+use crate::guard::{Cancel, Stopped};
 use serde::Serialize;
 use sweepclay_core::mesh;
 use sweepclay_core::toolpath::PointKind;
 use sweepclay_core::{correct, surface, Design, Sliced};
+use sweepclay_plan::{plan, Job, Planned, Unchecked, Verified};
 
-/// Parses a design and refuses one whose sample count is over the limit.
-/// One that leaves the build volume is let through: slicing refuses it all
-/// the same, and the preview shows it with the part outside marked.
-pub fn parse_design(text: &str, limits: &Limits) -> Result<Design, ApiError> {
+/// Parses a design into a job, refusing one whose parameters are out of
+/// range or whose sample count is over the limit. One that leaves the
+/// build volume is let through: slicing refuses it all the same, and the
+/// preview shows it with the part outside marked.
+pub fn parse_design(text: &str, limits: &Limits) -> Result<Job, ApiError> {
     let d = Design::from_json(text)?;
-    sweepclay_core::check_samples(&d, limits.max_samples)?;
-    Ok(d)
+    let limits = sweepclay_plan::Limits {
+        min_overlap: MIN_OVERLAP,
+        max_samples: limits.max_samples,
+        must_fit: false,
+    };
+    Ok(Job::new(d, &limits)?)
+}
+
+/// The overlap floor the modeler checks with: the checker's default.
+const MIN_OVERLAP: f64 = 0.5;
+
+/// The plan of a job, its G-code written to what `out` makes.
+fn planned<W: std::io::Write>(
+    job: &Job,
+    cancel: &Cancel,
+    out: impl FnMut() -> std::io::Result<W>,
+) -> Result<Planned<W>, ApiError> {
+    plan(job, cancel, out).map_err(|e| match e {
+        Unchecked::Design(e) => e.into(),
+        Unchecked::Io(e) => cancel.io_error("writing G-code", e),
+    })
 }
 
 /// The layering the path follows.
@@ -254,12 +276,12 @@ fn round2(x: f64) -> f32 {
 /// corrections moved from the drawing, and the check's verdict, so one
 /// edit costs one slice. A print that leaves the build volume is shown
 /// as the stages lay it, with why it cannot print and no verdict.
-pub fn slice_view(design: &Design, cancel: &Cancel) -> Result<SliceView, ApiError> {
+pub fn slice_view(job: &Job, cancel: &Cancel) -> Result<SliceView, ApiError> {
     let t0 = std::time::Instant::now();
-    let (checked, drawn) = match slice_checked_drawn(design, 0.5, cancel, || Ok(std::io::sink())) {
+    let Planned { checked, drawn } = match plan(job, cancel, || Ok(std::io::sink())) {
         Ok(c) => c,
         Err(Unchecked::Io(e)) => return Err(cancel.io_error("checking the G-code", e)),
-        Err(Unchecked::Design(e)) => return unfit_view(design, cancel, t0, e),
+        Err(Unchecked::Design(e)) => return unfit_view(job.design(), cancel, t0, e),
     };
     let verdict = Verdict {
         printable: checked.report.printable,
@@ -478,37 +500,19 @@ pub struct Verdict {
     pub lines: usize,
 }
 
-/// Slices a design stage by stage, stopping between them once `cancel`
-/// is set.
-pub fn sliced(design: &Design, cancel: &Cancel) -> Result<Sliced, ApiError> {
-    let sampled = surface::sample_surface(design)?;
-    cancel.check()?;
-    let corrected = correct::correct(&sampled)?;
-    drop(sampled);
-    cancel.check()?;
-    let s = sweepclay_core::finish(corrected)?;
-    cancel.check()?;
-    Ok(s)
-}
-
-/// Slices, emits and checks a design, through the correction loop
+/// Plans, emits and checks a job, through the correction loop
 /// (stopping once `cancel` is set).
-pub fn verified(design: &Design, cancel: &Cancel) -> Result<Verified, ApiError> {
-    match slice_checked(design, 0.5, cancel, || Ok(Vec::new())) {
-        Ok(c) => {
-            let advice = c.advice();
-            let reshaped = c.sliced.corrected.reshaped();
-            Ok(Verified {
-                gcode: String::from_utf8(c.out).expect("G-code is UTF-8"),
-                report: c.report,
-                locations: c.locations,
-                advice,
-                reshaped,
-            })
-        }
-        Err(Unchecked::Design(e)) => Err(e.into()),
-        Err(Unchecked::Io(e)) => Err(cancel.io_error("writing G-code", e)),
-    }
+pub fn verified(job: &Job, cancel: &Cancel) -> Result<Verified, ApiError> {
+    let c = planned(job, cancel, || Ok(Vec::new()))?.checked;
+    let advice = c.advice();
+    let reshaped = c.sliced.corrected.reshaped();
+    Ok(Verified {
+        gcode: String::from_utf8(c.out).expect("G-code is UTF-8"),
+        report: c.report,
+        locations: c.locations,
+        advice,
+        reshaped,
+    })
 }
 
 /// The verdict of [`verified`].
@@ -526,14 +530,14 @@ pub fn verdict(v: &Verified) -> Verdict {
 
 /// The G-code of a design, only if it passes the check; otherwise a 422
 /// that says why and where.
-pub fn gcode(design: &Design, cancel: &Cancel) -> Result<String, ApiError> {
+pub fn gcode(job: &Job, cancel: &Cancel) -> Result<String, ApiError> {
     let Verified {
         gcode,
         report,
         locations,
         advice,
         ..
-    } = verified(design, cancel)?;
+    } = verified(job, cancel)?;
     if report.printable {
         Ok(gcode)
     } else {
@@ -550,9 +554,10 @@ pub fn gcode(design: &Design, cancel: &Cancel) -> Result<String, ApiError> {
     }
 }
 
-/// A binary STL of the surface thickened to the bead width.
-pub fn stl(design: &Design, cancel: &Cancel) -> Result<Vec<u8>, ApiError> {
-    let s = sliced(design, cancel)?;
+/// A binary STL of the planned surface (the one the G-code prints)
+/// thickened to the bead width.
+pub fn stl(job: &Job, cancel: &Cancel) -> Result<Vec<u8>, ApiError> {
+    let s = planned(job, cancel, || Ok(std::io::sink()))?.checked.sliced;
     let mut out = Vec::new();
     mesh::write_stl(&s, &mut out).map_err(|e| ApiError::new(500, e.to_string()))?;
     Ok(out)
@@ -669,9 +674,19 @@ mod tests {
         Design::from_json(examples::example(name).unwrap()).unwrap()
     }
 
+    /// A design as the server takes it, with no sample cap.
+    fn job(d: Design) -> Job {
+        let limits = sweepclay_plan::Limits {
+            max_samples: f64::INFINITY,
+            must_fit: false,
+            ..sweepclay_plan::Limits::default()
+        };
+        Job::new(d, &limits).unwrap()
+    }
+
     #[test]
     fn slice_view_indexes_every_sample_once() {
-        let v = slice_view(&design("t2"), &Cancel::new()).unwrap();
+        let v = slice_view(&job(design("t2")), &Cancel::new()).unwrap();
         let n = v.surface.positions.len() / 3;
         assert_eq!(v.stats.sample_points, n);
         let mut seen = vec![false; n];
@@ -691,7 +706,7 @@ mod tests {
 
     #[test]
     fn binary_form_carries_the_same_arrays() {
-        let v = slice_view(&design("t2"), &Cancel::new()).unwrap();
+        let v = slice_view(&job(design("t2")), &Cancel::new()).unwrap();
         let b = v.to_binary();
         assert_eq!(&b[..4], b"SWCL");
         let u32_at = |o: usize| u32::from_le_bytes(b[o..o + 4].try_into().unwrap()) as usize;
@@ -737,7 +752,7 @@ mod tests {
         let (start, _) = arrays[5];
         assert_eq!(u32_at(start + 4 * (n - 1)) as u32, v.path.pass[n - 1]);
         // A textured design sends the texture kept, a value a path point.
-        let v = slice_view(&design("ripple-vase"), &Cancel::new()).unwrap();
+        let v = slice_view(&job(design("ripple-vase")), &Cancel::new()).unwrap();
         let b = v.to_binary();
         let last_len = {
             let json_len = u32::from_le_bytes(b[4..8].try_into().unwrap()) as usize;
@@ -756,7 +771,7 @@ mod tests {
 
     #[test]
     fn corrections_mark_moved_samples() {
-        let plain = slice_view(&design("t4"), &Cancel::new()).unwrap();
+        let plain = slice_view(&job(design("t4")), &Cancel::new()).unwrap();
         assert!(plain.corrections.is_empty() && plain.surface.moved.is_empty());
         // An end profile leaning 45 mm over 20 mm of height overhangs far
         // beyond 57°: the support correction moves its upper samples.
@@ -764,7 +779,7 @@ mod tests {
         d.profile_end = Some(sweepclay_core::design::CurveSpec {
             control_points: vec![[0.0, 0.0], [45.0, 20.0], [45.0, 40.0]],
         });
-        let v = slice_view(&d, &Cancel::new()).unwrap();
+        let v = slice_view(&job(d.clone()), &Cancel::new()).unwrap();
         assert!(!v.corrections.is_empty());
         assert!(!v.surface.moved.is_empty());
         let n = (v.surface.positions.len() / 3) as u32;
@@ -799,7 +814,7 @@ mod tests {
         assert!(serde_json::to_string(&v).unwrap().contains("\"fit_error\""));
         // ... but its G-code is refused.
         assert_eq!(gcode(&d, &Cancel::new()).unwrap_err().status, 422);
-        assert!(slice_view(&design("t1"), &Cancel::new())
+        assert!(slice_view(&job(design("t1")), &Cancel::new())
             .unwrap()
             .fit_error
             .is_none());
@@ -807,7 +822,7 @@ mod tests {
 
     #[test]
     fn the_bead_map_has_a_figure_for_every_path_point() {
-        let v = slice_view(&design("t2"), &Cancel::new()).unwrap();
+        let v = slice_view(&job(design("t2")), &Cancel::new()).unwrap();
         let n = v.path.order.len();
         let b = &v.path.beads;
         for a in [&b.overlap, &b.overhang_deg, &b.layer_height, &b.clearance] {
@@ -838,9 +853,10 @@ mod tests {
     fn errors_carry_status_and_key() {
         let e = parse_design("{", &Limits::default()).unwrap_err();
         assert_eq!(e.status, 400);
+        // Refused once, when the text becomes a job, before any slicing.
         let mut d = design("t1");
         d.params.layer_height = 0.1;
-        let e = slice_view(&d, &Cancel::new()).unwrap_err();
+        let e = parse_design(&d.to_json(), &Limits::default()).unwrap_err();
         assert_eq!(
             (e.status, e.key.as_deref()),
             (422, Some("params.layer_height"))
@@ -850,7 +866,7 @@ mod tests {
 
     #[test]
     fn gcode_is_verified() {
-        let text = gcode(&design("t5"), &Cancel::new()).unwrap();
+        let text = gcode(&job(design("t5")), &Cancel::new()).unwrap();
         assert!(text.contains("G1"));
     }
 
@@ -863,8 +879,9 @@ mod tests {
         // carries that G-code's verdict.
         // "New pot" on the cerambot-plus, its base typed 150 mm wide under
         // rows 60 mm wide.
-        let d = Design::from_json(include_str!("../tests/foot-pot.json")).unwrap();
-        let v = slice_view(&d, &Cancel::new()).unwrap();
+        let d =
+            Design::from_json(include_str!("../../sweepclay-plan/tests/foot-pot.json")).unwrap();
+        let v = slice_view(&job(d.clone()), &Cancel::new()).unwrap();
         let verdict = v.verdict.as_ref().expect("a verdict");
         assert!(verdict.printable, "{:?}", verdict.failures);
         assert!(
@@ -872,7 +889,7 @@ mod tests {
             "{:?}",
             v.corrections
         );
-        let text = gcode(&d, &Cancel::new()).unwrap();
+        let text = gcode(&job(d.clone()), &Cancel::new()).unwrap();
         assert_eq!(text.lines().count(), verdict.lines);
         // Every move's end in the file, in order, in the design's frame.
         let mut at = [0.0f64; 3];

@@ -62,7 +62,7 @@ impl Default for Limits {
     fn default() -> Self {
         let workers = std::thread::available_parallelism().map_or(2, |n| n.get());
         Limits {
-            max_samples: 1.5e6,
+            max_samples: sweepclay_plan::job::DEFAULT_MAX_SAMPLES as f64,
             workers,
             queue: 4 * workers,
             request_timeout: std::time::Duration::from_secs(60),
@@ -80,40 +80,25 @@ impl Default for Limits {
     }
 }
 
-/// Set when the request that asked for some work is gone (its client
-/// disconnected, or its time ran out): the work stops at its next check,
-/// between the pipeline's stages and every 64 KiB of G-code written or
-/// read (docs/MODELER.md, "Limits and safety").
-#[derive(Clone, Debug, Default)]
-pub struct Cancel(Arc<std::sync::atomic::AtomicBool>);
+/// The work's stop flag (`sweepclay_plan::Cancel`), set when the request
+/// that asked for the work is gone (its client disconnected, or its time
+/// ran out): the work stops at its next check, between the pipeline's
+/// stages and every 64 KiB of G-code written or read (docs/MODELER.md,
+/// "Limits and safety").
+pub use sweepclay_plan::{Cancel, CancelReader, CancelWriter};
 
-impl Cancel {
-    /// A flag not yet set.
-    pub fn new() -> Cancel {
-        Cancel::default()
-    }
-
-    /// Whether the work should stop.
-    pub fn is_set(&self) -> bool {
-        self.0.load(Ordering::Relaxed)
-    }
-
-    /// Asks the work to stop.
-    pub fn set(&self) {
-        self.0.store(true, Ordering::Relaxed);
-    }
-
+/// A stopped piece of work as the API answers it.
+pub trait Stopped {
+    /// An error to end the work with once the flag is set (503).
+    fn check(&self) -> Result<(), ApiError>;
     /// The error of an I/O step that failed: the stop, if the flag is set
     /// (a [`CancelWriter`] or [`CancelReader`] failing on purpose), else
-    /// `what` failing.
-    pub fn io_error(&self, what: &str, e: std::io::Error) -> ApiError {
-        self.check()
-            .err()
-            .unwrap_or_else(|| ApiError::new(500, format!("{what}: {e}")))
-    }
+    /// `what` failing (500).
+    fn io_error(&self, what: &str, e: std::io::Error) -> ApiError;
+}
 
-    /// An error to end the work with once the flag is set.
-    pub fn check(&self) -> Result<(), ApiError> {
+impl Stopped for Cancel {
+    fn check(&self) -> Result<(), ApiError> {
         if self.is_set() {
             Err(ApiError::new(
                 503,
@@ -122,6 +107,12 @@ impl Cancel {
         } else {
             Ok(())
         }
+    }
+
+    fn io_error(&self, what: &str, e: std::io::Error) -> ApiError {
+        self.check()
+            .err()
+            .unwrap_or_else(|| ApiError::new(500, format!("{what}: {e}")))
     }
 }
 
@@ -132,35 +123,6 @@ struct SetOnDrop(Cancel);
 impl Drop for SetOnDrop {
     fn drop(&mut self) {
         self.0.set();
-    }
-}
-
-/// A writer that fails once its [`Cancel`] is set, so a long emission or
-/// check stops between chunks.
-pub struct CancelWriter<W>(pub W, pub Cancel);
-
-impl<W: std::io::Write> std::io::Write for CancelWriter<W> {
-    fn write(&mut self, buf: &[u8]) -> std::io::Result<usize> {
-        if self.1.is_set() {
-            return Err(std::io::Error::other("cancelled"));
-        }
-        self.0.write(buf)
-    }
-
-    fn flush(&mut self) -> std::io::Result<()> {
-        self.0.flush()
-    }
-}
-
-/// A reader that fails once its [`Cancel`] is set.
-pub struct CancelReader<R>(pub R, pub Cancel);
-
-impl<R: std::io::Read> std::io::Read for CancelReader<R> {
-    fn read(&mut self, buf: &mut [u8]) -> std::io::Result<usize> {
-        if self.1.is_set() {
-            return Err(std::io::Error::other("cancelled"));
-        }
-        self.0.read(buf)
     }
 }
 

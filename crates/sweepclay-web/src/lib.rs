@@ -27,7 +27,6 @@ pub mod api;
 pub mod conn;
 pub mod error;
 pub mod guard;
-pub mod verify;
 
 use api::{ApiError, Limits};
 use axum::body::Bytes;
@@ -37,7 +36,7 @@ use axum::http::{header, StatusCode};
 use axum::response::{IntoResponse, Response};
 use axum::routing::{get, post};
 use axum::{Json, Router};
-use guard::Cancel;
+use guard::{Cancel, Stopped};
 use serde::Deserialize;
 use std::collections::HashMap;
 use std::sync::Arc;
@@ -212,7 +211,7 @@ fn text(body: Result<Bytes, BytesRejection>) -> Result<String, ApiError> {
 async fn with_design<T: Send + 'static>(
     limits: Shared,
     body: Result<Bytes, BytesRejection>,
-    f: impl FnOnce(sweepclay_core::Design, &Cancel) -> Result<T, ApiError> + Send + 'static,
+    f: impl FnOnce(sweepclay_plan::Job, &Cancel) -> Result<T, ApiError> + Send + 'static,
 ) -> Result<T, ApiError> {
     let text = text(body)?;
     let state = limits.clone();
@@ -330,7 +329,12 @@ async fn gcode(
 ) -> Result<Response, ApiError> {
     with_design(limits, body, |d, c| {
         let text = api::gcode(&d, c)?;
-        Ok(attachment(&d, "gcode", "text/x-gcode; charset=utf-8", text))
+        Ok(attachment(
+            d.design(),
+            "gcode",
+            "text/x-gcode; charset=utf-8",
+            text,
+        ))
     })
     .await
 }
@@ -341,7 +345,7 @@ async fn stl(
 ) -> Result<Response, ApiError> {
     with_design(limits, body, |d, c| {
         let bytes = api::stl(&d, c)?;
-        Ok(attachment(&d, "stl", "model/stl", bytes))
+        Ok(attachment(d.design(), "stl", "model/stl", bytes))
     })
     .await
 }
@@ -396,7 +400,7 @@ async fn check(
             // Without `printer`, a sweepclay file is checked for the printer
             // its header names, any other for `generic` (as the CLI does).
             let cfg = match printer {
-                Some(p) => verify::printer_check(&p),
+                Some(p) => sweepclay_plan::printer_check(&p),
                 None => {
                     // The header is read as the CLI reads it (its first
                     // 64 KB, bytes that are not UTF-8 replaced), and its

@@ -234,7 +234,7 @@ async fn imports_and_checks() {
     assert!(v["printer"].as_str().unwrap().contains("assumed"), "{v}");
     let mut d = Design::from_json(examples::example("t4").unwrap()).unwrap();
     d.printer = sweepclay_core::PrinterRef::Preset("cerambot-mini".into());
-    let ours = sweepclay_web::verify::verify(&sweepclay_core::slice(&d).unwrap(), 0.5).gcode;
+    let ours = sweepclay_plan::verify(&sweepclay_core::slice(&d).unwrap(), 0.5).gcode;
     let r = post(&format!("{base}/api/check"), ours.clone()).await;
     let v: Value = r.json().await.unwrap();
     assert_eq!(v["printable"], true, "{v}");

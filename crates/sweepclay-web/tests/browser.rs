@@ -198,7 +198,7 @@ async fn download_printable(
     let text = std::fs::read_to_string(&file).unwrap();
     let printer = js(c, "return window.sweepclay.design.printer").await;
     let printer = sweepclay_core::Printer::preset(printer.as_str().unwrap()).unwrap();
-    let report = sweepclay_check::check(&text, &sweepclay_web::verify::printer_check(&printer));
+    let report = sweepclay_check::check(&text, &sweepclay_plan::printer_check(&printer));
     assert!(report.printable, "{:?}", report.failures);
     (text, printer)
 }
@@ -507,7 +507,7 @@ async fn draw_preview_and_download_verified_gcode() {
     set_value(&c, "name", "t1 wave ring").await;
     let text = std::fs::read_to_string(&file).unwrap();
     let printer = sweepclay_core::Printer::preset("cerambot-plus").unwrap();
-    let report = sweepclay_check::check(&text, &sweepclay_web::verify::printer_check(&printer));
+    let report = sweepclay_check::check(&text, &sweepclay_plan::printer_check(&printer));
     assert!(report.printable, "{:?}", report.failures);
     assert!(report.extruding_moves as f64 > grown - 2.0);
 
@@ -670,7 +670,7 @@ async fn draw_preview_and_download_verified_gcode() {
     let file = download_gcode(&c, &downloads, "no vessel G-code was downloaded").await;
     let text = std::fs::read_to_string(&file).unwrap();
     assert!(text.contains(";TYPE:Bottom solid infill") && text.contains("floor_layers=3"));
-    let report = sweepclay_check::check(&text, &sweepclay_web::verify::printer_check(&printer));
+    let report = sweepclay_check::check(&text, &sweepclay_plan::printer_check(&printer));
     assert!(report.printable, "{:?}", report.failures);
     assert_eq!(report.extrusion_runs, 1);
     // A pot whose flare the support-free correction narrows by 16 mm:
@@ -1567,7 +1567,7 @@ async fn a_pot_on_a_phone_by_touch() {
     let text = std::fs::read_to_string(&file).unwrap();
     let printer = js(&c, "return window.sweepclay.design.printer").await;
     let printer = sweepclay_core::Printer::preset(printer.as_str().unwrap()).unwrap();
-    let report = sweepclay_check::check(&text, &sweepclay_web::verify::printer_check(&printer));
+    let report = sweepclay_check::check(&text, &sweepclay_plan::printer_check(&printer));
     assert!(report.printable, "{:?}", report.failures);
     assert_eq!(js(&c, "return window.sweepclayErrors").await, json!([]));
     c.close().await.unwrap();
@@ -1760,7 +1760,7 @@ async fn tabs_views_and_printers_keep_the_truth() {
     );
     let printer = js(&c, "return JSON.stringify(window.sweepclay.design.printer)").await;
     let printer: sweepclay_core::Printer = serde_json::from_str(printer.as_str().unwrap()).unwrap();
-    let report = sweepclay_check::check(&text, &sweepclay_web::verify::printer_check(&printer));
+    let report = sweepclay_check::check(&text, &sweepclay_plan::printer_check(&printer));
     assert!(report.printable, "{:?}", report.failures);
     set_value(&c, "p-printer", "cerambot-mini").await;
     wait_js(

@@ -9,6 +9,7 @@
 
 use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
+#[path = "../../sweepclay-plan/tests/seeds/mod.rs"]
 mod seeds;
 use sweepclay_web::api;
 

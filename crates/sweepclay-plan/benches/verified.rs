@@ -4,14 +4,14 @@
 //! scaling series of
 //! `examples::scaled` (10 thousand to 10 million samples).
 //!
-//! `cargo bench -p sweepclay-web` (all), `-- verified/t1`, `-- verified_scaling`.
+//! `cargo bench -p sweepclay-plan` (all), `-- verified/t1`, `-- verified_scaling`.
 //! `SWEEPCLAY_BENCH_MAX=1000000` stops the scaling series at 1 million.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use std::hint::black_box;
 use sweepclay_core::{examples, Design};
-use sweepclay_web::guard::Cancel;
-use sweepclay_web::verify::slice_checked;
+use sweepclay_plan::slice_checked;
+use sweepclay_plan::Cancel;
 
 /// The allocator the `sweepclay` binary ships with (mimalloc: it keeps
 /// freed pages for reuse, where glibc's returns large blocks to the system

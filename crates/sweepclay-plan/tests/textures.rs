@@ -11,8 +11,8 @@ use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 mod seeds;
 use sweepclay_core::{correct, surface, Design};
-use sweepclay_web::guard::Cancel;
-use sweepclay_web::verify::{slice_checked, Unchecked};
+use sweepclay_plan::Cancel;
+use sweepclay_plan::{slice_checked, Unchecked};
 
 /// 40 cases in CI; `PROPTEST_CASES` for more.
 fn cases() -> u32 {
@@ -152,7 +152,7 @@ fn design(
 /// Whether a check failed only where the extruder body meets a vessel's
 /// rim that the sampling found too uneven for one spiral, and the advice
 /// says so.
-fn rim_refused(c: &sweepclay_web::verify::Checked<std::io::Sink>) -> bool {
+fn rim_refused(c: &sweepclay_plan::Checked<std::io::Sink>) -> bool {
     let uneven = c
         .sliced
         .corrected

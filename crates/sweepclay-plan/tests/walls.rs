@@ -10,8 +10,8 @@ use proptest::prelude::*;
 use proptest::test_runner::RngSeed;
 mod seeds;
 use sweepclay_core::Design;
-use sweepclay_web::guard::Cancel;
-use sweepclay_web::verify::{slice_checked, Unchecked};
+use sweepclay_plan::Cancel;
+use sweepclay_plan::{slice_checked, Unchecked};
 
 /// 1,000 cases with `PROPTEST_CASES=1000`; a fixed sample of 40 in CI.
 fn cases() -> u32 {

@@ -1,113 +1,18 @@
-//! Sliced design → G-code → independent check (docs/CHECKER.md): what `slice`
-//! and the modeler's download both run before they hand out a file, and the
-//! way back from a failing G-code line to the place in the design.
+//! The one plan (docs/ARCHITECTURE.md): a validated [`Job`] through the
+//! pipeline's stages — sample (paper §3), correct (§4), path (§5.1–5.2),
+//! extrude (§5.3), emit — then the independent check, and while the check
+//! fails for a reason a correction can fix, the corrections tightened
+//! where it failed and the stages after sampling run again
+//! (docs/ALGORITHMS.md §4, "The loop closes"). The CLI's `slice`, the
+//! modeler's preview, its verdict and its download all come from here.
 
-use crate::guard::{Cancel, CancelWriter};
+use crate::cancel::{Cancel, CancelWriter};
+use crate::check::verify_lines;
+use crate::job::{Job, Limits};
 use std::io::{self, Write};
-use sweepclay_check::{CheckConfig, CheckWriter, Finding, Report};
+use sweepclay_check::{Finding, Report};
 use sweepclay_core::correct::{correct_with, Tightening};
-use sweepclay_core::toolpath::PointKind;
-use sweepclay_core::{gcode, surface, Design, Params, Printer, Sliced};
-
-/// The checker's defaults with the printer's build volume, calibration and
-/// extruder body.
-pub fn printer_check(p: &Printer) -> CheckConfig {
-    CheckConfig {
-        build_volume: p.build_volume,
-        bed_min: p.bed_min,
-        bed_diameter: p.bed_diameter,
-        printer: p.name.clone(),
-        e_per_mm3: p.e_per_mm3,
-        nozzle_radius: p.nozzle_radius,
-        ..CheckConfig::default()
-    }
-}
-
-/// The check a sliced design must pass: the printer's, with the design's
-/// parameters.
-pub fn check_config(p: &Printer, params: &Params) -> CheckConfig {
-    let base = printer_check(p);
-    CheckConfig {
-        nozzle_height: params.nozzle_height,
-        width_min: params.width_min,
-        width_max: params.width_max,
-        overlap_target: params.overlap,
-        max_overhang_deg: params.max_overhang_deg,
-        first_layer_max_mm: base.first_layer_max_mm.max(params.max_layer_height + 0.05),
-        ..base
-    }
-}
-
-/// G-code of a sliced design with the check's verdict on it.
-#[derive(Debug)]
-pub struct Verified {
-    /// The G-code text.
-    pub gcode: String,
-    /// The checker's report.
-    pub report: Report,
-    /// Where in the design the first failure of each kind is (see [`locate`]).
-    pub locations: Vec<String>,
-    /// What to change in the design, failure by failure (see
-    /// [`Checked::advice`]; empty when printable or not asked for).
-    pub advice: Vec<String>,
-    /// How far the corrections moved the shape, when beyond
-    /// `params.max_correction_mm` (`CorrectionReport::reshaped`).
-    pub reshaped: Option<String>,
-}
-
-/// Writes to two writers.
-struct Tee<A, B>(A, B);
-
-impl<A: Write, B: Write> Write for Tee<A, B> {
-    fn write(&mut self, buf: &[u8]) -> io::Result<usize> {
-        self.0.write_all(buf)?;
-        self.1.write_all(buf)?;
-        Ok(buf.len())
-    }
-    fn flush(&mut self) -> io::Result<()> {
-        self.0.flush()?;
-        self.1.flush()
-    }
-}
-
-/// Writes the G-code of `s` to `out` and checks it in the same pass,
-/// refusing beads that overlap the bead below by less than `min_overlap`
-/// of their width. Nothing of the text is kept: `out` may be a file of any
-/// size. Returns the report and where in the design its failures are.
-pub fn verify_into<W: Write>(
-    s: &Sliced,
-    min_overlap: f64,
-    out: W,
-) -> io::Result<(Report, Vec<String>)> {
-    verify_lines(s, min_overlap, out).map(|(r, l, _)| (r, l))
-}
-
-/// [`verify_into`], with the G-code line of each path point.
-fn verify_lines<W: Write>(
-    s: &Sliced,
-    min_overlap: f64,
-    out: W,
-) -> io::Result<(Report, Vec<String>, Vec<usize>)> {
-    let surface = &s.corrected.surface;
-    let cfg = CheckConfig {
-        overlap_min: min_overlap,
-        ..check_config(&surface.printer, &surface.params)
-    };
-    let mut tee = Tee(
-        out,
-        CheckWriter::with_capacity(&cfg, s.toolpath.points.len()),
-    );
-    let point_lines = gcode::emit(s, &mut tee)?;
-    tee.flush()?;
-    let Tee(_, checker) = tee;
-    let report = checker.finish();
-    let locations = failure_lines(&report)
-        .into_iter()
-        .take(5)
-        .filter_map(|l| locate(s, &point_lines, l))
-        .collect();
-    Ok((report, locations, point_lines))
-}
+use sweepclay_core::{surface, Design, Sliced};
 
 /// Most rounds of the correction loop after the first slicing.
 pub const MAX_ROUNDS: u32 = 8;
@@ -127,72 +32,8 @@ pub struct Checked<W> {
     pub point_lines: Vec<usize>,
 }
 
-impl<W> Checked<W> {
-    /// For each kind of failure the loop could not correct: the cause,
-    /// the place (G-code line, pass, curve, u, z) and the change to the
-    /// design that would fix it. Empty when printable.
-    pub fn advice(&self) -> Vec<String> {
-        let s = &self.sliced;
-        let p = &s.corrected.surface.params;
-        let r = s.corrected.surface.printer.nozzle_radius;
-        let rounds = s.corrected.report.rounds;
-        let uneven = s
-            .corrected
-            .surface
-            .vessel
-            .as_ref()
-            .and_then(|v| v.uneven.as_ref());
-        let tried = if rounds > 0 {
-            format!(" (after {rounds} round(s) of tightened corrections)")
-        } else {
-            String::new()
-        };
-        Finding::ALL
-            .iter()
-            .filter_map(|&k| {
-                let c = &self.report.findings[k];
-                let line = c.first_line?;
-                let worst = c.worst.map_or(0.0, |w| w.0);
-                let place = locate(s, &self.point_lines, line)
-                    .unwrap_or_else(|| format!("line {line}"));
-                let change = match k {
-                    Finding::Overhang => format!(
-                        "an overhang of {worst:.0}° beyond the {}° limit{tried}: lean the profiles less there, or raise params.max_overhang_deg if your clay stands steeper",
-                        p.max_overhang_deg
-                    ),
-                    Finding::UnderMinOverlap => format!(
-                        "a bead overlapping the one below by too little{tried}: lean the profiles less there, or raise params.width_max ({} mm) so a wider bead reaches",
-                        p.width_max
-                    ),
-                    Finding::NozzleCollision if uneven.is_some_and(|u| u.peaks.is_some()) => {
-                        let why = uneven.and_then(|u| u.peaks.as_ref()).expect("matched");
-                        format!("the extruder body ({r} mm radius) meets clay {worst:.1} mm above the nozzle{tried}: {why}")
-                    }
-                    Finding::NozzleCollision if uneven.is_some() => {
-                        let u = uneven.expect("matched");
-                        format!(
-                            "the extruder body ({r} mm radius) meets clay {worst:.1} mm above the nozzle{tried}: the rim rises or falls too steeply round the loop for one spiral (first near ({:.0}, {:.0}) mm); bring the rim's heights within {:.1} mm of each other (now {:.1} mm apart)",
-                            u.at[0], u.at[1], u.most_mm, u.spread_mm
-                        )
-                    }
-                    Finding::NozzleCollision => format!(
-                        "the extruder body ({r} mm radius) meets clay {worst:.1} mm above the nozzle{tried}: keep that part of the wall more than {:.0} mm in plan from the rest of it, or bring the two profiles' heights closer so the passes tilt less",
-                        r + p.width_max / 2.0
-                    ),
-                    Finding::DoubleDeposition => "clay laid on clay of its own layer: move those parts of the trajectory apart, or lower params.width_max".to_string(),
-                    Finding::TurnPile => "clay piling up where the path turns: lower params.max_layer_height, or set params.even_turn_flow".to_string(),
-                    Finding::Unsupported => "a bead with no clay under it: lean the profiles less there".to_string(),
-                    Finding::OutOfBounds => "outside the printer's build volume: make the design smaller or choose a larger printer".to_string(),
-                    other => other.failure().to_string(),
-                };
-                Some(format!("{change} — at {place}"))
-            })
-            .collect()
-    }
-}
-
 /// Why a slicing whose check fails cannot be corrected: the error
-/// [`slice_checked`] ends with.
+/// [`plan()`] ends with.
 #[derive(Debug)]
 pub enum Unchecked {
     /// The design does not slice (validation, sampling, corrections).
@@ -226,35 +67,63 @@ impl std::error::Error for Unchecked {}
 
 /// Ends the work once `cancel` is set.
 fn go_on(cancel: &Cancel) -> Result<(), Unchecked> {
-    match cancel.check() {
-        Ok(()) => Ok(()),
-        Err(e) => Err(Unchecked::Io(io::Error::other(e.error))),
+    if cancel.is_set() {
+        Err(Unchecked::Io(io::Error::other("cancelled")))
+    } else {
+        Ok(())
     }
 }
 
-/// Slices `design`, writes its G-code to a writer `out` makes and checks
-/// it in the same pass; while the check fails for a reason a correction
-/// can fix, tightens the corrections where it failed and does it again,
-/// at most [`MAX_ROUNDS`] more times (docs/ALGORITHMS.md §4, "The loop
+/// What [`plan()`] ends with: the last round's slicing, G-code writer and
+/// check, and the surface as sampled for that round (the drawing the
+/// corrections started from, its corners rounded if the loop rounded
+/// them), which the preview compares the print with.
+pub struct Planned<W> {
+    /// The last round, printable if any round was.
+    pub checked: Checked<W>,
+    /// The drawn surface of that round.
+    pub drawn: surface::Surface,
+}
+
+/// Plans a job: samples its design, corrects, plans the path and the
+/// extrusion, writes the G-code to a writer `out` makes and checks it in
+/// the same pass; while the check fails for a reason a correction can
+/// fix, tightens the corrections where it failed and does it again, at
+/// most [`MAX_ROUNDS`] more times (docs/ALGORITHMS.md §4, "The loop
 /// closes"). An overhang or a bead short of the overlap tightens the
-/// support-free correction on the transition curves within a bead of
-/// each failure; the extruder body meeting clay compresses all offsets,
-/// by steps and then by bisection, to the least compression that
-/// clears. A design that passes at once costs one slicing and one check.
-/// Returns the printable slicing the loop found, or else its last.
+/// support-free correction round each failure, tapering along Ψ; the
+/// extruder body meeting clay compresses all offsets, by steps and then
+/// by bisection, to the least compression that clears. A design that
+/// passes at once costs one slicing and one check. Returns the printable
+/// slicing the loop found, or else its last.
+pub fn plan<W: Write>(
+    job: &Job,
+    cancel: &Cancel,
+    out: impl FnMut() -> io::Result<W>,
+) -> Result<Planned<W>, Unchecked> {
+    let (checked, drawn) = run(job.design(), job.min_overlap(), cancel, out)?;
+    Ok(Planned { checked, drawn })
+}
+
+/// [`plan()`] for a design not yet made a [`Job`] (tests, benchmarks):
+/// validated with no sample cap, and its fit left to the slicing.
 pub fn slice_checked<W: Write>(
     design: &Design,
     min_overlap: f64,
     cancel: &Cancel,
     out: impl FnMut() -> io::Result<W>,
 ) -> Result<Checked<W>, Unchecked> {
-    slice_checked_drawn(design, min_overlap, cancel, out).map(|(c, _)| c)
+    let limits = Limits {
+        min_overlap,
+        max_samples: f64::INFINITY,
+        must_fit: false,
+    };
+    let job = Job::new(design.clone(), &limits)?;
+    plan(&job, cancel, out).map(|p| p.checked)
 }
 
-/// [`slice_checked`], with the surface as sampled for the last round
-/// (the drawing the corrections started from, its corners rounded if
-/// the loop rounded them): what the preview compares the print with.
-pub fn slice_checked_drawn<W: Write>(
+/// The correction loop of [`plan()`].
+fn run<W: Write>(
     design: &Design,
     min_overlap: f64,
     cancel: &Cancel,
@@ -435,60 +304,10 @@ fn tightening(failed: &[usize], n: usize, spacing: f64, closed: bool) -> Vec<f64
 /// the limit over it is 0.1 % a millimetre.
 const TIGHTEN_SPREAD_MM: f64 = 300.0;
 
-/// [`verify_into`] a string.
-pub fn verify(s: &Sliced, min_overlap: f64) -> Verified {
-    verify_until(s, min_overlap, &Cancel::new()).expect("writing to memory cannot fail")
-}
-
-/// [`verify`], stopping (with an error) at the next 64 KiB of G-code once
-/// `cancel` is set.
-pub fn verify_until(s: &Sliced, min_overlap: f64, cancel: &Cancel) -> io::Result<Verified> {
-    let mut text = Vec::with_capacity(gcode::size_hint(s));
-    let (report, locations) = verify_into(s, min_overlap, CancelWriter(&mut text, cancel.clone()))?;
-    Ok(Verified {
-        gcode: String::from_utf8(text).expect("G-code is UTF-8"),
-        report,
-        locations,
-        advice: Vec::new(),
-        reshaped: s.corrected.reshaped(),
-    })
-}
-
-/// The first line of each kind of failure in a report.
-pub fn failure_lines(r: &Report) -> Vec<usize> {
-    let mut v: Vec<usize> = r
-        .findings
-        .occurred()
-        .filter_map(|(_, c)| c.first_line)
-        .collect();
-    v.sort_unstable();
-    v.dedup();
-    v
-}
-
-/// Where in the design a G-code line of our own output is, given the line
-/// of each path point (`gcode::to_string_with_lines`).
-pub fn locate(s: &Sliced, lines: &[usize], line: usize) -> Option<String> {
-    let i = lines.partition_point(|&l| l < line);
-    if lines.get(i) != Some(&line) {
-        return None;
-    }
-    let p = &s.toolpath.points[i];
-    let col = &s.corrected.surface.columns[p.column as usize];
-    let top = if p.kind == PointKind::Top {
-        ", top-edge bead"
-    } else {
-        ""
-    };
-    Some(format!(
-        "line {line}: pass {}, transition curve {} (u = {:.3}), z = {:.2} mm{top}",
-        p.pass, p.column, col.u, p.pos[2]
-    ))
-}
-
 #[cfg(test)]
 mod tests {
     use super::*;
+    use crate::check::verify;
     use sweepclay_core::{examples, Design};
 
     #[test]
@@ -515,23 +334,6 @@ mod tests {
             (g[190] - 0.3 * (1.0 - 200.0 / 300.0)).abs() < 1e-12,
             "{}",
             g[190]
-        );
-    }
-
-    #[test]
-    fn examples_verify_and_a_strict_floor_fails_with_locations() {
-        let d = Design::from_json(examples::example("t4").unwrap()).unwrap();
-        let s = sweepclay_core::slice(&d).unwrap();
-        let ok = verify(&s, 0.5);
-        assert!(ok.report.printable, "{:?}", ok.report.failures);
-        assert!(ok.locations.is_empty());
-        // Beads overlap the bead below by 2/3 or a bit more, never 99 %.
-        let strict = verify(&s, 0.99);
-        assert!(!strict.report.printable);
-        assert!(
-            strict.locations[0].contains("pass") && strict.locations[0].starts_with("line "),
-            "{:?}",
-            strict.locations
         );
     }
 
