@@ -6,7 +6,7 @@
 //! Sampling (`surface.rs`) stores D per sample, its spacing and layer
 //! heights refined so each texture gets at least [`SAMPLES_PER_PERIOD`]
 //! samples a period ([`needs`], which `Design::printed` applies). The
-//! corrections (`keep_texture` in `correct.rs`) then choose the amount
+//! corrections (`keep_texture` in `correct/texture.rs`) then choose the amount
 //! kept, a ∈ [0, 1] per sample: 1 wherever the step from the bead below
 //! stays within the support-free and overlap limit, less only where it
 //! would not, and never more than [`MAX_A_STEP`] apart between
