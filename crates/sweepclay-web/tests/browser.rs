@@ -1965,3 +1965,163 @@ async fn a_pot_gets_a_raised_back_from_the_rim_control() {
     assert_eq!(js(&c, "return window.sweepclayErrors").await, json!([]));
     c.close().await.unwrap();
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_page_previews_the_path_it_downloads_point_for_point() {
+    // A pot on a foot 150 mm wide, whose first G-code fails the check:
+    // the plan tightens its corrections, and the preview must show the
+    // path of the last round, the one the download prints. Opened from a
+    // file and then edited (a twist), as a potter would.
+    let Some(Session {
+        tmp,
+        downloads,
+        driver: _driver,
+        c,
+        base,
+    }) = Session::start().await
+    else {
+        return;
+    };
+    c.goto(&base).await.unwrap();
+    close_guide(&c).await;
+    let file = tmp.path().join("foot-pot.json");
+    std::fs::write(
+        &file,
+        include_str!("../../sweepclay-plan/tests/foot-pot.json"),
+    )
+    .unwrap();
+    choose_file(&c, "open-file", &file).await;
+    wait_js(
+        &c,
+        &format!(
+            "return {IDLE} && window.sweepclay.design.name === 'new pot on a wide foot' && {}",
+            &PRINTABLE[7..]
+        ),
+        "the foot pot, printable",
+    )
+    .await;
+    set_value(&c, "twist", "20").await;
+    wait_js(
+        &c,
+        &format!(
+            "return {IDLE} && window.sweepclay.design.twist_deg === 20 && {}",
+            &PRINTABLE[7..]
+        ),
+        "the foot pot twisted 20°, printable",
+    )
+    .await;
+    let corrections = js(
+        &c,
+        "return document.getElementById('corrections').textContent",
+    )
+    .await;
+    assert!(
+        corrections.as_str().unwrap().contains("correction loop"),
+        "{corrections}"
+    );
+    let shown = js(
+        &c,
+        "const d = window.sweepclay.sliced;
+         return Array.from(d.path.order).flatMap((s) => Array.from(d.surface.positions.subarray(3 * s, 3 * s + 3)));",
+    )
+    .await;
+    let shown: Vec<f64> = shown
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    let (text, printer) =
+        download_printable(&c, &downloads, "no G-code of the foot pot was downloaded").await;
+    // Every move's end in the file, in order, in the design's frame.
+    let mut at = [0.0f64; 3];
+    let mut moves = Vec::new();
+    for line in text
+        .lines()
+        .filter(|l| l.starts_with("G1 ") || l.starts_with("G0 "))
+    {
+        for w in line.split_whitespace() {
+            match (w.as_bytes()[0], w[1..].parse::<f64>()) {
+                (b'X', Ok(x)) => at[0] = x - printer.origin[0],
+                (b'Y', Ok(y)) => at[1] = y - printer.origin[1],
+                (b'Z', Ok(z)) => at[2] = z,
+                _ => {}
+            }
+        }
+        moves.push(at);
+    }
+    let pts: Vec<[f64; 3]> = shown.chunks(3).map(|p| [p[0], p[1], p[2]]).collect();
+    let off = |p: &[f64; 3], m: &[f64; 3]| (0..3).map(|a| (p[a] - m[a]).abs()).fold(0.0, f64::max);
+    let first = moves
+        .iter()
+        .position(|m| off(&pts[0], m) < 0.006)
+        .expect("the preview's first point among the G-code's moves");
+    let tail = &moves[first..];
+    assert!(
+        tail.len() >= pts.len(),
+        "{} moves for {} points",
+        tail.len(),
+        pts.len()
+    );
+    let worst = pts
+        .iter()
+        .zip(tail)
+        .map(|(p, m)| off(p, m))
+        .fold(0.0, f64::max);
+    assert!(
+        worst < 0.006,
+        "the preview and the G-code differ by {worst} mm"
+    );
+    // The page draws the curves with its own B-splines (bspline.js): the
+    // same curves as the library's, on clamped polygons of 2 to 9 points
+    // and closed loops of 3 to 9.
+    let polygons: Vec<Vec<[f64; 2]>> = (2..=9)
+        .map(|n| {
+            (0..n)
+                .map(|i| {
+                    let a = i as f64 * 2.4;
+                    [
+                        40.0 * a.cos() + 3.0 * i as f64,
+                        25.0 * a.sin() - 7.0 * i as f64,
+                    ]
+                })
+                .collect()
+        })
+        .collect();
+    let page = c
+        .execute_async(
+            "const [polys, done] = arguments;
+             import('/assets/bspline.js').then((b) => done({
+               open: polys.map((p) => [0, 0.13, 0.5, 0.77, 1].map((t) => b.evalAt(p, t))),
+               closed: polys.filter((p) => p.length >= 3).map((p) => b.samplePeriodic(p, 7)),
+             }));",
+            vec![json!(polygons)],
+        )
+        .await
+        .unwrap();
+    let xy = |v: &Value| [v[0].as_f64().unwrap(), v[1].as_f64().unwrap()];
+    let near = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).abs().max((a[1] - b[1]).abs()) < 1e-9;
+    for (k, poly) in polygons.iter().enumerate() {
+        let curve = sweepclay_core::bspline::BSpline::clamped(poly.clone()).unwrap();
+        for (j, t) in [0.0, 0.13, 0.5, 0.77, 1.0].into_iter().enumerate() {
+            let (js_at, rust_at) = (xy(&page["open"][k][j]), curve.eval(t));
+            assert!(
+                near(js_at, rust_at),
+                "{} points, t {t}: page {js_at:?}, library {rust_at:?}",
+                poly.len()
+            );
+        }
+    }
+    for (k, poly) in polygons.iter().filter(|p| p.len() >= 3).enumerate() {
+        let rust = sweepclay_core::curves::periodic_bspline(poly, 7);
+        let page = page["closed"][k].as_array().unwrap();
+        assert_eq!(page.len(), rust.len());
+        assert!(
+            page.iter().zip(&rust).all(|(a, &b)| near(xy(a), b)),
+            "loop of {}",
+            poly.len()
+        );
+    }
+    assert_eq!(js(&c, "return window.sweepclayErrors").await, json!([]));
+    c.close().await.unwrap();
+}
