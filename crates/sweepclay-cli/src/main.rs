@@ -46,6 +46,10 @@ enum Command {
     Slice(SliceArgs),
     /// Check any G-code file for clay printability (exit 0 only if printable).
     Check(CheckArgs),
+    /// Turn a vessel mesh (STL or OBJ) into an editable design file:
+    /// cut into sections and fitted by one loop and one or two profiles
+    /// (docs/MESHES.md). Prints how close the fit is and where.
+    Import(ImportArgs),
     /// Write the bundled example designs (walls t1–t6, vessels vase, flower, cup) into a directory.
     Examples {
         /// Directory to write into (created if missing).
@@ -127,8 +131,18 @@ fn random_token() -> String {
 
 #[derive(Args, Debug)]
 struct SliceArgs {
-    /// Design file; a bundled example name (`t1` … `t6`, `vase`, `flower`, `cup`, `slanted-vase`, `pitcher`, `ripple-vase`, `fluted-cup`, `twisted-lobes`, `diamond-vase`) also works.
+    /// Design file; a vessel mesh (`.stl`, `.obj`), fitted to a design
+    /// first (docs/MESHES.md); or a bundled example name (`t1` … `t6`, `vase`, `flower`, `cup`, `slanted-vase`, `pitcher`, `ripple-vase`, `fluted-cup`, `twisted-lobes`, `diamond-vase`).
     design: String,
+    /// A mesh's units: multiply its coordinates by this to get
+    /// millimetres [default: 1, or 25.4 for a mesh 0.8 to 16 units tall,
+    /// which is said].
+    #[arg(long)]
+    scale: Option<f64>,
+    /// Also write the surface the G-code prints as STL (its beads'
+    /// width), e.g. to compare with a mesh.
+    #[arg(long, value_name = "FILE.stl")]
+    stl: Option<PathBuf>,
     /// Output G-code file [default: the design's name with .gcode].
     #[arg(short, long)]
     output: Option<PathBuf>,
@@ -155,6 +169,25 @@ struct SliceArgs {
     /// Print the summary as JSON.
     #[arg(long)]
     json: bool,
+}
+
+#[derive(Args, Debug)]
+struct ImportArgs {
+    /// The mesh: `.stl` (binary or ASCII) or `.obj`.
+    mesh: PathBuf,
+    /// The design file to write [default: the mesh's name with .json].
+    #[arg(short, long)]
+    output: Option<PathBuf>,
+    /// Multiply the mesh's coordinates by this to get millimetres
+    /// [default: 1, or 25.4 for a mesh 0.8 to 16 units tall, which is said].
+    #[arg(long)]
+    scale: Option<f64>,
+    /// The largest difference from the mesh the design may have (mm).
+    #[arg(long, default_value_t = 0.3)]
+    tolerance: f64,
+    /// Printer preset or printer JSON file for the design.
+    #[arg(long)]
+    printer: Option<String>,
 }
 
 #[derive(Args, Debug)]
@@ -270,6 +303,7 @@ fn run(cli: Cli) -> Result<i32> {
     match cli.command {
         Command::Slice(a) => slice(a),
         Command::Check(a) => check_cmd(a),
+        Command::Import(a) => import_cmd(a),
         Command::Serve(a) => serve(a),
         Command::Printers { json } => {
             let all: Vec<Printer> = PRESETS.iter().filter_map(|n| Printer::preset(n)).collect();
@@ -362,7 +396,85 @@ fn read_capped(path: &Path, cap: usize) -> std::result::Result<Vec<u8>, String> 
     Ok(bytes)
 }
 
+/// The most bytes of a mesh file read: a binary STL of the triangle cap.
+const MAX_MESH_BYTES: usize = 84 + 50 * sweepclay_core::meshread::MAX_TRIANGLES;
+
+/// Reads a mesh file and fits it by a design (named after the file),
+/// saying what was assumed and how close the fit is.
+fn mesh_design(path: &Path, scale: Option<f64>, tolerance: f64) -> Result<Design> {
+    use sweepclay_core::meshfit;
+    let shown = path.display().to_string();
+    let bytes = read_capped(path, MAX_MESH_BYTES).map_err(|e| anyhow::anyhow!("{shown}: {e}"))?;
+    let mut mesh =
+        sweepclay_core::meshread::TriMesh::read(&shown, &bytes).with_context(|| shown.clone())?;
+    let (k, note) = meshfit::units(&mesh, scale).with_context(|| shown.clone())?;
+    mesh.scale(k);
+    if let Some(n) = note {
+        eprintln!("note: {shown}: {n}");
+    }
+    let name = path
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let opts = meshfit::FitOptions {
+        tolerance_mm: tolerance,
+        name,
+    };
+    let f = meshfit::fit(&mesh, &opts).with_context(|| shown.clone())?;
+    say!(
+        "{shown}: {} triangles, a {}; fitted by a design (one loop, {}) within {:.2} mm of its {} sections (largest at ({:.1}, {:.1}, {:.1}) mm); its foot's centre moved to o",
+        mesh.triangles.len(),
+        if f.kind == "shell" { "wall with its thickness (fitted at its middle)" } else { "solid (fitted at its outside)" },
+        if f.design.profile_end.is_some() { "two profiles blended round it" } else { "one profile" },
+        f.deviation_mm,
+        f.sections,
+        f.at[0],
+        f.at[1],
+        f.at[2]
+    );
+    Ok(f.design)
+}
+
+fn is_mesh(path: &str) -> bool {
+    let lower = path.to_ascii_lowercase();
+    lower.ends_with(".stl") || lower.ends_with(".obj")
+}
+
+fn import_cmd(a: ImportArgs) -> Result<i32> {
+    if !(a.tolerance.is_finite() && a.tolerance > 0.0) {
+        bail!(
+            "--tolerance: must be a length above 0 mm (got {})",
+            a.tolerance
+        );
+    }
+    let mut design = mesh_design(&a.mesh, a.scale, a.tolerance)?;
+    if let Some(p) = &a.printer {
+        design.printer = PrinterRef::Inline(Box::new(load_printer(p)?));
+    }
+    let out = a
+        .output
+        .clone()
+        .unwrap_or_else(|| a.mesh.with_extension("json"));
+    let out = output_target(&out)?;
+    if std::fs::canonicalize(&out).ok() == std::fs::canonicalize(&a.mesh).ok() {
+        bail!(
+            "-o {}: that is the mesh; refusing to write over it",
+            out.display()
+        );
+    }
+    write_atomic(&out, design.to_json().as_bytes())?;
+    say!("wrote {}", out.display());
+    Ok(0)
+}
+
 fn slice(a: SliceArgs) -> Result<i32> {
+    if is_mesh(&a.design) {
+        let design = mesh_design(Path::new(&a.design), a.scale, 0.3)?;
+        return slice_design(a, design.to_json(), String::new());
+    }
+    if a.scale.is_some() {
+        bail!("--scale: only a mesh (.stl, .obj) is scaled; a design's sizes are millimetres");
+    }
     let (text, source) = match std::fs::read_to_string(&a.design) {
         Ok(t) => (t, a.design.clone()),
         Err(e) => match examples::example(&a.design) {
@@ -371,6 +483,16 @@ fn slice(a: SliceArgs) -> Result<i32> {
             }
             _ => return Err(e).with_context(|| format!("reading {}", a.design)),
         },
+    };
+    slice_design(a, text, source)
+}
+
+/// Slices design text (`source` names it in messages; empty: the file).
+fn slice_design(a: SliceArgs, text: String, source: String) -> Result<i32> {
+    let source = if source.is_empty() {
+        a.design.clone()
+    } else {
+        source
     };
     if !(0.0..=1.0).contains(&a.min_overlap) {
         bail!(
@@ -430,9 +552,14 @@ fn slice(a: SliceArgs) -> Result<i32> {
     // --force).
     let out = output_target(&out)?;
     let preview = a.preview.as_deref().map(output_target).transpose()?;
+    let stl = a.stl.as_deref().map(output_target).transpose()?;
     // `slice t4.json -o t4.json` would replace the design by its G-code,
     // `--preview d.json` by an SVG, `-o pic.png` a texture's picture.
-    for (flag, target) in [("-o", Some(&out)), ("--preview", preview.as_ref())] {
+    for (flag, target) in [
+        ("-o", Some(&out)),
+        ("--preview", preview.as_ref()),
+        ("--stl", stl.as_ref()),
+    ] {
         let Some(target) = target else { continue };
         let resolved = std::fs::canonicalize(target).unwrap_or_else(|_| target.clone());
         if let Some(input) = inputs.iter().find(|i| **i == resolved) {
@@ -473,6 +600,11 @@ fn slice(a: SliceArgs) -> Result<i32> {
     let printer = &sliced.corrected.surface.printer;
     if let Some(p) = &a.preview {
         write_atomic(p, sweepclay_core::preview::svg(&sliced).as_bytes())?;
+    }
+    if let Some(p) = &stl {
+        let mut bytes = Vec::new();
+        sweepclay_core::mesh::write_stl(&sliced, &mut bytes)?;
+        write_atomic(p, &bytes)?;
     }
     let st = &sliced.stats;
     if a.json {

@@ -932,3 +932,74 @@ fn lan_mode_prints_a_token_and_keeps_strangers_out() {
     assert!(get(addr, "/api/meta", &cookie).starts_with("HTTP/1.1 200"));
     assert!(get("evil.example", "/api/meta", &cookie).starts_with("HTTP/1.1 421"));
 }
+
+#[test]
+fn a_vessel_mesh_slices_and_imports_as_a_design() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    // The cup's own STL (its wall with its thickness, on its floor).
+    sweepclay(dir)
+        .args(["slice", "cup", "-o", "cup.gcode", "--stl", "cup.stl"])
+        .assert()
+        .success();
+    sweepclay(dir)
+        .args([
+            "slice",
+            "cup.stl",
+            "-o",
+            "again.gcode",
+            "--printer",
+            "cerambot-mini",
+        ])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains(
+            "a wall with its thickness (fitted at its middle)",
+        ))
+        .stdout(predicate::str::contains("check              printable"));
+    let r = sweepclay(dir)
+        .args(["check", "again.gcode"])
+        .assert()
+        .success();
+    drop(r);
+    sweepclay(dir)
+        .args(["import", "cup.stl", "-o", "cup-design.json"])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("wrote cup-design.json"));
+    let d = std::fs::read_to_string(dir.join("cup-design.json")).unwrap();
+    assert!(
+        d.contains("\"profile_start\"") && d.contains("\"closed\": true"),
+        "{d}"
+    );
+    // The mesh is an input: -o onto it is refused.
+    sweepclay(dir)
+        .args(["slice", "cup.stl", "-o", "cup.stl"])
+        .assert()
+        .failure()
+        .stderr(predicate::str::contains("that is an input"));
+    // A mesh in inches is scaled and said so; --scale on a design is an error.
+    sweepclay(dir)
+        .args([
+            "slice",
+            "cup.stl",
+            "--scale",
+            "0.0393700787",
+            "-o",
+            "inch.gcode",
+        ])
+        .assert()
+        .failure()
+        .stderr(predicate::str::contains("2.76 mm tall"));
+    sweepclay(dir)
+        .args(["slice", "cup", "--scale", "2"])
+        .assert()
+        .failure()
+        .stderr(predicate::str::contains("--scale: only a mesh"));
+    std::fs::write(dir.join("broken.stl"), b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 10 0 0\nvertex 0 10 20\nendloop\nendfacet\nendsolid x\n").unwrap();
+    sweepclay(dir)
+        .args(["slice", "broken.stl"])
+        .assert()
+        .failure()
+        .stderr(predicate::str::contains("broken.stl: mesh: has a hole"));
+}

@@ -1,0 +1,198 @@
+//! Triangle meshes in: binary and ASCII STL (through `stl_io`) and OBJ,
+//! read from bytes into one indexed [`TriMesh`] in millimetres
+//! (docs/MESHES.md). Pure: the caller reads the file.
+
+use crate::error::{Error, Result};
+
+/// An indexed triangle mesh: vertices shared by the triangles that use
+/// them, so an edge is the pair of its vertices' indices.
+#[derive(Clone, Debug, Default, PartialEq)]
+pub struct TriMesh {
+    /// Vertex positions (mm once scaled).
+    pub vertices: Vec<[f64; 3]>,
+    /// Triangles as indices into `vertices`.
+    pub triangles: Vec<[u32; 3]>,
+}
+
+/// The most triangles a mesh may have: a scan of a pot at 0.1 mm is a
+/// few million; beyond this the cutting's memory is the limit.
+pub const MAX_TRIANGLES: usize = 8_000_000;
+
+impl TriMesh {
+    /// Reads STL (binary or ASCII) or OBJ, told apart by `name`'s
+    /// extension (`.stl`, `.obj`; any case). Errors name the file's
+    /// format and what is wrong.
+    pub fn read(name: &str, bytes: &[u8]) -> Result<TriMesh> {
+        let lower = name.to_ascii_lowercase();
+        let mesh = if lower.ends_with(".obj") {
+            read_obj(bytes)?
+        } else if lower.ends_with(".stl") {
+            read_stl(bytes)?
+        } else {
+            return Err(Error::invalid(
+                "mesh",
+                format!("`{name}`: not a mesh file this reads (STL or OBJ, by the extension)"),
+            ));
+        };
+        mesh.check()?;
+        Ok(mesh)
+    }
+
+    /// The lowest and highest corner of the mesh's bounding box.
+    pub fn bounds(&self) -> ([f64; 3], [f64; 3]) {
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        for v in &self.vertices {
+            for a in 0..3 {
+                lo[a] = lo[a].min(v[a]);
+                hi[a] = hi[a].max(v[a]);
+            }
+        }
+        (lo, hi)
+    }
+
+    /// Scales every vertex by `k` about the origin.
+    pub fn scale(&mut self, k: f64) {
+        for v in &mut self.vertices {
+            *v = v.map(|x| x * k);
+        }
+    }
+
+    /// Moves every vertex by `d`.
+    pub fn translate(&mut self, d: [f64; 3]) {
+        for v in &mut self.vertices {
+            *v = [v[0] + d[0], v[1] + d[1], v[2] + d[2]];
+        }
+    }
+
+    fn check(&self) -> Result<()> {
+        if self.triangles.is_empty() {
+            return Err(Error::invalid("mesh", "has no triangles"));
+        }
+        if self.triangles.len() > MAX_TRIANGLES {
+            return Err(Error::invalid(
+                "mesh",
+                format!(
+                    "has {} triangles, over the cap of {MAX_TRIANGLES}; decimate it (Blender's Decimate, MeshLab's Quadric Edge Collapse)",
+                    self.triangles.len()
+                ),
+            ));
+        }
+        if let Some(v) = self
+            .vertices
+            .iter()
+            .find(|v| v.iter().any(|x| !x.is_finite()))
+        {
+            return Err(Error::invalid(
+                "mesh",
+                format!("has a vertex that is not a number: {v:?}"),
+            ));
+        }
+        Ok(())
+    }
+}
+
+fn read_stl(bytes: &[u8]) -> Result<TriMesh> {
+    // A binary STL states its triangle count: refuse a huge one before
+    // the reader allocates for it.
+    if bytes.len() >= 84 && !bytes.starts_with(b"solid") {
+        let n = u32::from_le_bytes([bytes[80], bytes[81], bytes[82], bytes[83]]) as usize;
+        if n > MAX_TRIANGLES {
+            return Err(Error::invalid(
+                "mesh",
+                format!("states {n} triangles, over the cap of {MAX_TRIANGLES}"),
+            ));
+        }
+    }
+    let m = stl_io::read_stl(&mut std::io::Cursor::new(bytes))
+        .map_err(|e| Error::invalid("mesh", format!("not a readable STL: {e}")))?;
+    Ok(TriMesh {
+        vertices: m.vertices.iter().map(|v| v.0.map(f64::from)).collect(),
+        triangles: m
+            .faces
+            .iter()
+            .map(|f| f.vertices.map(|i| i as u32))
+            .collect(),
+    })
+}
+
+/// OBJ's `v` and `f` lines (faces of any size, fanned into triangles;
+/// `i/t/n` forms and negative indices); everything else is skipped.
+fn read_obj(bytes: &[u8]) -> Result<TriMesh> {
+    let text = std::str::from_utf8(bytes)
+        .map_err(|e| Error::invalid("mesh", format!("an OBJ file must be text: {e}")))?;
+    let mut m = TriMesh::default();
+    for (k, line) in text.lines().enumerate() {
+        let bad = |what: &str| Error::invalid("mesh", format!("OBJ line {}: {what}", k + 1));
+        let mut words = line.split_whitespace();
+        match words.next() {
+            Some("v") => {
+                let xyz: Vec<f64> = words
+                    .take(3)
+                    .map(str::parse)
+                    .collect::<std::result::Result<_, _>>()
+                    .map_err(|_| bad("a vertex needs three numbers"))?;
+                if xyz.len() < 3 {
+                    return Err(bad("a vertex needs three numbers"));
+                }
+                m.vertices.push([xyz[0], xyz[1], xyz[2]]);
+            }
+            Some("f") => {
+                let n = m.vertices.len() as i64;
+                let idx: Vec<u32> = words
+                    .map(|w| {
+                        let i: i64 = w
+                            .split('/')
+                            .next()
+                            .unwrap_or("")
+                            .parse()
+                            .map_err(|_| bad("a face's index is not a number"))?;
+                        let i = if i < 0 { n + i } else { i - 1 };
+                        if i < 0 || i >= n {
+                            return Err(bad("a face names a vertex not yet given"));
+                        }
+                        Ok(i as u32)
+                    })
+                    .collect::<Result<_>>()?;
+                if idx.len() < 3 {
+                    return Err(bad("a face needs three vertices"));
+                }
+                for j in 1..idx.len() - 1 {
+                    m.triangles.push([idx[0], idx[j], idx[j + 1]]);
+                }
+                if m.triangles.len() > MAX_TRIANGLES {
+                    return Err(bad(&format!("over the cap of {MAX_TRIANGLES} triangles")));
+                }
+            }
+            _ => {}
+        }
+    }
+    Ok(m)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn obj_faces_are_fanned_and_errors_name_the_line() {
+        let m = TriMesh::read(
+            "quad.OBJ",
+            b"# a square\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nf 1/1 2/2 3/3 -1\n",
+        )
+        .unwrap();
+        assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3]]);
+        let e = TriMesh::read("x.obj", b"v 0 0 0\nf 1 2 3\n").unwrap_err();
+        assert!(e.to_string().contains("OBJ line 2"), "{e}");
+        let e = TriMesh::read("x.ply", b"").unwrap_err();
+        assert!(e.to_string().contains("STL or OBJ"), "{e}");
+    }
+
+    #[test]
+    fn ascii_stl_shares_its_vertices() {
+        let stl = b"solid t\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 1 0 0\nvertex 0 1 0\nendloop\nendfacet\nfacet normal 0 0 1\nouter loop\nvertex 1 0 0\nvertex 1 1 0\nvertex 0 1 0\nendloop\nendfacet\nendsolid t\n";
+        let m = TriMesh::read("t.stl", stl).unwrap();
+        assert_eq!(m.vertices.len(), 4);
+        assert_eq!(m.triangles.len(), 2);
+    }
+}

@@ -1,0 +1,164 @@
+//! Meshes in (docs/MESHES.md): closed forms cut and fitted back to the
+//! sweep they are, the bundled vessels' own STL export round-tripped to a
+//! design within 0.3 mm, and the faults refused by name.
+
+mod common;
+
+use sweepclay_core::meshfit::{fit, FitOptions};
+use sweepclay_core::meshread::TriMesh;
+use sweepclay_core::{examples, Design};
+
+/// A closed solid whose section at height z is the loop `r(θ, z)` about
+/// the axis, `m` points round and `k` + 1 rings up `h` mm, capped top
+/// and bottom by fans.
+fn solid(r: impl Fn(f64, f64) -> f64, h: f64, m: usize, k: usize) -> TriMesh {
+    let mut vertices = Vec::new();
+    for i in 0..=k {
+        let z = h * i as f64 / k as f64;
+        for j in 0..m {
+            let a = std::f64::consts::TAU * j as f64 / m as f64;
+            let rr = r(a, z);
+            vertices.push([rr * a.cos(), rr * a.sin(), z]);
+        }
+    }
+    let (bottom, top) = (vertices.len() as u32, vertices.len() as u32 + 1);
+    vertices.push([0.0, 0.0, 0.0]);
+    vertices.push([0.0, 0.0, h]);
+    let id = |i: usize, j: usize| (i * m + j % m) as u32;
+    let mut triangles = Vec::new();
+    for i in 0..k {
+        for j in 0..m {
+            triangles.push([id(i, j), id(i, j + 1), id(i + 1, j + 1)]);
+            triangles.push([id(i, j), id(i + 1, j + 1), id(i + 1, j)]);
+        }
+    }
+    for j in 0..m {
+        triangles.push([bottom, id(0, j + 1), id(0, j)]);
+        triangles.push([top, id(k, j), id(k, j + 1)]);
+    }
+    TriMesh {
+        vertices,
+        triangles,
+    }
+}
+
+#[test]
+fn a_revolved_profile_comes_back_as_one_profile() {
+    let r = |_: f64, z: f64| 30.0 + 8.0 * (z / 20.0).sin();
+    let f = fit(&solid(r, 80.0, 240, 160), &FitOptions::default()).unwrap();
+    assert!(f.deviation_mm < 0.1, "{}", f.deviation_mm);
+    assert_eq!(f.kind, "solid");
+    assert!(f.design.profile_end.is_none());
+    assert!(f.design.trajectory.closed);
+}
+
+#[test]
+fn a_lofted_oval_comes_back_as_two_profiles_blended_round_it() {
+    // An oval whose long axis flares out with height and whose short
+    // axis leans in: r(θ, z) = base(θ) + (1 − λ(θ)) s(z) + λ(θ) t(z).
+    let r = |a: f64, z: f64| {
+        let base = 40.0 / (1.0 + 0.3 * a.sin().powi(2)).sqrt();
+        let l = a.sin().powi(2);
+        base + (1.0 - l) * (6.0 * z / 70.0) + l * (-4.0 * (z / 70.0).powi(2))
+    };
+    let f = fit(&solid(r, 70.0, 240, 140), &FitOptions::default()).unwrap();
+    assert!(f.deviation_mm < 0.3, "{}", f.deviation_mm);
+    assert!(f.design.profile_end.is_some() && f.design.interpolation.is_some());
+}
+
+#[test]
+fn a_twisted_square_is_refused_with_how_far_it_is_from_a_sweep() {
+    let r = |a: f64, z: f64| {
+        let t = a - 0.5 * z / 60.0;
+        30.0 / t.cos().abs().max(t.sin().abs())
+    };
+    let e = fit(&solid(r, 60.0, 240, 120), &FitOptions::default())
+        .unwrap_err()
+        .to_string();
+    assert!(
+        e.contains("is not a sweep of one loop within 0.3 mm"),
+        "{e}"
+    );
+    assert!(e.contains("differs from it by"), "{e}");
+}
+
+#[test]
+fn a_mesh_that_is_too_small_or_has_a_hole_is_refused_by_name() {
+    let r = |_: f64, _: f64| 30.0;
+    let mut m = solid(r, 80.0, 60, 40);
+    m.scale(1.0 / 25.4);
+    let e = fit(&m, &FitOptions::default()).unwrap_err().to_string();
+    assert!(e.contains("3.15 mm tall") && e.contains("--scale"), "{e}");
+    let mut m = solid(r, 80.0, 60, 40);
+    m.triangles.remove(60 * 20);
+    let e = fit(&m, &FitOptions::default()).unwrap_err().to_string();
+    assert!(e.contains("has a hole"), "{e}");
+}
+
+#[test]
+fn the_bundled_vessels_come_back_from_their_own_stl() {
+    // Each vessel's STL export (its surface thickened to the bead width,
+    // standing on its floor: a shell) is read, cut and fitted. A level
+    // rim comes back as a design within 0.3 mm of the mesh's wall, whose
+    // G-code prints and is the original's size; an uneven rim, a texture
+    // the corrections kept only in places, and a twist are refused by
+    // name with the reason.
+    let back = ["vase", "cup", "fluted-cup"];
+    let uneven = ["flower", "slanted-vase", "pitcher"];
+    let not_a_sweep = ["ripple-vase", "diamond-vase", "twisted-lobes"];
+    for name in back.iter().chain(&uneven).chain(&not_a_sweep) {
+        let d = Design::from_json(examples::example(name).unwrap()).unwrap();
+        let s = sweepclay_core::slice(&d).unwrap();
+        let mut bytes = Vec::new();
+        sweepclay_core::mesh::write_stl(&s, &mut bytes).unwrap();
+        let mesh = TriMesh::read("pot.stl", &bytes).unwrap();
+        let got = fit(&mesh, &FitOptions::default());
+        if back.contains(name) {
+            let f = got.unwrap_or_else(|e| panic!("{name}: {e}"));
+            assert!(f.deviation_mm <= 0.3, "{name}: {}", f.deviation_mm);
+            assert_eq!(f.kind, "shell", "{name}");
+            let mut again = f.design;
+            again.printer = d.printer.clone();
+            again.params = d.params.clone();
+            let t = sweepclay_core::slice(&again).unwrap_or_else(|e| panic!("{name}: {e}"));
+            let r = common::check_full(&t);
+            assert!(r.printable, "{name}: {}", r.render());
+            for a in 0..3 {
+                let (x, y) = (s.stats.size_mm[a], t.stats.size_mm[a]);
+                assert!(
+                    (x - y).abs() < 0.3,
+                    "{name}: size {:?} against {:?}",
+                    t.stats.size_mm,
+                    s.stats.size_mm
+                );
+            }
+        } else {
+            let e = got.map(|f| f.deviation_mm).unwrap_err().to_string();
+            let why = if uneven.contains(name) {
+                "has an uneven rim"
+            } else {
+                "is not a sweep of one loop"
+            };
+            assert!(e.contains(why), "{name}: {e}");
+        }
+    }
+}
+
+#[test]
+fn a_mesh_a_few_units_tall_is_taken_as_inches_and_said_so() {
+    use sweepclay_core::meshfit::units;
+    let mut m = solid(|_, _| 30.0, 80.0, 60, 40);
+    assert_eq!(units(&m, None).unwrap(), (1.0, None));
+    m.scale(1.0 / 25.4);
+    let (k, note) = units(&m, None).unwrap();
+    assert_eq!(k, 25.4);
+    assert!(note.unwrap().contains("taken as inches"));
+    assert_eq!(units(&m, Some(1.0)).unwrap(), (1.0, None));
+    assert!(units(&m, Some(-2.0))
+        .unwrap_err()
+        .to_string()
+        .starts_with("scale:"));
+    m.scale(25.4);
+    let f = fit(&m, &FitOptions::default()).unwrap();
+    assert!(f.deviation_mm < 0.05, "{}", f.deviation_mm);
+}
