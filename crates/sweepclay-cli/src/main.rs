@@ -139,6 +139,10 @@ struct SliceArgs {
     /// which is said].
     #[arg(long)]
     scale: Option<f64>,
+    /// A mesh's axis that points up (x, y or z): a Y-up export (Blender's
+    /// glTF habit, many CAD tools) stands on its side otherwise.
+    #[arg(long, default_value = "z", value_parser = ["x", "y", "z"])]
+    up: String,
     /// Also write the surface the G-code prints as STL (its beads'
     /// width), e.g. to compare with a mesh.
     #[arg(long, value_name = "FILE.stl")]
@@ -185,6 +189,9 @@ struct ImportArgs {
     /// The largest difference from the mesh the design may have (mm).
     #[arg(long, default_value_t = 0.3)]
     tolerance: f64,
+    /// The mesh's axis that points up (x, y or z).
+    #[arg(long, default_value = "z", value_parser = ["x", "y", "z"])]
+    up: String,
     /// Printer preset or printer JSON file for the design.
     #[arg(long)]
     printer: Option<String>,
@@ -401,12 +408,17 @@ const MAX_MESH_BYTES: usize = 84 + 50 * sweepclay_core::meshread::MAX_TRIANGLES;
 
 /// Reads a mesh file and fits it by a design (named after the file),
 /// saying what was assumed and how close the fit is.
-fn mesh_design(path: &Path, scale: Option<f64>, tolerance: f64) -> Result<Design> {
+fn mesh_design(path: &Path, scale: Option<f64>, tolerance: f64, up: &str) -> Result<Design> {
     use sweepclay_core::meshfit;
     let shown = path.display().to_string();
     let bytes = read_capped(path, MAX_MESH_BYTES).map_err(|e| anyhow::anyhow!("{shown}: {e}"))?;
     let mut mesh =
         sweepclay_core::meshread::TriMesh::read(&shown, &bytes).with_context(|| shown.clone())?;
+    mesh.stand_up(match up {
+        "x" => 0,
+        "y" => 1,
+        _ => 2,
+    });
     let (k, note) = meshfit::units(&mesh, scale).with_context(|| shown.clone())?;
     mesh.scale(k);
     if let Some(n) = note {
@@ -447,7 +459,7 @@ fn import_cmd(a: ImportArgs) -> Result<i32> {
             a.tolerance
         );
     }
-    let mut design = mesh_design(&a.mesh, a.scale, a.tolerance)?;
+    let mut design = mesh_design(&a.mesh, a.scale, a.tolerance, &a.up)?;
     if let Some(p) = &a.printer {
         design.printer = PrinterRef::Inline(Box::new(load_printer(p)?));
     }
@@ -469,11 +481,11 @@ fn import_cmd(a: ImportArgs) -> Result<i32> {
 
 fn slice(a: SliceArgs) -> Result<i32> {
     if is_mesh(&a.design) {
-        let design = mesh_design(Path::new(&a.design), a.scale, 0.3)?;
+        let design = mesh_design(Path::new(&a.design), a.scale, 0.3, &a.up)?;
         return slice_design(a, design.to_json(), String::new());
     }
-    if a.scale.is_some() {
-        bail!("--scale: only a mesh (.stl, .obj) is scaled; a design's sizes are millimetres");
+    if a.scale.is_some() || a.up != "z" {
+        bail!("--scale, --up: only a mesh (.stl, .obj) is scaled or turned; a design's sizes are millimetres, z up");
     }
     let (text, source) = match std::fs::read_to_string(&a.design) {
         Ok(t) => (t, a.design.clone()),

@@ -995,7 +995,7 @@ fn a_vessel_mesh_slices_and_imports_as_a_design() {
         .args(["slice", "cup", "--scale", "2"])
         .assert()
         .failure()
-        .stderr(predicate::str::contains("--scale: only a mesh"));
+        .stderr(predicate::str::contains("--scale, --up: only a mesh"));
     std::fs::write(dir.join("broken.stl"), b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 10 0 0\nvertex 0 10 20\nendloop\nendfacet\nendsolid x\n").unwrap();
     sweepclay(dir)
         .args(["slice", "broken.stl"])

@@ -98,15 +98,12 @@ pub fn fit(mesh: &TriMesh, opts: &FitOptions) -> Result<Fitted> {
     if !(5.0..=2000.0).contains(&height) {
         return Err(Error::invalid(
             "mesh",
-            format!("is {height:.2} mm tall: a vessel is 5 to 2000 mm; give --scale (millimetres are assumed)"),
+            format!("is {height:.2} mm tall: a vessel is 5 to 2000 mm; give --scale (millimetres are assumed: --scale 1000 for metres, 10 for centimetres, 25.4 for inches)"),
         ));
     }
     let n = ((height / 0.5) as usize).clamp(20, MAX_SECTIONS);
     let dz = height / n as f64;
-    let mut cut = sections::cut(mesh, lo[2] + 0.5 * dz, dz, n)?;
-    for s in &mut cut {
-        s.z -= lo[2];
-    }
+    let mut cut = sections::cut(mesh, lo[2] + 0.5 * dz, dz, n, lo[2])?;
     // A rim that is not quite level (a helix's last turn, a rim's
     // rounding) leaves sections near the top that do not go round: the
     // rim is where the last whole section is, if that is within 3 mm of
@@ -132,8 +129,13 @@ pub fn fit(mesh: &TriMesh, opts: &FitOptions) -> Result<Fitted> {
             return Err(Error::invalid(
                 "mesh",
                 format!(
-                    "has an uneven rim: from z = {z:.1} mm up ({:.1} mm below its top) the wall does not go all the way round; a slanted or raised rim is not fitted yet (cut the mesh level there, or draw the rim with the design's `rim` key)",
-                    height - z
+                    "has an uneven rim: from z = {z:.1} mm up ({:.1} mm below its top) the wall does not go all the way round; a slanted or raised rim is not fitted yet (cut the mesh level there, or draw the rim with the design's `rim` key){}",
+                    height - z,
+                    if hi[0] - lo[0] > height || hi[1] - lo[1] > height {
+                        "; or it lies on its side: --up y (or x) stands it up"
+                    } else {
+                        ""
+                    }
                 ),
             ));
         }
@@ -188,9 +190,9 @@ pub fn fit(mesh: &TriMesh, opts: &FitOptions) -> Result<Fitted> {
         .collect();
     let zs: Vec<f64> = cut.iter().map(|s| s.z).collect();
     let mut best: Option<Candidate> = None;
-    let mut why = String::new();
+    let mut why = Vec::new();
     for offset in [Offset::Radial, Offset::Normal] {
-        match offsets(&psi, &loops, offset, shell) {
+        match offsets(&psi, &zs, &loops, offset, shell) {
             Ok((mut d, dirs)) => {
                 // Only a profile's change from its foot counts (docs/
                 // FORMATS.md): Ψ is the wall at the lowest section (a
@@ -215,11 +217,15 @@ pub fn fit(mesh: &TriMesh, opts: &FitOptions) -> Result<Fitted> {
                     best = Some(cand);
                 }
             }
-            Err(e) => why = e,
+            Err(e) => why.push(e),
         }
     }
     let Some(b) = best else {
-        return Err(Error::invalid("mesh", why));
+        // Neither frame finds one wall a ray: the radial reason says where.
+        return Err(Error::invalid(
+            "mesh",
+            format!("is not a sweep of its foot's loop: {}", why[0]),
+        ));
     };
     if b.deviation > opts.tolerance_mm {
         return Err(Error::invalid(
@@ -381,10 +387,13 @@ fn hits(l: &[[f64; 2]], o: [f64; 2], d: [f64; 2]) -> Vec<f64> {
         let w = [p[0] - o[0], p[1] - o[1]];
         let t = (w[0] * e[1] - w[1] * e[0]) / den;
         let s = (w[0] * d[1] - w[1] * d[0]) / den;
-        if (0.0..1.0).contains(&s) {
+        if (-1e-9..1.0 + 1e-9).contains(&s) {
             ts.push(t);
         }
     }
+    // A ray through a vertex crosses both its edges at one place.
+    ts.sort_by(f64::total_cmp);
+    ts.dedup_by(|a, b| (*a - *b).abs() < 1e-6);
     ts
 }
 
@@ -398,6 +407,7 @@ type Offsets = (Vec<Vec<f64>>, Vec<[f64; 2]>);
 /// wall there folds back across the ray.
 fn offsets(
     psi: &[[f64; 2]],
+    zs: &[f64],
     loops: &[Vec<Vec<[f64; 2]>>],
     offset: Offset,
     shell: bool,
@@ -438,9 +448,11 @@ fn offsets(
                         let ahead: Vec<f64> = ts.into_iter().filter(|&t| t > 0.0).collect();
                         if ahead.len() != 1 {
                             return Err(format!(
-                                "the section {k} ({} crossings of a ray from its centre) is not one wall round its centre: a ray from the centre meets it {} times",
+                                "its wall at z = {:.1} mm does not go once round its foot's centre (a ray from the centre meets it {} times, near ({:.1}, {:.1}) mm)",
+                                zs[k],
                                 ahead.len(),
-                                ahead.len()
+                                dir[0] * base,
+                                dir[1] * base
                             ));
                         }
                         ahead[0]
@@ -451,7 +463,10 @@ fn offsets(
                     {
                         Some(t) => t,
                         None => {
-                            return Err(format!("the section {k} has no wall across Ψ's normal"))
+                            return Err(format!(
+                                "its wall at z = {:.1} mm is not across the foot's wall near ({:.1}, {:.1}) mm (it leans out beyond where the foot reaches)",
+                                zs[k], o[0], o[1]
+                            ))
                         }
                     },
                 };

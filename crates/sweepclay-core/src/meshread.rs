@@ -34,8 +34,28 @@ impl TriMesh {
                 format!("`{name}`: not a mesh file this reads (STL or OBJ, by the extension)"),
             ));
         };
+        let mut mesh = mesh;
         mesh.check()?;
+        mesh.repair();
         Ok(mesh)
+    }
+
+    /// The standard repairs that change no surface: triangles with a
+    /// repeated vertex (no area, they join nothing) and second copies of
+    /// a triangle (exporters write some twice) are dropped. Returns how
+    /// many were.
+    pub fn repair(&mut self) -> usize {
+        let before = self.triangles.len();
+        let mut seen = rustc_hash::FxHashSet::default();
+        self.triangles.retain(|t| {
+            if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
+                return false;
+            }
+            let mut k = *t;
+            k.sort_unstable();
+            seen.insert(k)
+        });
+        before - self.triangles.len()
     }
 
     /// The lowest and highest corner of the mesh's bounding box.
@@ -55,6 +75,19 @@ impl TriMesh {
     pub fn scale(&mut self, k: f64) {
         for v in &mut self.vertices {
             *v = v.map(|x| x * k);
+        }
+    }
+
+    /// Turns the mesh so that its axis `up` (0 x, 1 y, 2 z) points up,
+    /// a quarter turn about another axis (a Y-up export stands on its
+    /// side otherwise).
+    pub fn stand_up(&mut self, up: usize) {
+        for v in &mut self.vertices {
+            *v = match up {
+                0 => [v[1], v[2], v[0]],
+                1 => [v[0], -v[2], v[1]],
+                _ => *v,
+            };
         }
     }
 

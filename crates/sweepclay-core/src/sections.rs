@@ -27,8 +27,10 @@ struct Seg {
 }
 
 /// Cuts `mesh` at `n` heights `z0`, `z0 + dz`, …. A vertex exactly at a
-/// height counts as above it, so no crossing falls on a vertex.
-pub fn cut(mesh: &TriMesh, z0: f64, dz: f64, n: usize) -> Result<Vec<Section>> {
+/// height counts as above it, so no crossing falls on a vertex. Errors
+/// and sections give heights above `bed` (the mesh's lowest point, for
+/// the user; 0 keeps the mesh's own).
+pub fn cut(mesh: &TriMesh, z0: f64, dz: f64, n: usize, bed: f64) -> Result<Vec<Section>> {
     let mut buckets: Vec<Vec<Seg>> = vec![Vec::new(); n];
     let v = &mesh.vertices;
     for t in &mesh.triangles {
@@ -65,7 +67,7 @@ pub fn cut(mesh: &TriMesh, z0: f64, dz: f64, n: usize) -> Result<Vec<Section>> {
         .into_iter()
         .enumerate()
         .map(|(k, segs)| {
-            let z = z0 + k as f64 * dz;
+            let z = z0 + k as f64 * dz - bed;
             Ok(Section {
                 z,
                 loops: chain(&segs, z)?,
@@ -176,7 +178,7 @@ mod tests {
 
     #[test]
     fn a_box_cuts_into_one_square_a_height() {
-        let s = cut(&cube(10.0, 20.0), 0.5, 1.0, 19).unwrap();
+        let s = cut(&cube(10.0, 20.0), 0.5, 1.0, 19, 0.0).unwrap();
         assert_eq!(s.len(), 19);
         for sec in &s {
             assert_eq!(sec.loops.len(), 1, "at {}", sec.z);
@@ -184,7 +186,7 @@ mod tests {
         }
         // The top face's height counts as above: a cut there meets the
         // side faces' top edges only and still closes.
-        let top = cut(&cube(10.0, 20.0), 20.0, 1.0, 1).unwrap();
+        let top = cut(&cube(10.0, 20.0), 20.0, 1.0, 1, 0.0).unwrap();
         assert!(top[0].loops.len() <= 1);
     }
 
@@ -192,7 +194,7 @@ mod tests {
     fn a_hole_is_named_by_its_height() {
         let mut m = cube(10.0, 20.0);
         m.triangles.remove(4);
-        let e = cut(&m, 0.5, 1.0, 19).unwrap_err().to_string();
+        let e = cut(&m, 0.5, 1.0, 19, 0.0).unwrap_err().to_string();
         assert!(e.contains("has a hole") && e.contains("z = 0.50 mm"), "{e}");
     }
 }
