@@ -212,7 +212,7 @@ pub fn fit(mesh: &TriMesh, opts: &FitOptions) -> Result<Fitted> {
                         *x -= b;
                     }
                 }
-                let cand = fit_offsets(&psi, &zs, &d, offset, height);
+                let cand = fit_offsets(&psi, &zs, &d, offset, height, opts.tolerance_mm);
                 if best.as_ref().is_none_or(|b| cand.deviation < b.deviation) {
                     best = Some(cand);
                 }
@@ -514,6 +514,7 @@ fn fit_offsets(
     d: &[Vec<f64>],
     offset: Offset,
     height: f64,
+    tol: f64,
 ) -> Candidate {
     let (kk, jj) = (d.len(), psi.len());
     let mean: Vec<f64> = d
@@ -558,11 +559,20 @@ fn fit_offsets(
         .collect();
     let s: Vec<f64> = (0..kk).map(|k| mean[k] + a[k] * bmin).collect();
     let t: Vec<f64> = (0..kk).map(|k| s[k] + a[k] * spread).collect();
-    let one = candidate(&psi, zs, &d, offset, height, &mean, None);
-    if one.deviation <= 0.02 {
+    // One profile is the simpler design to edit: kept when it is within
+    // the tolerance.
+    let g = Frame {
+        psi: &psi,
+        zs,
+        offset,
+        height,
+        tol,
+    };
+    let one = candidate(&g, &d, &mean, None);
+    if one.deviation <= tol {
         return one;
     }
-    let two = candidate(&psi, zs, &d, offset, height, &s, Some((&t, &lambda)));
+    let two = candidate(&g, &d, &s, Some((&t, &lambda)));
     if two.deviation < one.deviation {
         two
     } else {
@@ -570,25 +580,49 @@ fn fit_offsets(
     }
 }
 
+/// What every candidate of one fit shares: Ψ, the sections' heights,
+/// the frame of the offsets, the height and the tolerance.
+#[derive(Clone, Copy)]
+struct Frame<'a> {
+    psi: &'a [[f64; 2]],
+    zs: &'a [f64],
+    offset: Offset,
+    height: f64,
+    tol: f64,
+}
+
 /// The design of profile values `s` (and `t` blended by `lambda`) at the
 /// sections' heights, as B-splines through them, and its largest
 /// difference from `d`.
-fn candidate(
-    psi: &[[f64; 2]],
-    zs: &[f64],
-    d: &[Vec<f64>],
-    offset: Offset,
-    height: f64,
-    s: &[f64],
-    two: Option<(&[f64], &[f64])>,
-) -> Candidate {
+fn candidate(g: &Frame, d: &[Vec<f64>], s: &[f64], two: Option<(&[f64], &[f64])>) -> Candidate {
+    let Frame {
+        psi,
+        zs,
+        offset,
+        height,
+        tol,
+    } = *g;
     let profile = |v: &[f64]| -> Vec<[f64; 2]> {
         // From the bed to the rim: the lowest and highest sections'
         // values held to z 0 and the top.
         let mut pts: Vec<[f64; 2]> = vec![[v[0], 0.0]];
         pts.extend(v.iter().zip(zs).map(|(&x, &z)| [x, z]));
         pts.push([v[v.len() - 1], height]);
-        through(&thin(&pts, MAX_CURVE_POINTS))
+        // As few points as keep the curve within a third of the
+        // tolerance of the values: a profile a potter can still edit.
+        let mut curve = Vec::new();
+        for k in [6, 8, 12, 16, 24, 32, 48, 64, 96, 128, MAX_CURVE_POINTS] {
+            curve = through(&thin(&pts, k));
+            let line = dense(&curve);
+            let off = pts
+                .iter()
+                .map(|p| (at_z(&line, p[1]) - p[0]).abs())
+                .fold(0.0, f64::max);
+            if off <= tol / 3.0 || k >= pts.len() {
+                break;
+            }
+        }
+        curve
     };
     let start = profile(s);
     let (end, interp) = match two {

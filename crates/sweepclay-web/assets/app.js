@@ -1371,6 +1371,12 @@ $('save').addEventListener('click', () => {
 });
 $('open').addEventListener('click', () => $('open-file').click());
 $('open-file').addEventListener('change', async () => {
+  const file = $('open-file').files[0];
+  if (file && /\.(stl|obj)$/i.test(file.name)) {
+    $('open-file').value = '';
+    openMesh(file);
+    return;
+  }
   const { name, text } = await readFile($('open-file'));
   let d;
   try {
@@ -1385,6 +1391,33 @@ $('open-file').addEventListener('change', async () => {
   }
   setDesign(d, { fit: true });
 });
+/**
+ * A vessel mesh: the server cuts it into sections and fits it by a
+ * design (docs/MESHES.md), which opens as any design does; the note
+ * says how close the fit is, or the error why there is none.
+ */
+async function openMesh(file) {
+  showNote(`${file.name}: cutting and fitting the mesh…`);
+  let r;
+  try {
+    r = await fetch(`/api/mesh?name=${encodeURIComponent(file.name)}`, {
+      method: 'POST', headers: { 'content-type': 'application/octet-stream' }, body: await file.arrayBuffer(),
+    });
+  } catch (e) {
+    showError(`${file.name}: the server could not be reached (${e.message})`);
+    return;
+  }
+  const body = await r.json();
+  if (!r.ok) {
+    $('status').querySelector('.note')?.remove();
+    showError(`${file.name}: ${body.error}`);
+    return;
+  }
+  setDesign(body.design, { fit: true });
+  const kind = body.kind === 'shell' ? 'a wall with its thickness, fitted at its middle' : 'a solid, fitted at its outside';
+  showNote(`${file.name}: ${body.triangles} triangles (${kind}), now an editable design within ${body.deviation_mm.toFixed(2)} mm of the mesh${body.note ? `; ${body.note}` : ''}`);
+}
+
 $('import').addEventListener('click', () => $('import-file').click());
 $('import-file').addEventListener('change', async () => {
   const { name, text } = await readFile($('import-file'));

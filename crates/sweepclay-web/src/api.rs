@@ -554,6 +554,50 @@ pub fn gcode(job: &Job, cancel: &Cancel) -> Result<String, ApiError> {
     }
 }
 
+/// A vessel mesh fitted by a design (docs/MESHES.md): the design, how
+/// close it is and what was assumed.
+#[derive(Clone, Debug, Serialize)]
+pub struct MeshImport {
+    /// The design the page opens.
+    pub design: serde_json::Value,
+    /// The largest difference from the mesh's sections (mm).
+    pub deviation_mm: f64,
+    /// Where it lies (mm, the design's frame).
+    pub at: [f64; 3],
+    /// `solid` (fitted at its outside) or `shell` (at its wall's middle).
+    pub kind: &'static str,
+    /// Triangles read.
+    pub triangles: usize,
+    /// What was assumed about its units, if anything.
+    pub note: Option<String>,
+}
+
+/// Reads a mesh (`name` gives its format by the extension), stands it
+/// up (`up`: 0 x, 1 y, 2 z), takes its units, and fits it by a design.
+pub fn import_mesh(name: &str, bytes: &[u8], up: usize) -> Result<MeshImport, ApiError> {
+    use sweepclay_core::meshfit;
+    let mut mesh = sweepclay_core::meshread::TriMesh::read(name, bytes)?;
+    mesh.stand_up(up);
+    let (k, note) = meshfit::units(&mesh, None)?;
+    mesh.scale(k);
+    let stem = name.rsplit_once('.').map_or(name, |(s, _)| s).to_string();
+    let opts = meshfit::FitOptions {
+        name: stem,
+        ..meshfit::FitOptions::default()
+    };
+    let f = meshfit::fit(&mesh, &opts)?;
+    let design = serde_json::from_str(&f.design.to_json())
+        .map_err(|e| ApiError::new(500, format!("the fitted design: {e}")))?;
+    Ok(MeshImport {
+        design,
+        deviation_mm: f.deviation_mm,
+        at: f.at,
+        kind: f.kind,
+        triangles: mesh.triangles.len(),
+        note,
+    })
+}
+
 /// A binary STL of the planned surface (the one the G-code prints)
 /// thickened to the bead width.
 pub fn stl(job: &Job, cancel: &Cancel) -> Result<Vec<u8>, ApiError> {

@@ -46,6 +46,9 @@ use sweepclay_core::{examples, Params, Printer};
 
 /// Largest design or imported file accepted (bytes).
 pub const DESIGN_BODY_LIMIT: usize = 4 << 20;
+/// Largest mesh `/api/mesh` accepts (bytes): a binary STL of two
+/// million triangles.
+pub const MESH_BODY_LIMIT: usize = 100 << 20;
 /// Largest G-code file `/api/check` accepts (bytes).
 pub const GCODE_BODY_LIMIT: usize = 64 << 20;
 
@@ -131,12 +134,15 @@ pub fn router(limits: Limits) -> Router {
     let check_route = Router::new()
         .route("/api/check", post(check))
         .layer(DefaultBodyLimit::max(GCODE_BODY_LIMIT));
+    let mesh_route = Router::new()
+        .route("/api/mesh", post(mesh))
+        .layer(DefaultBodyLimit::max(MESH_BODY_LIMIT));
     let who = Arc::new(guard::Admission::of(&limits));
     let guard = axum::middleware::from_fn(move |req: axum::extract::Request, next| {
-        let body_limit = if req.uri().path() == "/api/check" {
-            GCODE_BODY_LIMIT
-        } else {
-            DESIGN_BODY_LIMIT
+        let body_limit = match req.uri().path() {
+            "/api/check" => GCODE_BODY_LIMIT,
+            "/api/mesh" => MESH_BODY_LIMIT,
+            _ => DESIGN_BODY_LIMIT,
         };
         guard::same_origin(who.clone(), body_limit, req, next)
     });
@@ -150,6 +156,7 @@ pub fn router(limits: Limits) -> Router {
         .route("/api/meta", get(meta))
         .merge(design_routes)
         .merge(check_route)
+        .merge(mesh_route)
         .fallback(|| async { ApiError::new(404, "no such page or API route") })
         .method_not_allowed_fallback(|| async {
             ApiError::new(405, "this route does not take that method")
@@ -359,6 +366,39 @@ async fn import(
     state
         .pool
         .run(move |_| api::import(&format, &text))
+        .await
+        .map(Json)
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct MeshQuery {
+    /// The file's name: its extension says STL or OBJ.
+    name: String,
+    /// The axis that points up: x, y or z (default).
+    up: Option<String>,
+}
+
+async fn mesh(
+    State(state): State<Shared>,
+    query: Result<Query<MeshQuery>, axum::extract::rejection::QueryRejection>,
+    body: Result<Bytes, BytesRejection>,
+) -> Result<Json<api::MeshImport>, ApiError> {
+    let Query(q) = query.map_err(|e| ApiError::new(400, e.body_text()))?;
+    let up = match q.up.as_deref() {
+        None | Some("z") => 2,
+        Some("y") => 1,
+        Some("x") => 0,
+        Some(other) => {
+            return Err(
+                ApiError::new(400, format!("up: `{other}` is not x, y or z")).with_key("up"),
+            )
+        }
+    };
+    let bytes = bytes(body)?;
+    state
+        .pool
+        .run(move |_| api::import_mesh(&q.name, &bytes, up))
         .await
         .map(Json)
 }

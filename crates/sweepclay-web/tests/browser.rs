@@ -2125,3 +2125,61 @@ async fn the_page_previews_the_path_it_downloads_point_for_point() {
     assert_eq!(js(&c, "return window.sweepclayErrors").await, json!([]));
     c.close().await.unwrap();
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_mesh_opens_as_an_editable_design_and_downloads_its_gcode() {
+    // The cup's own STL, as a potter would bring a pot from elsewhere.
+    let Some(Session {
+        tmp,
+        downloads,
+        driver: _driver,
+        c,
+        base,
+    }) = Session::start().await
+    else {
+        return;
+    };
+    let cup = sweepclay_core::Design::from_json(sweepclay_core::examples::example("cup").unwrap())
+        .unwrap();
+    let mut stl = Vec::new();
+    sweepclay_core::mesh::write_stl(&sweepclay_core::slice(&cup).unwrap(), &mut stl).unwrap();
+    let file = tmp.path().join("old-cup.stl");
+    std::fs::write(&file, &stl).unwrap();
+    c.goto(&base).await.unwrap();
+    close_guide(&c).await;
+    choose_file(&c, "open-file", &file).await;
+    let note = wait_js(
+        &c,
+        &format!(
+            "return {IDLE} && window.sweepclay.design.name === 'old-cup' && {} && document.querySelector('#status .note')?.textContent || null",
+            &PRINTABLE[7..]
+        ),
+        "the mesh opened as a printable design",
+    )
+    .await;
+    let note = note.as_str().unwrap().to_string();
+    assert!(
+        note.contains("now an editable design within")
+            && note.contains("a wall with its thickness"),
+        "{note}"
+    );
+    if let Ok(path) = std::env::var("SWEEPCLAY_MESH_SCREENSHOT") {
+        std::fs::write(&path, c.screenshot().await.unwrap()).unwrap();
+    }
+    // Editable: its profile is a curve the editors hold.
+    assert_eq!(
+        js(&c, "return window.sweepclay.design.trajectory.closed").await,
+        json!(true)
+    );
+    let (text, _) =
+        download_printable(&c, &downloads, "no G-code of the mesh was downloaded").await;
+    assert!(text.contains("; design: old-cup"), "{}", &text[..300]);
+    // A mesh with a hole is refused by name.
+    let broken = tmp.path().join("broken.stl");
+    std::fs::write(&broken, b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 10 0 0\nvertex 0 10 20\nendloop\nendfacet\nendsolid x\n").unwrap();
+    choose_file(&c, "open-file", &broken).await;
+    let said = error_text(&c, "the broken mesh refused").await;
+    assert!(said.as_str().unwrap().contains("has a hole"), "{said}");
+    assert_eq!(js(&c, "return window.sweepclayErrors").await, json!([]));
+    c.close().await.unwrap();
+}
