@@ -40,12 +40,32 @@ impl TriMesh {
         Ok(mesh)
     }
 
-    /// The standard repairs that change no surface: triangles with a
-    /// repeated vertex (no area, they join nothing) and second copies of
-    /// a triangle (exporters write some twice) are dropped. Returns how
-    /// many were.
+    /// The standard repairs that change no surface: vertices less than
+    /// a micrometre apart are merged (a seam written with two roundings
+    /// of one point, which leaves a crack no section can close: Blender's
+    /// "Merge by Distance"), then triangles with a repeated vertex (no
+    /// area, they join nothing) and second copies of a triangle
+    /// (exporters write some twice) are dropped. Returns how many
+    /// triangles were.
     pub fn repair(&mut self) -> usize {
         let before = self.triangles.len();
+        let mut index: rustc_hash::FxHashMap<[i64; 3], u32> = rustc_hash::FxHashMap::default();
+        let mut merged = Vec::with_capacity(self.vertices.len());
+        let remap: Vec<u32> = self
+            .vertices
+            .iter()
+            .map(|v| {
+                let key = v.map(|x| (x * 1e3).round() as i64);
+                *index.entry(key).or_insert_with(|| {
+                    merged.push(*v);
+                    merged.len() as u32 - 1
+                })
+            })
+            .collect();
+        self.vertices = merged;
+        for t in &mut self.triangles {
+            *t = t.map(|i| remap[i as usize]);
+        }
         let mut seen = rustc_hash::FxHashSet::default();
         self.triangles.retain(|t| {
             if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
