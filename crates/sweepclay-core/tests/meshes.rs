@@ -98,15 +98,21 @@ fn a_mesh_that_is_too_small_or_has_a_hole_is_refused_by_name() {
 #[test]
 fn the_bundled_vessels_come_back_from_their_own_stl() {
     // Each vessel's STL export (its surface thickened to the bead width,
-    // standing on its floor: a shell) is read, cut and fitted. A level
-    // rim comes back as a design within 0.3 mm of the mesh's wall, whose
-    // G-code prints and is the original's size; an uneven rim, a texture
+    // standing on its floor: a shell) is read, cut and fitted. A level or
+    // uneven rim comes back as a design within 0.3 mm of the mesh's wall
+    // (below its 3 mm lip), whose G-code prints and is the original's
+    // size within 0.6 mm (its beads' extents); a slanted cut whose raised
+    // part is printed in partial layers (its rim 0.45 mm off), a texture
     // the corrections kept only in places, and a twist are refused by
-    // name with the reason.
-    let back = ["vase", "cup", "fluted-cup"];
-    let uneven = ["flower", "slanted-vase", "pitcher"];
-    let not_a_sweep = ["ripple-vase", "diamond-vase", "twisted-lobes"];
-    for name in back.iter().chain(&uneven).chain(&not_a_sweep) {
+    // name with how far they are.
+    let back = ["vase", "cup", "fluted-cup", "flower", "pitcher"];
+    let not_a_sweep = [
+        "slanted-vase",
+        "ripple-vase",
+        "diamond-vase",
+        "twisted-lobes",
+    ];
+    for name in back.iter().chain(&not_a_sweep) {
         let d = Design::from_json(examples::example(name).unwrap()).unwrap();
         let s = sweepclay_core::slice(&d).unwrap();
         let mut bytes = Vec::new();
@@ -126,7 +132,7 @@ fn the_bundled_vessels_come_back_from_their_own_stl() {
             for a in 0..3 {
                 let (x, y) = (s.stats.size_mm[a], t.stats.size_mm[a]);
                 assert!(
-                    (x - y).abs() < 0.3,
+                    (x - y).abs() < 0.6,
                     "{name}: size {:?} against {:?}",
                     t.stats.size_mm,
                     s.stats.size_mm
@@ -134,12 +140,7 @@ fn the_bundled_vessels_come_back_from_their_own_stl() {
             }
         } else {
             let e = got.map(|f| f.deviation_mm).unwrap_err().to_string();
-            let why = if uneven.contains(name) {
-                "has an uneven rim"
-            } else {
-                "is not a sweep of one loop"
-            };
-            assert!(e.contains(why), "{name}: {e}");
+            assert!(e.contains("is not a sweep of one loop"), "{name}: {e}");
         }
     }
 }
