@@ -606,6 +606,7 @@ fn slice_design(a: SliceArgs, text: String, source: String) -> Result<i32> {
         report,
         locations,
         point_lines,
+        most_twist: _,
     } = checked;
     drop((written, point_lines));
     let reshaped = sliced.corrected.reshaped();

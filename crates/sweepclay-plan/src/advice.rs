@@ -66,6 +66,12 @@ impl<W> Checked<W> {
                 };
                 Some(format!("{change} — at {place}"))
             })
+            .chain(self.most_twist.map(|most| {
+                let t = s.corrected.surface.columns.first().map_or(0.0, |c| c.twist.to_degrees());
+                format!(
+                    "the twist ({t:.0}°) turns the wall across the clay below faster than it holds here: at most {most:.0}° of twist prints this shape (twist_deg)"
+                )
+            }))
             .collect()
     }
 }

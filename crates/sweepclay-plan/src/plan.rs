@@ -30,6 +30,11 @@ pub struct Checked<W> {
     pub locations: Vec<String>,
     /// The G-code line of each path point.
     pub point_lines: Vec<usize>,
+    /// For a twisted design that does not print: the largest twist of the
+    /// same sense that does (degrees; 0 when only the untwisted one
+    /// does), found by bisection. `None` when it prints, has no twist, or
+    /// does not print untwisted either (the twist is not the cause).
+    pub most_twist: Option<f64>,
 }
 
 /// Why a slicing whose check fails cannot be corrected: the error
@@ -101,8 +106,44 @@ pub fn plan<W: Write>(
     cancel: &Cancel,
     out: impl FnMut() -> io::Result<W>,
 ) -> Result<Planned<W>, Unchecked> {
-    let (checked, drawn) = run(job.design(), job.min_overlap(), cancel, out)?;
+    let (mut checked, drawn) = run(job.design(), job.min_overlap(), cancel, out)?;
+    let twist = job.design().twist_deg;
+    if !checked.report.printable && twist != 0.0 {
+        checked.most_twist = most_twist(job, cancel)?;
+    }
     Ok(Planned { checked, drawn })
+}
+
+/// The largest twist of the design's sense (at most its own) whose plan
+/// prints, to 5° below, by bisection between the
+/// untwisted design and the design's twist: a refusal then names the
+/// most the shape takes (docs/ALGORITHMS.md §11). `None` if the design
+/// does not print untwisted.
+fn most_twist(job: &Job, cancel: &Cancel) -> Result<Option<f64>, Unchecked> {
+    let d = job.design();
+    let prints = |deg: f64| -> Result<bool, Unchecked> {
+        let mut t = d.clone();
+        t.twist_deg = deg;
+        match run(&t, job.min_overlap(), cancel, || Ok(io::sink())) {
+            Ok((c, _)) => Ok(c.report.printable),
+            Err(Unchecked::Design(_)) => Ok(false),
+            Err(e) => Err(e),
+        }
+    };
+    if !prints(0.0)? {
+        return Ok(None);
+    }
+    let (mut good, mut bad) = (0.0f64, d.twist_deg.abs());
+    while bad - good > 5.0 {
+        go_on(cancel)?;
+        let mid = 0.5 * (good + bad);
+        if prints(mid.copysign(d.twist_deg))? {
+            good = mid;
+        } else {
+            bad = mid;
+        }
+    }
+    Ok(Some((good / 5.0).floor() * 5.0))
 }
 
 /// [`plan()`] for a design not yet made a [`Job`] (tests, benchmarks):
@@ -168,6 +209,7 @@ fn run<W: Write>(
         support.dedup();
         let body = report.findings[Finding::NozzleCollision].count > 0;
         let checked = Checked {
+            most_twist: None,
             sliced,
             out: w,
             report,
@@ -383,6 +425,32 @@ mod tests {
             advice[0].contains("lean the profiles less") && advice[0].contains("transition curve"),
             "{advice:?}"
         );
+    }
+
+    #[test]
+    fn a_twist_the_shape_cannot_take_is_refused_with_the_most_it_takes() {
+        // The cup, off its centre, turned two whole turns clockwise: its
+        // wall passes 10 mm from o, where the turn carries it across the
+        // clay below faster than any correction holds. The refusal says
+        // how much twist this shape takes, and that much prints.
+        let mut d = Design::from_json(examples::example("cup").unwrap()).unwrap();
+        d.twist_deg = -720.0;
+        let c = checked(&d, 0.5);
+        assert!(!c.report.printable);
+        let most = c.most_twist.expect("the untwisted cup prints");
+        assert!(most > -720.0 && most < 720.0 && most >= 0.0, "{most}");
+        assert!(
+            c.advice()
+                .iter()
+                .any(|a| a.contains(&format!("at most {most:.0}° of twist"))),
+            "{:?}",
+            c.advice()
+        );
+        d.twist_deg = -most;
+        assert!(checked(&d, 0.5).report.printable, "at {most}°");
+        // A design that prints has no such figure; nor one without twist.
+        d.twist_deg = 0.0;
+        assert_eq!(checked(&d, 0.5).most_twist, None);
     }
 
     #[test]
