@@ -595,6 +595,11 @@ $('pot-height').addEventListener('change', () => {
     potError(inp, `height ${fmtMm(h)} mm: too low for ${pts.length} heights`);
     return;
   }
+  const printer = currentPrinter(state.design);
+  if (printer && h > printer.build_volume[2]) {
+    potError(inp, `height ${fmtMm(h)} mm: taller than the ${printer.name} prints (${fmtMm(printer.build_volume[2])} mm)`);
+    return;
+  }
   edit((d) => {
     for (const p of d.profile_start.control_points) p[1] = +((p[1] * h) / top).toFixed(3);
   }, true);
@@ -1114,6 +1119,11 @@ function buildParams() {
         showError(`${label}: "${inp.value}" is not a number (write 1.5 or 1,5)`, `params.${key}`);
         return;
       }
+      // Layers come whole: said beside the field, the value left as it was.
+      if (key === 'floor_layers' && !(Number.isInteger(v) && v >= 0 && v <= state.meta.max_floor_layers)) {
+        showError(`${label}: "${inp.value}" is not a whole number of layers from 0 (bottomless) to ${state.meta.max_floor_layers}`, `params.${key}`);
+        return;
+      }
       edit((d) => { d.params = { ...(d.params || {}), [key]: v / factor }; }, true);
       state.lastParam = key;
     });
@@ -1593,9 +1603,14 @@ function keptPrinters() {
 
 const PRINTER_FIELDS = [['pr-bv', 'build_volume', 3], ['pr-bm', 'bed_min', 3], ['pr-o', 'origin', 2]];
 
+/** The design's printer: its own, or the preset it names. */
+function currentPrinter(d) {
+  return typeof d.printer === 'object' && d.printer ? d.printer : state.meta.presets.find((p) => p.name === (d.printer || 'generic'));
+}
+
 function openPrinter() {
   const d = state.design;
-  const current = typeof d.printer === 'object' && d.printer ? d.printer : state.meta.presets.find((p) => p.name === (d.printer || 'generic'));
+  const current = currentPrinter(d);
   const base = { ...state.meta.presets.find((p) => p.name === 'generic'), ...current };
   state.printerBase = base;
   $('pr-name').value = typeof d.printer === 'object' ? base.name : `my ${base.name}`;

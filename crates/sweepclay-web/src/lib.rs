@@ -194,6 +194,7 @@ async fn meta(State(limits): State<Shared>) -> Response {
         "params": Params::default(),
         "examples": examples,
         "max_samples": limits.limits.max_samples,
+        "max_floor_layers": sweepclay_core::design::MAX_FLOOR_LAYERS,
     }))
     .into_response()
 }

@@ -2183,3 +2183,90 @@ async fn a_mesh_opens_as_an_editable_design_and_downloads_its_gcode() {
     assert_eq!(js(&c, "return window.sweepclayErrors").await, json!([]));
     c.close().await.unwrap();
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn fields_take_what_is_typed_or_say_why_beside_it() {
+    // Round 3's walk: presets whose own values failed the printer
+    // dialog's steps could not be saved; "2.5" floor layers gave a serde
+    // message; a pot 99999 mm tall blamed the point spacing.
+    let Some(Session {
+        tmp: _tmp,
+        downloads: _downloads,
+        driver: _driver,
+        c,
+        base,
+    }) = Session::start().await
+    else {
+        return;
+    };
+    c.goto(&format!("{base}/?example=vase")).await.unwrap();
+    close_guide(&c).await;
+    wait_js(&c, PRINTABLE, "the vase").await;
+    for preset in [
+        "eazao-zero",
+        "eazao-potter",
+        "wasp-2040-clay",
+        "vormvrij-lutum-4.6",
+    ] {
+        set_value(&c, "p-printer", preset).await;
+        wait_js(
+            &c,
+            &format!("return {IDLE} && window.sweepclay.design.printer === '{preset}'"),
+            "the preset chosen",
+        )
+        .await;
+        click(&c, "printer-edit").await;
+        wait_js(
+            &c,
+            "return document.getElementById('printer-dialog').open",
+            "the printer dialog",
+        )
+        .await;
+        click(&c, "pr-save").await;
+        let saved = wait_js(
+            &c,
+            "return !document.getElementById('printer-dialog').open && window.sweepclay.design.printer.name || null",
+            &format!("{preset} saved as the user's own"),
+        )
+        .await;
+        assert_eq!(saved, json!(format!("my {preset}")));
+    }
+    click(&c, "new-pot").await;
+    wait_js(
+        &c,
+        &format!("return {IDLE} && !window.sweepclay.design.profile_end"),
+        "a new pot",
+    )
+    .await;
+    set_value(&c, "p-floor_layers", "2.5").await;
+    let said = error_text(&c, "2.5 floor layers refused").await;
+    let said = said.as_str().unwrap();
+    assert!(
+        said.contains("not a whole number of layers from 0 (bottomless) to 20")
+            && !said.contains("u32"),
+        "{said}"
+    );
+    assert_eq!(
+        js(
+            &c,
+            "return window.sweepclay.design.params.floor_layers ?? 2"
+        )
+        .await,
+        json!(2)
+    );
+    set_value(&c, "pot-height", "99999").await;
+    let said = wait_js(
+        &c,
+        "return document.getElementById('pot-error').textContent || null",
+        "the height refused",
+    )
+    .await;
+    assert!(
+        said.as_str()
+            .unwrap()
+            .contains("taller than the my vormvrij-lutum-4.6 prints"),
+        "{said}"
+    );
+    assert_eq!(js(&c, "return window.sweepclayErrors").await, json!([]));
+    c.close().await.unwrap();
+}
