@@ -438,7 +438,7 @@ mod tests {
         let c = checked(&d, 0.5);
         assert!(!c.report.printable);
         let most = c.most_twist.expect("the untwisted cup prints");
-        assert!(most > -720.0 && most < 720.0 && most >= 0.0, "{most}");
+        assert!((0.0..720.0).contains(&most), "{most}");
         assert!(
             c.advice()
                 .iter()
