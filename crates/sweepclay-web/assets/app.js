@@ -595,9 +595,11 @@ $('pot-height').addEventListener('change', () => {
     potError(inp, `height ${fmtMm(h)} mm: too low for ${pts.length} heights`);
     return;
   }
+  // Taller than the printer is shown, the part outside in violet; far
+  // taller is a slip of the keyboard (99999 once blamed the point spacing).
   const printer = currentPrinter(state.design);
-  if (printer && h > printer.build_volume[2]) {
-    potError(inp, `height ${fmtMm(h)} mm: taller than the ${printer.name} prints (${fmtMm(printer.build_volume[2])} mm)`);
+  if (printer && h > 4 * printer.build_volume[2]) {
+    potError(inp, `height ${fmtMm(h)} mm: at most ${fmtMm(4 * printer.build_volume[2])} mm here, four times the ${fmtMm(printer.build_volume[2])} mm the ${printer.name} prints (a taller pot is shown with the part outside the printer in violet)`);
     return;
   }
   edit((d) => {

@@ -2262,9 +2262,9 @@ async fn fields_take_what_is_typed_or_say_why_beside_it() {
     )
     .await;
     assert!(
-        said.as_str()
-            .unwrap()
-            .contains("taller than the my vormvrij-lutum-4.6 prints"),
+        said.as_str().unwrap().contains(
+            "at most 2040 mm here, four times the 510 mm the my vormvrij-lutum-4.6 prints"
+        ),
         "{said}"
     );
     assert_eq!(js(&c, "return window.sweepclayErrors").await, json!([]));
