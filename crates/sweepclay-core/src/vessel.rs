@@ -393,7 +393,10 @@ impl VesselPlan {
             return Err(Error::invalid(
                 "params.max_layer_height",
                 format!(
-                    "the rim's height varies from {lo:.1} to {hi:.1} mm round the loop: no whole number of spiral turns keeps every layer between {dmin} and {dmax} mm (at most {most} turns of {dmin} mm on the low side, at least {fewest} on the high side); raise params.max_layer_height or bring the profiles' heights closer"
+                    "the rim's height varies from {lo:.1} to {hi:.1} mm round the loop: no whole number of spiral turns keeps every layer between {dmin} and {dmax} mm (at most {most} turns of {dmin} mm on the low side, at least {fewest} on the high side); with {most} turns the rim may lie from {:.1} to {:.1} mm (now {lo:.1} to {hi:.1} mm): bring the profiles' heights within that, or raise params.max_layer_height to about {:.2} mm",
+                    base + a0 + f64::from(most) * dmin,
+                    base + a0 + f64::from(most) * dmax,
+                    (hi - base - a0) / f64::from(most.max(1))
                 ),
             ));
         }
@@ -892,6 +895,14 @@ mod tests {
             .unwrap_err()
             .to_string();
         assert!(e.contains("no whole number of spiral turns"), "{e}");
+        // The most it may be: 13 turns over 2.5 mm of floor and 0.05 mm of
+        // first turn lay 18.8 to 19.5 mm; 27.45 mm of wall over 13 turns is
+        // 2.11 mm a layer.
+        assert!(
+            e.contains("with 13 turns the rim may lie from 18.8 to 19.5 mm (now 20.0 to 30.0 mm)")
+                && e.contains("max_layer_height to about 2.11 mm"),
+            "{e}"
+        );
     }
 
     /// The rims of a raised arc of 9 columns above level 50 (mm): a hill.
