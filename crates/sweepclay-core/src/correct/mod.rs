@@ -114,6 +114,19 @@ pub fn correct_with(surface: &Surface, tight: &Tightening) -> Result<Corrected> 
         scale_offsets(&mut out, surface, compression * body);
         support = support_free(&mut out, scale);
     }
+    // A correction at one curve spreads to its neighbours, fading by at
+    // most FAIR_PER_MM a millimetre along Ψ: a column pulled in alone
+    // left a notch (or a fin where its neighbours followed the drawing);
+    // whatever the spreading leaves steeper than the limit is corrected
+    // again.
+    if fair(&mut out, surface, FAIR_PER_MM) {
+        let again = support_free(&mut out, scale);
+        for f in again {
+            if !support.iter().any(|g| g.curve == f.curve) {
+                support.push(f);
+            }
+        }
+    }
     let by = if tight.body.is_some() {
         "extruder body"
     } else if intersection.is_some() {
@@ -232,6 +245,58 @@ fn nearest_u(s: &Surface, p: [f64; 2]) -> f64 {
             d(a).total_cmp(&d(b))
         })
         .map_or(0.0, |c| c.u)
+}
+
+/// How fast a correction fades along Ψ (mm of correction a mm): a 6 mm
+/// correction reaches 60 mm to either side.
+const FAIR_PER_MM: f64 = 0.1;
+
+/// Spreads each sample's correction (its offset less the design's) to
+/// the same sample of the neighbouring curves, fading by `per_mm` a
+/// millimetre along Ψ (round a loop, both ways): no correction changes
+/// faster along the wall than that. Returns whether any moved.
+fn fair(out: &mut Surface, design: &Surface, per_mm: f64) -> bool {
+    let n = out.columns.len();
+    if n < 2 {
+        return false;
+    }
+    let closed = out.vessel.is_some();
+    let step = per_mm * out.spacing;
+    let mut c: Vec<f64> = out
+        .samples
+        .iter()
+        .zip(&design.samples)
+        .map(|(o, d)| o.xi - d.xi)
+        .collect();
+    if c.iter().all(|x| x.abs() < 1e-9) {
+        return false;
+    }
+    let mut moved = false;
+    let mut relax = |c: &mut Vec<f64>, a: usize, b: usize| {
+        let (ca, cb) = (&out.columns[a], &out.columns[b]);
+        for m in 0..ca.len().min(cb.len()) {
+            let (i, j) = (ca.first as usize + m, cb.first as usize + m);
+            let want = c[i].abs() - step;
+            if want > c[j].abs() + 1e-9 && (c[j] == 0.0 || c[j].signum() == c[i].signum()) {
+                c[j] = want.copysign(c[i]);
+                moved = true;
+            }
+        }
+    };
+    for _ in 0..if closed { 2 } else { 1 } {
+        for k in 1..n + usize::from(closed) {
+            relax(&mut c, (k - 1) % n, k % n);
+        }
+        for k in (0..n - 1 + usize::from(closed)).rev() {
+            relax(&mut c, (k + 1) % n, k);
+        }
+    }
+    if moved {
+        for ((o, d), x) in out.samples.iter_mut().zip(&design.samples).zip(&c) {
+            o.xi = d.xi + x;
+        }
+    }
+    moved
 }
 
 /// Sets every offset to `c` times the design's.
