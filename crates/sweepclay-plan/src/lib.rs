@@ -16,4 +16,4 @@ pub mod plan;
 pub use cancel::{Cancel, CancelReader, CancelWriter};
 pub use check::{check_config, locate, printer_check, verify, verify_into, verify_until, Verified};
 pub use job::{Job, Limits};
-pub use plan::{plan, slice_checked, Checked, Planned, Unchecked, MAX_ROUNDS};
+pub use plan::{plan, slice_checked, unfit, Checked, Planned, Unchecked, Unfit, MAX_ROUNDS};

@@ -146,6 +146,38 @@ fn most_twist(job: &Job, cancel: &Cancel) -> Result<Option<f64>, Unchecked> {
     Ok(Some((good / 5.0).floor() * 5.0))
 }
 
+/// A print that does not fit its printer, laid as the stages lay it: what
+/// the modeler's preview shows, with the part outside marked, when
+/// [`plan()`] refuses a job for leaving the build volume (or for a floor
+/// one spiral cannot fill). The first round's corrections, no check (the
+/// G-code could not be printed anyway). `None` when the job fails for
+/// any other reason, which [`plan()`]'s error says.
+pub struct Unfit {
+    /// The stages' output, unchecked.
+    pub sliced: Sliced,
+    /// The surface as sampled (before the corrections).
+    pub drawn: surface::Surface,
+    /// Why it cannot be printed.
+    pub why: sweepclay_core::Error,
+}
+
+/// The stages of a job whose print does not fit (see [`Unfit`]).
+pub fn unfit(job: &Job, cancel: &Cancel) -> Result<Option<Unfit>, Unchecked> {
+    let Ok(drawn) = surface::sample_surface(job.design()) else {
+        return Ok(None);
+    };
+    go_on(cancel)?;
+    let Ok(corrected) = correct_with(&drawn, &Tightening::default()) else {
+        return Ok(None);
+    };
+    go_on(cancel)?;
+    let sliced = sweepclay_core::finish_unchecked(corrected);
+    Ok(match sweepclay_core::fits(&sliced) {
+        Err(why) => Some(Unfit { sliced, drawn, why }),
+        Ok(()) => None,
+    })
+}
+
 /// [`plan()`] for a design not yet made a [`Job`] (tests, benchmarks):
 /// validated with no sample cap, and its fit left to the slicing.
 pub fn slice_checked<W: Write>(

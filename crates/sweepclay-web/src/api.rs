@@ -281,7 +281,7 @@ pub fn slice_view(job: &Job, cancel: &Cancel) -> Result<SliceView, ApiError> {
     let Planned { checked, drawn } = match plan(job, cancel, || Ok(std::io::sink())) {
         Ok(c) => c,
         Err(Unchecked::Io(e)) => return Err(cancel.io_error("checking the G-code", e)),
-        Err(Unchecked::Design(e)) => return unfit_view(job.design(), cancel, t0, e),
+        Err(Unchecked::Design(e)) => return unfit_view(job, cancel, t0, e),
     };
     let verdict = Verdict {
         printable: checked.report.printable,
@@ -330,26 +330,19 @@ fn moved_from(
 /// fill), it is shown with what lies outside marked and why it cannot be
 /// printed; any other refusal is the answer.
 fn unfit_view(
-    design: &Design,
+    job: &Job,
     cancel: &Cancel,
     t0: std::time::Instant,
     why: sweepclay_core::Error,
 ) -> Result<SliceView, ApiError> {
-    let Ok(sampled) = surface::sample_surface(design) else {
-        return Err(why.into());
+    let unfit = match sweepclay_plan::unfit(job, cancel) {
+        Ok(Some(u)) => u,
+        Ok(None) => return Err(why.into()),
+        Err(Unchecked::Io(e)) => return Err(cancel.io_error("slicing", e)),
+        Err(Unchecked::Design(_)) => return Err(why.into()),
     };
-    cancel.check()?;
-    let Ok(corrected) = correct::correct(&sampled) else {
-        return Err(why.into());
-    };
-    cancel.check()?;
-    let (moved, printed) = moved_from(&sampled, &corrected);
-    drop(sampled);
-    let sliced = sweepclay_core::finish_unchecked(corrected);
-    let Err(unfit) = sweepclay_core::fits(&sliced) else {
-        return Err(why.into());
-    };
-    let e = ApiError::from(unfit);
+    let (moved, printed) = moved_from(&unfit.drawn, &unfit.sliced.corrected);
+    let e = ApiError::from(unfit.why);
     let fit_error = Some(FitError {
         error: e.error,
         key: e.key,
@@ -357,7 +350,7 @@ fn unfit_view(
     let slice_ms = t0.elapsed().as_secs_f64() * 1e3;
     Ok(SliceView {
         printed,
-        ..view(&sliced, moved, slice_ms, fit_error)
+        ..view(&unfit.sliced, moved, slice_ms, fit_error)
     })
 }
 
