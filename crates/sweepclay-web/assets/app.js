@@ -491,13 +491,22 @@ function potEdit(i, what, inp) {
   const d = state.design;
   const pts = d.profile_start.control_points;
   if (what === 'z') {
-    const lo = pts[i - 1][1] + MIN_DZ;
-    const hi = i + 1 < pts.length ? pts[i + 1][1] - MIN_DZ : Infinity;
-    if (!(v >= lo && v <= hi)) {
-      potError(inp, `height ${fmtMm(v)} mm: must lie between the heights below and above it (${fmtMm(lo)} to ${Number.isFinite(hi) ? `${fmtMm(hi)} mm` : 'any'})`);
+    // Any height above the base takes its place among the rows (they
+    // stay sorted, each keeping its width); it may not sit on another.
+    if (!(v >= MIN_DZ)) {
+      potError(inp, `height ${fmtMm(v)} mm: must be above the base (at least ${fmtMm(MIN_DZ)} mm)`);
       return;
     }
-    edit((dd) => { dd.profile_start.control_points[i][1] = v; }, true);
+    const clash = pts.find((p, j) => j !== i && Math.abs(p[1] - v) < MIN_DZ);
+    if (clash) {
+      potError(inp, `height ${fmtMm(v)} mm: another row is at ${fmtMm(clash[1])} mm; heights must be at least ${fmtMm(MIN_DZ)} mm apart`);
+      return;
+    }
+    edit((dd) => {
+      const p = dd.profile_start.control_points;
+      p[i][1] = v;
+      p.sort((a, b) => a[1] - b[1]);
+    }, true);
     return;
   }
   if (!(v > 0)) {
@@ -577,11 +586,14 @@ $('rim-toward').addEventListener('change', () => rimEdit('rim-toward', 'toward_d
 $('rim-peaks').addEventListener('change', () => rimEdit('rim-peaks', 'peaks', 'rim crests', 1, 12, true));
 $('rim-width').addEventListener('change', () => rimEdit('rim-width', 'width_deg', 'raised part (°)', 1, 360, false));
 
+// A new height goes in the middle of the largest gap between the rows
+// (type any height into it: the rows re-sort).
 $('pot-add').addEventListener('click', () => edit((d) => {
   const p = d.profile_start.control_points;
-  const n = p.length;
-  const [a, b] = [p[n - 2], p[n - 1]];
-  p.splice(n - 1, 0, [(a[0] + b[0]) / 2, (a[1] + b[1]) / 2]);
+  let k = 1;
+  for (let j = 2; j < p.length; j++) if (p[j][1] - p[j - 1][1] > p[k][1] - p[k - 1][1]) k = j;
+  const [a, b] = [p[k - 1], p[k]];
+  p.splice(k, 0, [+((a[0] + b[0]) / 2).toFixed(3), +((a[1] + b[1]) / 2).toFixed(3)]);
 }, true));
 
 $('pot-height').addEventListener('change', () => {

@@ -1416,14 +1416,17 @@ async fn a_pot_on_a_phone_by_touch() {
         "the pot 80 mm tall",
     )
     .await;
-    type_into(&c, "pot-z2", "1").await;
+    type_into(&c, "pot-z2", "0,3").await;
     let err = wait_js(
         &c,
         "return document.getElementById('pot-error').textContent || null",
-        "a height out of order refused beside the table",
+        "a height on the base refused beside the table",
     )
     .await;
-    assert!(err.as_str().unwrap().contains("must lie between"), "{err}");
+    assert!(
+        err.as_str().unwrap().contains("must be above the base"),
+        "{err}"
+    );
     wait_js(
         &c,
         &format!("return {IDLE} && {}", &PRINTABLE[7..]),
@@ -2254,6 +2257,59 @@ async fn fields_take_what_is_typed_or_say_why_beside_it() {
         .await,
         json!(2)
     );
+    // "Add a height" goes into the largest gap; any height typed there
+    // takes its place among the rows, which stay sorted.
+    let before = js(
+        &c,
+        "return window.sweepclay.design.profile_start.control_points.map((p) => p[1])",
+    )
+    .await;
+    click(&c, "pot-add").await;
+    let n = before.as_array().unwrap().len();
+    wait_js(
+        &c,
+        &format!(
+            "return window.sweepclay.design.profile_start.control_points.length === {} || null",
+            n + 1
+        ),
+        "a height added",
+    )
+    .await;
+    let added = js(
+        &c,
+        "return window.sweepclay.design.profile_start.control_points.map((p) => p[1])",
+    )
+    .await;
+    let added: Vec<f64> = added
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    let i = (1..added.len())
+        .find(|&i| {
+            !before
+                .as_array()
+                .unwrap()
+                .iter()
+                .any(|b| b.as_f64() == Some(added[i]))
+        })
+        .expect("the new row");
+    set_value(&c, &format!("pot-z{i}"), "10").await;
+    let zs = wait_js(
+        &c,
+        "const z = window.sweepclay.design.profile_start.control_points.map((p) => p[1]); return z.includes(10) ? z : null",
+        "the new height at 10 mm",
+    )
+    .await;
+    let zs: Vec<f64> = zs
+        .as_array()
+        .unwrap()
+        .iter()
+        .map(|v| v.as_f64().unwrap())
+        .collect();
+    assert!(zs.windows(2).all(|w| w[0] < w[1]), "{zs:?}");
+    assert_eq!(zs[1], 10.0, "{zs:?}");
     set_value(&c, "pot-height", "99999").await;
     let said = wait_js(
         &c,
