@@ -300,8 +300,12 @@ state.editors = editors;
 // screens have no double-click).
 const EDITOR_NAMES = ['start side profile', 'end side profile', 'path seen from above', 'how one profile turns into the other'];
 const AXES = [['x', 'z'], ['x', 'z'], ['x', 'y'], ['u', 'λ']];
-function showPoint(ed) {
-  if (ed.selected >= 0) state.activeEditor = ed;
+function showPoint(ed, user = true) {
+  // Only the user's own selection makes an editor the bar's: a refresh of
+  // every editor after an edit made the last one refreshed (the end
+  // profile) take the start profile's typed values.
+  if (user && ed.selected >= 0) state.activeEditor = ed;
+  else if (ed !== state.activeEditor) return;
   const a = state.activeEditor;
   const k = editors.indexOf(a);
   const p = a && a.selected >= 0 ? a.points[a.selected] : null;
@@ -320,8 +324,34 @@ for (const id of ['pb-x', 'pb-y']) {
   $(id).addEventListener('change', () => {
     const a = state.activeEditor;
     if (!a || a.selected < 0) return;
-    const p = [parseFloat($('pb-x').value), parseFloat($('pb-y').value)];
-    if (!p.every(Number.isFinite) || !a.moveSelected(p)) showPoint(a);
+    const k = editors.indexOf(a);
+    $('pb-error').textContent = '';
+    $(id).classList.remove('bad');
+    const said = (msg) => {
+      $('pb-error').textContent = msg;
+      $(id).classList.add('bad');
+    };
+    const axis = $(`${id}l`).textContent;
+    const v = parseDecimal($(id).value);
+    if (!Number.isFinite(v)) {
+      said(`${axis}: "${$(id).value}" is not a number (write 1.5 or 1,5)`);
+      return;
+    }
+    const old = a.points[a.selected];
+    const p = id === 'pb-x' ? [v, old[1]] : [old[0], v];
+    // Taken as typed or refused: a point its neighbours hold in place
+    // is not moved somewhere else silently.
+    if (a.o.pinned && a.o.pinned(a.selected, a.points)) {
+      said(`this point of the ${EDITOR_NAMES[k]} stays where it is (the base of a profile, or an end)`);
+      return;
+    }
+    const q = a.o.constrain ? a.o.constrain(a.selected, p, a.points) : p;
+    if (!q || Math.abs(q[0] - p[0]) > 1e-6 || Math.abs(q[1] - p[1]) > 1e-6) {
+      const near = q ? ` (the nearest it may go: ${AXES[k][0]} ${Number(q[0].toFixed(3))}, ${AXES[k][1]} ${Number(q[1].toFixed(3))})` : '';
+      said(`${axis} ${Number(v.toFixed(3))}: the point cannot go there, between its neighbours${near}`);
+      return;
+    }
+    if (!a.moveSelected(p)) showPoint(a);
   });
 }
 $('pb-add').addEventListener('click', () => {

@@ -30,7 +30,8 @@ export class CurveEditor {
    *   printed(): the curve as printed, where the corrections moved it
    *     (a polyline in model coordinates, or null): drawn dashed green
    *   label(p): text beside the selected point
-   *   onSelect(editor): the selection changed (or its point moved)
+   *   onSelect(editor, user): the selection changed (or its point moved);
+   *     `user` false for a refresh from the model
    */
   constructor(canvas, o) {
     this.canvas = canvas;
@@ -87,11 +88,13 @@ export class CurveEditor {
       this.look = look;
       onFrame(`${this.key}-draw`, () => this.draw());
     }
-    this.told();
+    this.told(false);
   }
 
-  told() {
-    if (this.o.onSelect) this.o.onSelect(this);
+  /** Tells `onSelect`; `user`: the user selected or moved a point here
+   * (not a refresh from the model, which every editor gets). */
+  told(user = true) {
+    if (this.o.onSelect) this.o.onSelect(this, user);
   }
 
   /** Whether the selected point may be deleted. */

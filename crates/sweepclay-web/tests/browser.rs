@@ -2234,6 +2234,62 @@ async fn fields_take_what_is_typed_or_say_why_beside_it() {
         .await;
         assert_eq!(saved, json!(format!("my {preset}")));
     }
+    // The point bar: a value typed for the start profile's point goes to
+    // that point, though the end profile had one selected before and is
+    // refreshed after it; "1,5" is 1.5; a height its neighbours forbid is
+    // refused beside the field, not moved elsewhere.
+    let end_before = js(
+        &c,
+        "return JSON.stringify(window.sweepclay.design.profile_end)",
+    )
+    .await;
+    js(&c, "const e = window.sweepclay.editors[1]; e.selected = 1; e.told(); const s = window.sweepclay.editors[0]; s.selected = 1; s.told(); return 0").await;
+    set_value(&c, "pb-x", "1,5").await;
+    wait_js(
+        &c,
+        &format!(
+            "return {IDLE} && window.sweepclay.design.profile_start.control_points[1][0] === 1.5"
+        ),
+        "the start profile's point at x 1.5",
+    )
+    .await;
+    assert_eq!(
+        js(
+            &c,
+            "return JSON.stringify(window.sweepclay.design.profile_end)"
+        )
+        .await,
+        end_before
+    );
+    js(
+        &c,
+        "const s = window.sweepclay.editors[0]; s.selected = 2; s.told(); return 0",
+    )
+    .await;
+    let z2 = js(
+        &c,
+        "return window.sweepclay.design.profile_start.control_points[2][1]",
+    )
+    .await;
+    set_value(&c, "pb-y", "5").await;
+    let said = wait_js(
+        &c,
+        "return document.getElementById('pb-error').textContent || null",
+        "a height between the neighbours' refused",
+    )
+    .await;
+    assert!(
+        said.as_str().unwrap().contains("the point cannot go there"),
+        "{said}"
+    );
+    assert_eq!(
+        js(
+            &c,
+            "return window.sweepclay.design.profile_start.control_points[2][1]"
+        )
+        .await,
+        z2
+    );
     click(&c, "new-pot").await;
     wait_js(
         &c,
