@@ -56,6 +56,8 @@ const state = {
   verifyTimer: 0,
   verifySeq: 0,
   sliced: null,
+  // The point the point bar shows (its editor is `activeEditor`).
+  barPoint: -1,
 };
 // For tests and the curious: the last round trips (edit → preview drawn), ms.
 window.sweepclay = state;
@@ -88,6 +90,9 @@ function interpolationPoints(d) {
 /** Replaces the design; `record` adds an undo step. */
 function setDesign(d, { record = true, fit = false } = {}) {
   state.design = d;
+  // Another design (opened, an example, a new pot): no refusal of a value
+  // typed for the last one stays beside the point bar.
+  if (fit) $('pb-error').textContent = '';
   if (record) {
     state.history = state.history.slice(0, state.at + 1);
     state.history.push(JSON.stringify(d));
@@ -304,8 +309,16 @@ function showPoint(ed, user = true) {
   // Only the user's own selection makes an editor the bar's: a refresh of
   // every editor after an edit made the last one refreshed (the end
   // profile) take the start profile's typed values.
-  if (user && ed.selected >= 0) state.activeEditor = ed;
-  else if (ed !== state.activeEditor) return;
+  if (user && ed.selected >= 0) {
+    // A refusal beside the bar was about the last value typed there.
+    if (ed !== state.activeEditor || ed.selected !== state.barPoint) {
+      $('pb-error').textContent = '';
+      $('pb-x').classList.remove('bad');
+      $('pb-y').classList.remove('bad');
+    }
+    state.activeEditor = ed;
+    state.barPoint = ed.selected;
+  } else if (ed !== state.activeEditor) return;
   const a = state.activeEditor;
   const k = editors.indexOf(a);
   const p = a && a.selected >= 0 ? a.points[a.selected] : null;

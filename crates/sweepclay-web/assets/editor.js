@@ -81,6 +81,20 @@ export class CurveEditor {
   refresh() {
     this.points = this.o.get().map((p) => p.slice());
     if (this.selected >= this.points.length) this.selected = -1;
+    // A change typed elsewhere (a pot's base made 150 mm wide, its
+    // height 260 mm) re-frames the view when the curve leaves it or
+    // shrinks to a speck in it; never while a finger or the mouse drags.
+    if (this.fitted && !this.drag && !this.o.fixed && this.points.length && this.w) {
+      const s = this.points.map((p) => this.toScreen(p));
+      const xs = s.map((p) => p[0]);
+      const ys = s.map((p) => p[1]);
+      const out = Math.min(...xs) < 0 || Math.max(...xs) > this.w || Math.min(...ys) < 0 || Math.max(...ys) > this.h;
+      const speck = Math.max(...xs) - Math.min(...xs) < 0.1 * this.w && Math.max(...ys) - Math.min(...ys) < 0.1 * this.h;
+      if (out || speck) {
+        this.fit();
+        this.look = null;
+      }
+    }
     // An editor whose curves did not change is not drawn again: a drag in
     // one editor repaints that one (and the other profile's ghost).
     const look = JSON.stringify([this.points, this.o.ghost?.(), this.o.printed?.(), this.selected, this.o.curve(this.points).length]);

@@ -2366,6 +2366,21 @@ async fn fields_take_what_is_typed_or_say_why_beside_it() {
         .collect();
     assert!(zs.windows(2).all(|w| w[0] < w[1]), "{zs:?}");
     assert_eq!(zs[1], 10.0, "{zs:?}");
+    // Typed changes re-frame the editors: the path at a 150 mm base, the
+    // profile at 260 mm tall, each wholly in its view.
+    let in_view = "return [0, 2].map((k) => { const e = window.sweepclay.editors[k]; return e.points.every((p) => { const [x, y] = e.toScreen(p); return x >= 0 && y >= 0 && x <= e.w && y <= e.h; }); })";
+    set_value(&c, "pot-w0", "150").await;
+    set_value(&c, "pot-height", "260").await;
+    wait_js(
+        &c,
+        &format!("return {IDLE} && window.sweepclay.design.profile_start.control_points.at(-1)[1] === 260"),
+        "the pot 260 mm tall on a 150 mm base",
+    )
+    .await;
+    assert_eq!(js(&c, in_view).await, json!([true, true]));
+    if let Ok(path) = std::env::var("SWEEPCLAY_FIELDS_SCREENSHOT") {
+        std::fs::write(&path, c.screenshot().await.unwrap()).unwrap();
+    }
     set_value(&c, "pot-height", "99999").await;
     let said = wait_js(
         &c,
