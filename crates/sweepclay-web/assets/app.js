@@ -34,6 +34,8 @@ const PARAMS = [
   ['max_overhang_deg', 'steepest overhang', '°', 1, 'how far from vertical the wall may lean before it is corrected', 1],
   ['feedrate', 'print speed', 'mm/min', 50, 'how fast the nozzle moves while printing', 1],
   ['floor_layers', 'floor layers (vessel)', '', 1, 'flat layers of the floor of a closed vessel; 0 for bottomless', 1],
+  ['shrinkage_xy', 'firing shrinkage across', '%', 0.5, 'how much your clay body shrinks across from wet to fired (0 to 50 %): the piece is printed that much larger, so the fired piece has the drawn size', 100],
+  ['shrinkage_z', 'firing shrinkage in height', '%', 0.5, 'how much your clay body shrinks in height from wet to fired (0 to 50 %)', 100],
 ];
 
 const state = {
@@ -911,6 +913,9 @@ function render(data, fit) {
         ['passes', `${s.passes} (${s.stages} stage${s.stages > 1 ? 's' : ''})`],
         ['returning turns', s.returning_points],
       ]),
+    ...(s.print_scale[0] !== 1 || s.print_scale[1] !== 1
+      ? [['firing shrinkage', `printed ${((s.print_scale[0] - 1) * 100).toFixed(1)} % larger across, ${((s.print_scale[1] - 1) * 100).toFixed(1)} % taller: fired, the drawn size`]]
+      : []),
     ['path length', `${(s.path_length_mm / 1000).toFixed(2)} m`],
     ['clay', `${s.volume_ml.toFixed(1)} ml, ${s.clay_g.toFixed(0)} g`],
     ['printing time', `${s.time_min.toFixed(1)} min`],

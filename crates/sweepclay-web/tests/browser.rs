@@ -2381,6 +2381,22 @@ async fn fields_take_what_is_typed_or_say_why_beside_it() {
     if let Ok(path) = std::env::var("SWEEPCLAY_FIELDS_SCREENSHOT") {
         std::fs::write(&path, c.screenshot().await.unwrap()).unwrap();
     }
+    // Firing shrinkage, in the file format, is on the page: 10 % across
+    // prints the pot 11.1 % larger, and the statistics say so.
+    set_value(&c, "p-shrinkage_xy", "10").await;
+    let said = wait_js(
+        &c,
+        &format!("return {IDLE} && window.sweepclay.design.params.shrinkage_xy === 0.1 && document.querySelector('[data-stat=\"firing shrinkage\"]')?.textContent || null"),
+        "the shrinkage in the statistics",
+    )
+    .await;
+    assert!(
+        said.as_str()
+            .unwrap()
+            .starts_with("printed 11.1 % larger across, 0.0 % taller"),
+        "{said}"
+    );
+    set_value(&c, "p-shrinkage_xy", "0").await;
     set_value(&c, "pot-height", "99999").await;
     let said = wait_js(
         &c,
