@@ -421,7 +421,22 @@ export class View3D {
     return Math.max(0.5, Math.round(mm * 2) / 2);
   }
 
+  /**
+   * The colours' legend, and the marks every colouring shares: the black
+   * beads of the rim and the top edge, the start and end, the samples a
+   * correction moved (orange on the surface).
+   */
   legend() {
+    const main = this.colourLegend();
+    if (!main) return main;
+    const keys = [];
+    if (this.topCount) keys.push(`<b>● ${this.data.stats.vessel ? 'rim and top-edge beads' : 'top-edge beads'}</b>`);
+    keys.push('<b style="color:#1a9933">●</b> start · <b style="color:#cc1a1a">●</b> end');
+    if (this.data.surface.moved.length) keys.push('<b style="color:#ff8000">■</b> surface moved by a correction');
+    return `${main} · ${keys.join(' · ')}`;
+  }
+
+  colourLegend() {
     const p = this.params;
     if (!p || !this.data) return '';
     const out = this.outsideCount ? ` · <b style="color:#8f45e0">■ ${this.outsideCount} points outside the printer</b>` : '';
@@ -440,7 +455,7 @@ export class View3D {
     if (this.colourBy === 'pass') return `pass 1 <i style="background:${grad()}"></i> ${this.data.plan.passes}${out}`;
     if (this.colourBy === 'stage') {
       return this.data.plan.stages === 2
-        ? '<b style="color:#2666cc">lower stage</b> · <b style="color:#ed731a">upper stage</b> · <b>● top-edge beads (returning turns)</b>'
+        ? '<b style="color:#2666cc">lower stage</b> · <b style="color:#ed731a">upper stage</b>'
         : '<b style="color:#2666cc">one stage</b>';
     }
     return `width ${p.width_min} mm <i style="background:${grad()}"></i> ${p.width_max} mm${out}`;

@@ -2013,6 +2013,14 @@ async fn the_page_previews_the_path_it_downloads_point_for_point() {
         "the foot pot twisted 20°, printable",
     )
     .await;
+    // What the 3D view draws besides its colours is named in the legend.
+    let legend = js(&c, "return document.getElementById('legend').textContent").await;
+    let legend = legend.as_str().unwrap();
+    assert!(
+        legend.contains("rim and top-edge beads")
+            && legend.contains("surface moved by a correction"),
+        "{legend}"
+    );
     let corrections = js(
         &c,
         "return document.getElementById('corrections').textContent",
