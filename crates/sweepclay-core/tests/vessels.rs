@@ -154,7 +154,7 @@ proptest! {
         // z never falls by more than a graze from one point to the next
         // of the spiral, and the top is within one layer of the rim.
         let top = t.points.iter().map(|q| q.pos[2]).fold(0.0, f64::max);
-        let rim = s.corrected.surface.columns.iter().map(|c| c.height).fold(0.0, f64::max);
+        let rim = tallest(&s);
         prop_assert!((rim - top).abs() <= p.max_layer_height + 1e-9);
         // The floor covers the inside: at least 97 % of it lies under a
         // bead of the first layer, as the floor module measures it and
@@ -381,13 +381,7 @@ fn rims_slanted_raised_and_waved_print_as_drawn() {
         let r = common::check_full(&s);
         assert!(r.printable, "{what}: {}", r.render());
         let top = path_top(&s);
-        let rim = s
-            .corrected
-            .surface
-            .columns
-            .iter()
-            .map(|c| c.height)
-            .fold(0.0, f64::max);
+        let rim = tallest(&s);
         // A raised arc's tops reach the rim; a spiral's rim turn ends
         // where its beads would be under half a layer (within a layer).
         let below = if raised { 1e-6 } else { 1.25 };
@@ -440,13 +434,7 @@ fn a_rim_shaped_by_its_rise_and_angle_prints_as_drawn() {
         }
         let r = common::check_full(&s);
         assert!(r.printable, "{rim}: {}", r.render());
-        let hi = s
-            .corrected
-            .surface
-            .columns
-            .iter()
-            .map(|c| c.height)
-            .fold(0.0, f64::max);
+        let hi = tallest(&s);
         assert!(hi > 60.0 + 0.95 * spec.rise, "{rim}: {hi}");
     }
     // Old files read as before; a rim on a wall, or beside a second
@@ -563,4 +551,14 @@ fn a_peanut_pot_gets_one_spiral_floor_and_prints() {
             assert!(e.contains("floor_layers = 0"), "{e}");
         }
     }
+}
+
+/// The tallest column's height (mm): the rim's highest point.
+fn tallest(s: &sweepclay_core::Sliced) -> f64 {
+    s.corrected
+        .surface
+        .columns
+        .iter()
+        .map(|c| c.height)
+        .fold(0.0, f64::max)
 }
