@@ -616,55 +616,79 @@ fn sample_vessel(
         }
         chosen?;
         let v = match full.expect("a layering was chosen") {
-        Ok(clear) => clear,
-        Err(None) => {
-            return Err(Error::invalid(
+            Ok(clear) => clear,
+            Err(None) => {
+                let lo = heights.iter().copied().fold(f64::INFINITY, f64::min);
+                let hi = heights.iter().copied().fold(0.0, f64::max);
+                // The most the rim may rise: the rim's heights drawn toward
+                // its lowest by a share f of their spread, the largest f whose
+                // first turn fits somewhere (bisection, to 1/1000 of it).
+                let fits = |f: f64| {
+                    let hs: Vec<f64> = heights.iter().map(|&h| lo + f * (h - lo)).collect();
+                    VesselPlan::choose(&hs, &params, floor).is_ok_and(|v| {
+                        (v.fewest_turns..=v.turns).any(|t| {
+                            starts
+                                .iter()
+                                .any(|&st| v.with(t, st, &params).first_fits(&params))
+                        })
+                    })
+                };
+                let (mut ok, mut bad) = (0.0f64, 1.0f64);
+                for _ in 0..10 {
+                    let f = 0.5 * (ok + bad);
+                    if fits(f) {
+                        ok = f;
+                    } else {
+                        bad = f;
+                    }
+                }
+                return Err(Error::invalid(
                 "params.max_layer_height",
                 format!(
-                    "the rim's height varies from {:.1} to {:.1} mm round the loop: the wall's first turn, starting a layer above the floor, would end more than {} mm above it wherever it starts; raise params.max_layer_height or bring the profiles' heights closer{}",
-                    heights.iter().copied().fold(f64::INFINITY, f64::min),
-                    heights.iter().copied().fold(0.0, f64::max),
+                    "the rim's height varies from {lo:.1} to {hi:.1} mm round the loop: the wall's first turn, starting a layer above the floor, would end more than {} mm above it wherever it starts; bring the rim's highest point to {:.1} mm or less, or raise params.max_layer_height{}",
                     params.max_layer_height,
+                    lo + ok * (hi - lo),
                     places()
                 ),
-            ))
-        }
-        Err(Some(least)) => {
-            let (least, i, over) = *least;
-            // No layering clears by this estimate: print the thickest and
-            // let the replay of the path judge (the checker names where the
-            // body meets clay, and `--force` writes it); the estimate says
-            // how far the rim's heights must come together.
-            let lo = heights.iter().copied().fold(f64::INFINITY, f64::min);
-            let hi = heights.iter().copied().fold(0.0, f64::max);
-            // The largest share of today's spread whose spiral clears, by
-            // bisection.
-            let clears = |share: f64| {
-                let h: Vec<f64> = heights.iter().map(|&h| lo + share * (h - lo)).collect();
-                VesselPlan::choose(&h, &params, floor)
-                    .is_ok_and(|w| clear_layering(&w, &starts, &near, &h, exempt, &params).is_ok())
-            };
-            let (mut ok, mut bad) = (0.0, 1.0);
-            for _ in 0..12 {
-                let mid = 0.5 * (ok + bad);
-                if clears(mid) {
-                    ok = mid;
-                } else {
-                    bad = mid;
-                }
+            ));
             }
-            let c = &columns[i];
-            let mut v = least;
-            v.uneven = Some(crate::vessel::Uneven {
-                at: [c.p[0], c.p[1]],
-                over_mm: over,
-                spread_mm: hi - lo,
-                most_mm: ok * (hi - lo),
-                peaks,
-            });
-            v
-        }
-    };
+            Err(Some(least)) => {
+                let (least, i, over) = *least;
+                // No layering clears by this estimate: print the thickest and
+                // let the replay of the path judge (the checker names where the
+                // body meets clay, and `--force` writes it); the estimate says
+                // how far the rim's heights must come together.
+                let lo = heights.iter().copied().fold(f64::INFINITY, f64::min);
+                let hi = heights.iter().copied().fold(0.0, f64::max);
+                // The largest share of today's spread whose spiral clears, by
+                // bisection.
+                let clears = |share: f64| {
+                    let h: Vec<f64> = heights.iter().map(|&h| lo + share * (h - lo)).collect();
+                    VesselPlan::choose(&h, &params, floor).is_ok_and(|w| {
+                        clear_layering(&w, &starts, &near, &h, exempt, &params).is_ok()
+                    })
+                };
+                let (mut ok, mut bad) = (0.0, 1.0);
+                for _ in 0..12 {
+                    let mid = 0.5 * (ok + bad);
+                    if clears(mid) {
+                        ok = mid;
+                    } else {
+                        bad = mid;
+                    }
+                }
+                let c = &columns[i];
+                let mut v = least;
+                v.uneven = Some(crate::vessel::Uneven {
+                    at: [c.p[0], c.p[1]],
+                    over_mm: over,
+                    spread_mm: hi - lo,
+                    most_mm: ok * (hi - lo),
+                    peaks,
+                });
+                v
+            }
+        };
         let rim = v.rim_beads(&near, &heights, exempt);
         (v, Some(rim))
     };

@@ -562,3 +562,41 @@ fn tallest(s: &sweepclay_core::Sliced) -> f64 {
         .map(|c| c.height)
         .fold(0.0, f64::max)
 }
+
+#[test]
+fn a_first_turn_that_cannot_start_names_the_most_the_rim_may_rise() {
+    // A rounded square with no floor whose two-crest rim (21 to 38 mm)
+    // leaves the wall's first turn more than a thickest layer above the
+    // bed wherever it starts (random vessel 29 of `RIMS=1` seed 11). The
+    // refusal names the highest the rim may be; lowered to it, that
+    // refusal is gone.
+    let text = include_str!("first-turn.json");
+    let e = slice(&Design::from_json(text).unwrap())
+        .unwrap_err()
+        .to_string();
+    let most: f64 = e
+        .split("bring the rim's highest point to ")
+        .nth(1)
+        .and_then(|r| r.split(" mm or less").next())
+        .and_then(|v| v.parse().ok())
+        .unwrap_or_else(|| panic!("{e}"));
+    assert!(
+        e.contains("wherever it starts") && most < 38.0 && most > 21.2,
+        "{e}"
+    );
+    // The rim drawn toward its lowest (the start profile's top, 21.17 mm)
+    // until its highest is `most`: the end profile's heights scaled.
+    let mut d = Design::from_json(text).unwrap();
+    let lo = d.profile_start.control_points.last().unwrap()[1];
+    let end = d.profile_end.as_mut().unwrap();
+    let zt = end.control_points.last().unwrap()[1];
+    let f = (most - 0.05 - lo) / (38.0 - lo);
+    let k = (lo + f * (zt - lo)) / zt;
+    for p in &mut end.control_points {
+        p[1] *= k;
+    }
+    let again = slice(&d)
+        .map(|_| String::new())
+        .unwrap_or_else(|e| e.to_string());
+    assert!(!again.contains("wherever it starts"), "{again}");
+}
