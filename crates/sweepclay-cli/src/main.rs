@@ -412,30 +412,23 @@ fn mesh_design(path: &Path, scale: Option<f64>, tolerance: f64, up: &str) -> Res
     use sweepclay_core::meshfit;
     let shown = path.display().to_string();
     let bytes = read_capped(path, MAX_MESH_BYTES).map_err(|e| anyhow::anyhow!("{shown}: {e}"))?;
-    let mut mesh =
-        sweepclay_core::meshread::TriMesh::read(&shown, &bytes).with_context(|| shown.clone())?;
-    mesh.stand_up(match up {
+    let up = match up {
         "x" => 0,
         "y" => 1,
         _ => 2,
-    });
-    let (k, note) = meshfit::units(&mesh, scale).with_context(|| shown.clone())?;
-    mesh.scale(k);
-    if let Some(n) = note {
-        eprintln!("note: {shown}: {n}");
-    }
-    let name = path
-        .file_stem()
-        .map(|s| s.to_string_lossy().into_owned())
-        .unwrap_or_default();
+    };
     let opts = meshfit::FitOptions {
         tolerance_mm: tolerance,
-        name,
+        ..meshfit::FitOptions::default()
     };
-    let f = meshfit::fit(&mesh, &opts).with_context(|| shown.clone())?;
+    let m = meshfit::import(&shown, &bytes, up, scale, &opts).with_context(|| shown.clone())?;
+    if let Some(n) = m.units_note {
+        eprintln!("note: {shown}: {n}");
+    }
+    let f = m.fitted;
     say!(
         "{shown}: {} triangles, a {}; fitted by a design (one loop, {}) within {:.2} mm of its {} sections (largest at ({:.1}, {:.1}, {:.1}) mm); its foot's centre moved to o",
-        mesh.triangles.len(),
+        m.triangles,
         if f.kind == "shell" { "wall with its thickness (fitted at its middle)" } else { "solid (fitted at its outside)" },
         if f.design.profile_end.is_some() { "two profiles blended round it" } else { "one profile" },
         f.deviation_mm,

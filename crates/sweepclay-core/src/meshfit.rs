@@ -59,6 +59,48 @@ pub struct Fitted {
     pub moved: [f64; 3],
 }
 
+/// A mesh file read and fitted: what `slice pot.stl`, `import` and the
+/// modeler's "Open…" share.
+#[derive(Clone, Debug)]
+pub struct Imported {
+    /// The fit.
+    pub fitted: Fitted,
+    /// Triangles read (after the repairs).
+    pub triangles: usize,
+    /// What was assumed about the mesh's units, to be said.
+    pub units_note: Option<String>,
+}
+
+/// Reads a mesh file's bytes (`name` gives the format by its extension
+/// and the design's name by its stem), stands it on axis `up` (0 x, 1 y,
+/// 2 z), brings it to millimetres ([`units`]) and fits it with `opts`
+/// (its name replaced by the file's stem).
+pub fn import(
+    name: &str,
+    bytes: &[u8],
+    up: usize,
+    scale: Option<f64>,
+    opts: &FitOptions,
+) -> Result<Imported> {
+    let mut mesh = TriMesh::read(name, bytes)?;
+    mesh.stand_up(up);
+    let (k, units_note) = units(&mesh, scale)?;
+    mesh.scale(k);
+    let stem = std::path::Path::new(name)
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let opts = FitOptions {
+        name: stem,
+        ..opts.clone()
+    };
+    Ok(Imported {
+        fitted: fit(&mesh, &opts)?,
+        triangles: mesh.triangles.len(),
+        units_note,
+    })
+}
+
 /// The factor that brings `mesh` to millimetres, and what to tell the
 /// user about it: `scale` if given; else 25.4 for a mesh 0.8 to 16 units
 /// tall (a pot drawn in inches: 20 to 400 mm), said so; else 1.
@@ -176,28 +218,8 @@ pub fn fit(mesh: &TriMesh, opts: &FitOptions) -> Result<Fitted> {
             }
         }
     }
-    // The foot's wall is Ψ, its centre o.
-    let foot = wall_loop(&cut[0].loops);
-    let c = centroid(foot);
-    let psi: Vec<[f64; 2]> = resample(foot, RAYS)
-        .into_iter()
-        .map(|p| [p[0] - c[0], p[1] - c[1]])
-        .collect();
-    let loops: Vec<Vec<Vec<[f64; 2]>>> = cut
-        .iter()
-        .map(|s| {
-            s.loops
-                .iter()
-                .map(|l| {
-                    let k = (perimeter(l) / 0.4).ceil().clamp(16.0, 4000.0) as usize;
-                    resample(l, k)
-                        .into_iter()
-                        .map(|p| [p[0] - c[0], p[1] - c[1]])
-                        .collect()
-                })
-                .collect()
-        })
-        .collect();
+    let (c, psi) = foot_frame(&cut);
+    let loops: Vec<Vec<Vec<[f64; 2]>>> = cut.iter().map(|s| about(s, c)).collect();
     let zs: Vec<f64> = cut.iter().map(|s| s.z).collect();
     let mut best: Option<Candidate> = None;
     let mut why = Vec::new();
@@ -281,29 +303,14 @@ fn fit_uneven(
     bed: f64,
 ) -> Result<Fitted> {
     let tol = opts.tolerance_mm;
-    let foot = wall_loop(&cut[0].loops);
-    let c = centroid(foot);
-    let psi0: Vec<[f64; 2]> = resample(foot, RAYS)
-        .into_iter()
-        .map(|p| [p[0] - c[0], p[1] - c[1]])
-        .collect();
+    let (c, psi0) = foot_frame(cut);
     let jj = psi0.len();
     let zs: Vec<f64> = cut.iter().map(|s| s.z).collect();
     // The wall's middle along each ray in each section it reaches.
     let mut d: Vec<Vec<Option<f64>>> = Vec::with_capacity(cut.len());
     let mut half = vec![None::<f64>; jj];
     for (k, sec) in cut.iter().enumerate() {
-        let loops: Vec<Vec<[f64; 2]>> = sec
-            .loops
-            .iter()
-            .map(|l| {
-                let n = (perimeter(l) / 0.4).ceil().clamp(16.0, 4000.0) as usize;
-                resample(l, n)
-                    .into_iter()
-                    .map(|p| [p[0] - c[0], p[1] - c[1]])
-                    .collect()
-            })
-            .collect();
+        let loops = about(sec, c);
         let mut row = Vec::with_capacity(jj);
         for (j, p) in psi0.iter().enumerate() {
             let r = p[0].hypot(p[1]).max(1e-9);
@@ -507,6 +514,34 @@ fn fit_uneven(
         sections: cut.len(),
         moved: [-c[0], -c[1], -bed],
     })
+}
+
+/// The foot's wall (the lowest section's) as Ψ: its area centroid, o,
+/// and [`RAYS`] points evenly along it, about o.
+fn foot_frame(cut: &[sections::Section]) -> ([f64; 2], Vec<[f64; 2]>) {
+    let foot = wall_loop(&cut[0].loops);
+    let c = centroid(foot);
+    let psi = resample(foot, RAYS)
+        .into_iter()
+        .map(|p| [p[0] - c[0], p[1] - c[1]])
+        .collect();
+    (c, psi)
+}
+
+/// A section's loops about the centre `c`, resampled a point every
+/// 0.4 mm (16 to 4,000 a loop): the rays' cost does not grow with the
+/// mesh's triangles.
+fn about(sec: &sections::Section, c: [f64; 2]) -> Vec<Vec<[f64; 2]>> {
+    sec.loops
+        .iter()
+        .map(|l| {
+            let k = (perimeter(l) / 0.4).ceil().clamp(16.0, 4000.0) as usize;
+            resample(l, k)
+                .into_iter()
+                .map(|p| [p[0] - c[0], p[1] - c[1]])
+                .collect()
+        })
+        .collect()
 }
 
 /// A fitted form and its largest difference from the mesh.

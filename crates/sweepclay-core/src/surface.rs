@@ -538,6 +538,26 @@ fn clear_layering(
     Err(least)
 }
 
+/// The rim's lowest and highest heights, and the largest share f of its
+/// spread for which `holds` is true of the heights drawn toward the
+/// lowest, lo + f·(h − lo), by bisection over `steps` halvings (0 if
+/// none holds): how far a refused rim's heights must come together.
+fn largest_share(heights: &[f64], steps: u32, holds: impl Fn(&[f64]) -> bool) -> (f64, f64, f64) {
+    let lo = heights.iter().copied().fold(f64::INFINITY, f64::min);
+    let hi = heights.iter().copied().fold(0.0, f64::max);
+    let (mut ok, mut bad) = (0.0f64, 1.0f64);
+    for _ in 0..steps {
+        let f = 0.5 * (ok + bad);
+        let h: Vec<f64> = heights.iter().map(|&h| lo + f * (h - lo)).collect();
+        if holds(&h) {
+            ok = f;
+        } else {
+            bad = f;
+        }
+    }
+    (lo, hi, ok)
+}
+
 /// The samples of a vessel (docs/ALGORITHMS.md §8): each column's spiral
 /// turns and, where the last turn ends half a layer or more below the
 /// rim, the rim bead. The floor is not sampled: the path stage fills the
@@ -618,30 +638,17 @@ fn sample_vessel(
         let v = match full.expect("a layering was chosen") {
             Ok(clear) => clear,
             Err(None) => {
-                let lo = heights.iter().copied().fold(f64::INFINITY, f64::min);
-                let hi = heights.iter().copied().fold(0.0, f64::max);
-                // The most the rim may rise: the rim's heights drawn toward
-                // its lowest by a share f of their spread, the largest f whose
-                // first turn fits somewhere (bisection, to 1/1000 of it).
-                let fits = |f: f64| {
-                    let hs: Vec<f64> = heights.iter().map(|&h| lo + f * (h - lo)).collect();
-                    VesselPlan::choose(&hs, &params, floor).is_ok_and(|v| {
+                // The most the rim may rise: the largest share of its spread
+                // whose first turn fits somewhere (to 1/1000 of it).
+                let (lo, hi, ok) = largest_share(&heights, 10, |hs| {
+                    VesselPlan::choose(hs, &params, floor).is_ok_and(|v| {
                         (v.fewest_turns..=v.turns).any(|t| {
                             starts
                                 .iter()
                                 .any(|&st| v.with(t, st, &params).first_fits(&params))
                         })
                     })
-                };
-                let (mut ok, mut bad) = (0.0f64, 1.0f64);
-                for _ in 0..10 {
-                    let f = 0.5 * (ok + bad);
-                    if fits(f) {
-                        ok = f;
-                    } else {
-                        bad = f;
-                    }
-                }
+                });
                 return Err(Error::invalid(
                 "params.max_layer_height",
                 format!(
@@ -658,25 +665,12 @@ fn sample_vessel(
                 // let the replay of the path judge (the checker names where the
                 // body meets clay, and `--force` writes it); the estimate says
                 // how far the rim's heights must come together.
-                let lo = heights.iter().copied().fold(f64::INFINITY, f64::min);
-                let hi = heights.iter().copied().fold(0.0, f64::max);
-                // The largest share of today's spread whose spiral clears, by
-                // bisection.
-                let clears = |share: f64| {
-                    let h: Vec<f64> = heights.iter().map(|&h| lo + share * (h - lo)).collect();
-                    VesselPlan::choose(&h, &params, floor).is_ok_and(|w| {
-                        clear_layering(&w, &starts, &near, &h, exempt, &params).is_ok()
+                // The largest share of today's spread whose spiral clears.
+                let (lo, hi, ok) = largest_share(&heights, 12, |h| {
+                    VesselPlan::choose(h, &params, floor).is_ok_and(|w| {
+                        clear_layering(&w, &starts, &near, h, exempt, &params).is_ok()
                     })
-                };
-                let (mut ok, mut bad) = (0.0, 1.0);
-                for _ in 0..12 {
-                    let mid = 0.5 * (ok + bad);
-                    if clears(mid) {
-                        ok = mid;
-                    } else {
-                        bad = mid;
-                    }
-                }
+                });
                 let c = &columns[i];
                 let mut v = least;
                 v.uneven = Some(crate::vessel::Uneven {

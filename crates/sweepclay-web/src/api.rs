@@ -569,16 +569,8 @@ pub struct MeshImport {
 /// up (`up`: 0 x, 1 y, 2 z), takes its units, and fits it by a design.
 pub fn import_mesh(name: &str, bytes: &[u8], up: usize) -> Result<MeshImport, ApiError> {
     use sweepclay_core::meshfit;
-    let mut mesh = sweepclay_core::meshread::TriMesh::read(name, bytes)?;
-    mesh.stand_up(up);
-    let (k, note) = meshfit::units(&mesh, None)?;
-    mesh.scale(k);
-    let stem = name.rsplit_once('.').map_or(name, |(s, _)| s).to_string();
-    let opts = meshfit::FitOptions {
-        name: stem,
-        ..meshfit::FitOptions::default()
-    };
-    let f = meshfit::fit(&mesh, &opts)?;
+    let m = meshfit::import(name, bytes, up, None, &meshfit::FitOptions::default())?;
+    let f = m.fitted;
     let design = serde_json::from_str(&f.design.to_json())
         .map_err(|e| ApiError::new(500, format!("the fitted design: {e}")))?;
     Ok(MeshImport {
@@ -586,8 +578,8 @@ pub fn import_mesh(name: &str, bytes: &[u8], up: usize) -> Result<MeshImport, Ap
         deviation_mm: f.deviation_mm,
         at: f.at,
         kind: f.kind,
-        triangles: mesh.triangles.len(),
-        note,
+        triangles: m.triangles,
+        note: m.units_note,
     })
 }
 

@@ -235,6 +235,23 @@ async fn error_text(c: &Client, what: &str) -> Value {
     .await
 }
 
+/// Clicks "Edit printer…" and waits for its dialog.
+async fn open_printer_dialog(c: &Client) {
+    click(c, "printer-edit").await;
+    wait_js(
+        c,
+        "return document.getElementById('printer-dialog').open",
+        "the printer dialog",
+    )
+    .await;
+}
+
+/// Ends a browser test: the page logged no error, and the browser closes.
+async fn no_page_errors_and_close(c: Client) {
+    assert_eq!(js(&c, "return window.sweepclayErrors").await, json!([]));
+    c.close().await.unwrap();
+}
+
 /// Whether the verdict says printable.
 const PRINTABLE: &str = "return document.getElementById('verdict').dataset.printable === 'true'";
 
@@ -710,8 +727,7 @@ async fn draw_preview_and_download_verified_gcode() {
         std::fs::write(&path, c.screenshot().await.unwrap()).unwrap();
         eprintln!("reshaped screenshot written to {path}");
     }
-    assert_eq!(js(&c, "return window.sweepclayErrors").await, json!([]));
-    c.close().await.unwrap();
+    no_page_errors_and_close(c).await;
 }
 
 /// A server for one test: `SWEEPCLAY_URL`, or one in this process.
@@ -927,13 +943,7 @@ async fn truthful_state_imports_printers_and_phones() {
     assert_eq!(shown, json!([true, false, "false"]));
 
     // A custom printer, kept in the browser: big enough for t1.
-    click(&c, "printer-edit").await;
-    wait_js(
-        &c,
-        "return document.getElementById('printer-dialog').open",
-        "the printer dialog",
-    )
-    .await;
+    open_printer_dialog(&c).await;
     for (id, v) in [
         ("pr-name", "my big printer"),
         ("pr-bv0", "300"),
@@ -1128,8 +1138,7 @@ async fn truthful_state_imports_printers_and_phones() {
         5,
         "{b:?}"
     );
-    assert_eq!(js(&c, "return window.sweepclayErrors").await, json!([]));
-    c.close().await.unwrap();
+    no_page_errors_and_close(c).await;
 }
 
 /// The speed budget of docs/MODELER.md, measured (not a pass/fail timing:
@@ -1572,8 +1581,7 @@ async fn a_pot_on_a_phone_by_touch() {
     let printer = sweepclay_core::Printer::preset(printer.as_str().unwrap()).unwrap();
     let report = sweepclay_check::check(&text, &sweepclay_plan::printer_check(&printer));
     assert!(report.printable, "{:?}", report.failures);
-    assert_eq!(js(&c, "return window.sweepclayErrors").await, json!([]));
-    c.close().await.unwrap();
+    no_page_errors_and_close(c).await;
 }
 
 /// Issue 29's state defects at desktop size, each checked: two tabs keep
@@ -1779,8 +1787,7 @@ async fn tabs_views_and_printers_keep_the_truth() {
         "the example on the printer chosen",
     )
     .await;
-    assert_eq!(js(&c, "return window.sweepclayErrors").await, json!([]));
-    c.close().await.unwrap();
+    no_page_errors_and_close(c).await;
 }
 
 /// Issue 31 in the modeler: a texture added from the Surface panel, its
@@ -1858,8 +1865,7 @@ async fn a_texture_and_a_twist_are_added_and_their_gcode_prints() {
         kept.iter().filter(|&&k| k > 0.99).count() > kept.len() / 2,
         "the ripple is mostly kept whole"
     );
-    assert_eq!(js(&c, "return window.sweepclayErrors").await, json!([]));
-    c.close().await.unwrap();
+    no_page_errors_and_close(c).await;
 }
 
 /// The pot panel's rim control (docs/MODELER.md): a new pot's rim raised
@@ -1965,8 +1971,7 @@ async fn a_pot_gets_a_raised_back_from_the_rim_control() {
         (back - front - 30.0).abs() < 1.5,
         "back {back}, front {front}"
     );
-    assert_eq!(js(&c, "return window.sweepclayErrors").await, json!([]));
-    c.close().await.unwrap();
+    no_page_errors_and_close(c).await;
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
@@ -2133,8 +2138,7 @@ async fn the_page_previews_the_path_it_downloads_point_for_point() {
             poly.len()
         );
     }
-    assert_eq!(js(&c, "return window.sweepclayErrors").await, json!([]));
-    c.close().await.unwrap();
+    no_page_errors_and_close(c).await;
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
@@ -2191,8 +2195,7 @@ async fn a_mesh_opens_as_an_editable_design_and_downloads_its_gcode() {
     choose_file(&c, "open-file", &broken).await;
     let said = error_text(&c, "the broken mesh refused").await;
     assert!(said.as_str().unwrap().contains("has a hole"), "{said}");
-    assert_eq!(js(&c, "return window.sweepclayErrors").await, json!([]));
-    c.close().await.unwrap();
+    no_page_errors_and_close(c).await;
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
@@ -2226,13 +2229,7 @@ async fn fields_take_what_is_typed_or_say_why_beside_it() {
             "the preset chosen",
         )
         .await;
-        click(&c, "printer-edit").await;
-        wait_js(
-            &c,
-            "return document.getElementById('printer-dialog').open",
-            "the printer dialog",
-        )
-        .await;
+        open_printer_dialog(&c).await;
         click(&c, "pr-save").await;
         let saved = wait_js(
             &c,
@@ -2418,6 +2415,5 @@ async fn fields_take_what_is_typed_or_say_why_beside_it() {
         ),
         "{said}"
     );
-    assert_eq!(js(&c, "return window.sweepclayErrors").await, json!([]));
-    c.close().await.unwrap();
+    no_page_errors_and_close(c).await;
 }
