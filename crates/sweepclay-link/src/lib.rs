@@ -1,0 +1,444 @@
+//! The printer link: sends a checked G-code file to the machine's print
+//! host and follows the print (docs/PRINTING.md).
+//!
+//! Three hosts, the ones clay printers sit behind: OctoPrint (Marlin
+//! machines such as Eazao's on a Raspberry Pi), Klipper's Moonraker, and
+//! RepRapFirmware's own web server (Duet boards). Each speaks its published
+//! HTTP API; [`Link`] gives the same four verbs over all three: upload,
+//! start, status and list. Every failure a potter can meet is one
+//! [`LinkError`] with one plain sentence: a wrong key, an unreachable host,
+//! a full card, a printer busy printing or not connected.
+//!
+//! This crate knows nothing of the pipeline or the checker: the CLI and the
+//! server check a file before they hand it here. Secrets (API keys,
+//! passwords) never live in a printer profile or a design: [`keys`] keeps
+//! them in the user's configuration directory.
+
+pub mod keys;
+mod moonraker;
+mod octoprint;
+mod reprap;
+
+use serde::Serialize;
+use std::fmt;
+use std::time::Duration;
+
+/// Which print host a printer sits behind.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum Kind {
+    /// OctoPrint (`/api/files/local`, `X-Api-Key`).
+    OctoPrint,
+    /// Klipper's Moonraker (`/server/files/upload`, optional `X-Api-Key`).
+    Moonraker,
+    /// RepRapFirmware's web server in standalone mode (`rr_connect`,
+    /// `rr_upload`, `M32`).
+    RepRap,
+}
+
+impl Kind {
+    /// The name a printer profile uses for it.
+    pub fn name(self) -> &'static str {
+        match self {
+            Kind::OctoPrint => "octoprint",
+            Kind::Moonraker => "moonraker",
+            Kind::RepRap => "reprap",
+        }
+    }
+
+    /// What the potter calls it, in messages.
+    fn title(self) -> &'static str {
+        match self {
+            Kind::OctoPrint => "OctoPrint",
+            Kind::Moonraker => "Moonraker",
+            Kind::RepRap => "the Duet (RepRapFirmware)",
+        }
+    }
+
+    /// The kind a profile names, if it is one.
+    pub fn from_name(name: &str) -> Option<Kind> {
+        [Kind::OctoPrint, Kind::Moonraker, Kind::RepRap]
+            .into_iter()
+            .find(|k| k.name() == name)
+    }
+}
+
+impl fmt::Display for Kind {
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.write_str(self.name())
+    }
+}
+
+/// Why talking to a print host failed, each in one plain sentence.
+#[derive(Debug, thiserror::Error, PartialEq)]
+pub enum LinkError {
+    /// The address is not one the link can use.
+    #[error("print host address `{url}`: {why}")]
+    Address {
+        /// The address as given.
+        url: String,
+        /// What is wrong with it.
+        why: String,
+    },
+    /// Nothing answered (off, another network, a wrong address or port).
+    #[error("cannot reach {host} at {url}: {why}; is it switched on and on this network, and is the address right?")]
+    Unreachable {
+        /// The host's name in messages.
+        host: &'static str,
+        /// Its address.
+        url: String,
+        /// What the network said.
+        why: String,
+    },
+    /// The key or password was refused.
+    #[error("{host} refused the {what}: copy it again from {host}'s settings (`sweepclay send --save-key`, or the printer dialog)")]
+    WrongKey {
+        /// The host's name in messages.
+        host: &'static str,
+        /// "API key" or "password".
+        what: &'static str,
+    },
+    /// The host has no room for the file.
+    #[error("{host} has no room for the file: delete old prints from its storage (SD card) and send again")]
+    Full {
+        /// The host's name in messages.
+        host: &'static str,
+    },
+    /// The printer is printing (or paused in a print).
+    #[error("the printer is busy printing `{file}`: wait for it to finish, or stop it on the printer, then start the new file")]
+    Busy {
+        /// The file it is printing, as the host names it.
+        file: String,
+    },
+    /// The host runs but the printer is not connected to it.
+    #[error("{host} is running but the printer is not connected to it ({state}): connect the printer there, then start the file")]
+    NotConnected {
+        /// The host's name in messages.
+        host: &'static str,
+        /// The state the host reports.
+        state: String,
+    },
+    /// Any other refusal, with the host's own words.
+    #[error("{host} refused: HTTP {status}: {message}")]
+    Refused {
+        /// The host's name in messages.
+        host: &'static str,
+        /// The HTTP status.
+        status: u16,
+        /// The host's message, shortened.
+        message: String,
+    },
+    /// An answer that is not the host's API (another program on the port).
+    #[error("{host} at {url} answered something that is not its API ({why}): is the kind right?")]
+    BadAnswer {
+        /// The host's name in messages.
+        host: &'static str,
+        /// Its address.
+        url: String,
+        /// What was wrong.
+        why: String,
+    },
+}
+
+/// What the host says the printer is doing.
+#[derive(Clone, Debug, PartialEq, Serialize)]
+pub struct Status {
+    /// The state in the host's own word ("Printing", "standby",
+    /// "processing", …).
+    pub state: String,
+    /// Whether a print is under way (printing, paused or finishing).
+    pub printing: bool,
+    /// Whether the printer is connected and ready or busy (not offline or
+    /// in error).
+    pub connected: bool,
+    /// The file selected or printing, if any.
+    pub file: Option<String>,
+    /// How far through the file, 0 to 1, where the host reports it.
+    pub progress: Option<f64>,
+}
+
+/// How long a connection may take to open.
+const CONNECT: Duration = Duration::from_secs(5);
+/// How long a short request (status, start, list) may take.
+const SHORT: Duration = Duration::from_secs(15);
+/// How long an upload may take: 100 MB over a slow Wi-Fi link.
+const UPLOAD: Duration = Duration::from_secs(600);
+/// The most of a host's error text a message quotes.
+const QUOTE: usize = 200;
+
+/// A print host: its kind, address and secret.
+#[derive(Clone)]
+pub struct Link {
+    kind: Kind,
+    base: reqwest::Url,
+    secret: Option<String>,
+    http: reqwest::Client,
+}
+
+impl fmt::Debug for Link {
+    // The secret stays out of logs and panics.
+    fn fmt(&self, f: &mut fmt::Formatter<'_>) -> fmt::Result {
+        f.debug_struct("Link")
+            .field("kind", &self.kind)
+            .field("base", &self.base.as_str())
+            .field("secret", &self.secret.as_ref().map(|_| "…"))
+            .finish()
+    }
+}
+
+/// The address as the keys file and messages spell it: no trailing slash.
+pub fn normalize_url(url: &str) -> String {
+    url.trim().trim_end_matches('/').to_string()
+}
+
+/// Checks a print host address: plain `http://` with a host name or IP
+/// address and optionally a port and path, no user name or password in it.
+pub fn check_url(url: &str) -> Result<reqwest::Url, LinkError> {
+    let bad = |why: &str| LinkError::Address {
+        url: url.to_string(),
+        why: why.to_string(),
+    };
+    let u = reqwest::Url::parse(&normalize_url(url))
+        .map_err(|e| bad(&format!("not an address ({e}); write it as http://octopi.local")))?;
+    match u.scheme() {
+        "http" => {}
+        "https" => return Err(bad("sweepclay talks plain http:// to printers on the studio's network; use the host's http:// address")),
+        s => return Err(bad(&format!("`{s}:` is no web address; write it as http://octopi.local"))),
+    }
+    if u.host_str().is_none_or(str::is_empty) {
+        return Err(bad("no host name"));
+    }
+    if !u.username().is_empty() || u.password().is_some() {
+        return Err(bad(
+            "a user name or password in the address would be saved with the printer; give the key or password separately",
+        ));
+    }
+    if u.query().is_some() || u.fragment().is_some() {
+        return Err(bad("no `?` or `#` part, only the host, port and path"));
+    }
+    Ok(u)
+}
+
+impl Link {
+    /// A link to the host at `url` with its API key or password, if it
+    /// needs one.
+    pub fn new(kind: Kind, url: &str, secret: Option<String>) -> Result<Link, LinkError> {
+        let mut base = check_url(url)?;
+        if !base.path().ends_with('/') {
+            base.set_path(&format!("{}/", base.path()));
+        }
+        let http = reqwest::Client::builder()
+            .connect_timeout(CONNECT)
+            // Printers sit on the local network: no system proxy.
+            .no_proxy()
+            .build()
+            .map_err(|e| LinkError::Address {
+                url: url.to_string(),
+                why: e.to_string(),
+            })?;
+        Ok(Link {
+            kind,
+            base,
+            secret: secret.filter(|s| !s.is_empty()),
+            http,
+        })
+    }
+
+    /// The host's kind.
+    pub fn kind(&self) -> Kind {
+        self.kind
+    }
+
+    /// The host's address, without a trailing slash.
+    pub fn url(&self) -> String {
+        normalize_url(self.base.as_str())
+    }
+
+    /// Uploads `gcode` as `name` (a file name, `.gcode` added if missing)
+    /// and returns the name the host stored it under.
+    pub async fn upload(&self, name: &str, gcode: Vec<u8>) -> Result<String, LinkError> {
+        let name = file_name(name);
+        match self.kind {
+            Kind::OctoPrint => octoprint::upload(self, &name, gcode).await,
+            Kind::Moonraker => moonraker::upload(self, &name, gcode).await,
+            Kind::RepRap => reprap::upload(self, &name, gcode).await,
+        }
+    }
+
+    /// Starts printing a file the host holds (the name [`Link::upload`]
+    /// returned). Refused if the printer is busy or not connected.
+    pub async fn start(&self, file: &str) -> Result<(), LinkError> {
+        match self.kind {
+            Kind::OctoPrint => octoprint::start(self, file).await,
+            Kind::Moonraker => moonraker::start(self, file).await,
+            Kind::RepRap => reprap::start(self, file).await,
+        }
+    }
+
+    /// What the printer is doing.
+    pub async fn status(&self) -> Result<Status, LinkError> {
+        match self.kind {
+            Kind::OctoPrint => octoprint::status(self).await,
+            Kind::Moonraker => moonraker::status(self).await,
+            Kind::RepRap => reprap::status(self).await,
+        }
+    }
+
+    /// The G-code files the host holds.
+    pub async fn files(&self) -> Result<Vec<String>, LinkError> {
+        match self.kind {
+            Kind::OctoPrint => octoprint::files(self).await,
+            Kind::Moonraker => moonraker::files(self).await,
+            Kind::RepRap => reprap::files(self).await,
+        }
+    }
+
+    /// The address of `path` under the host's base.
+    fn at(&self, path: &str) -> reqwest::Url {
+        // The base ends in `/` and `path` is relative: join cannot fail.
+        self.base
+            .join(path)
+            .unwrap_or_else(|_| self.base.clone())
+    }
+
+    /// Sends a request; a failure to connect is [`LinkError::Unreachable`].
+    async fn send(
+        &self,
+        req: reqwest::RequestBuilder,
+        timeout: Duration,
+    ) -> Result<reqwest::Response, LinkError> {
+        req.timeout(timeout).send().await.map_err(|e| {
+            let why = if e.is_timeout() {
+                format!("no answer within {} s", timeout.as_secs())
+            } else if e.is_connect() {
+                "the connection was refused or timed out".to_string()
+            } else {
+                plain(&e)
+            };
+            LinkError::Unreachable {
+                host: self.kind.title(),
+                url: self.url(),
+                why,
+            }
+        })
+    }
+
+    /// A JSON answer, or [`LinkError::BadAnswer`].
+    async fn json(&self, resp: reqwest::Response) -> Result<serde_json::Value, LinkError> {
+        let text = resp.text().await.map_err(|e| self.bad(plain(&e)))?;
+        serde_json::from_str(&text).map_err(|_| self.bad(format!("not JSON: {}", quote(&text))))
+    }
+
+    fn bad(&self, why: String) -> LinkError {
+        LinkError::BadAnswer {
+            host: self.kind.title(),
+            url: self.url(),
+            why,
+        }
+    }
+
+    fn refused(&self, status: u16, message: &str) -> LinkError {
+        LinkError::Refused {
+            host: self.kind.title(),
+            status,
+            message: quote(message),
+        }
+    }
+}
+
+/// A file name the hosts store as G-code: no folders, `.gcode` at the end.
+fn file_name(name: &str) -> String {
+    let base = name.rsplit(['/', '\\']).next().unwrap_or(name);
+    let clean: String = base
+        .chars()
+        .map(|c| if c.is_control() || c == '"' { '_' } else { c })
+        .collect();
+    let clean = if clean.trim().is_empty() {
+        "sweepclay".to_string()
+    } else {
+        clean
+    };
+    let lower = clean.to_ascii_lowercase();
+    if lower.ends_with(".gcode") || lower.ends_with(".g") || lower.ends_with(".gco") {
+        clean
+    } else {
+        format!("{clean}.gcode")
+    }
+}
+
+/// An error's words and its causes', without the URL (which may carry a
+/// password in a query).
+fn plain(e: &reqwest::Error) -> String {
+    let mut s = match e.url() {
+        Some(u) => e.to_string().replace(&format!(" ({u})"), ""),
+        None => e.to_string(),
+    };
+    let mut src = std::error::Error::source(e);
+    while let Some(c) = src {
+        s.push_str(": ");
+        s.push_str(&c.to_string());
+        src = c.source();
+    }
+    s
+}
+
+/// At most [`QUOTE`] characters of a host's text, on one line.
+fn quote(text: &str) -> String {
+    let one: String = text.split_whitespace().collect::<Vec<_>>().join(" ");
+    match one.char_indices().nth(QUOTE) {
+        Some((i, _)) => format!("{}…", &one[..i]),
+        None => one,
+    }
+}
+
+/// Whether a host's error text says its storage is full.
+fn says_full(text: &str) -> bool {
+    let t = text.to_ascii_lowercase();
+    t.contains("no space") || t.contains("disk full") || t.contains("not enough space")
+        || t.contains("insufficient storage") || t.contains("enospc")
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    #[test]
+    fn addresses_are_plain_http_without_credentials() {
+        assert!(check_url("http://octopi.local").is_ok());
+        assert!(check_url("http://192.168.1.20:7125/").is_ok());
+        for (url, says) in [
+            ("https://octopi.local", "plain http://"),
+            ("octopi.local", "not an address"),
+            ("ftp://octopi.local", "no web address"),
+            ("http://pi:raspberry@octopi.local", "user name or password"),
+            ("http://octopi.local/?apikey=1", "no `?`"),
+        ] {
+            let e = check_url(url).unwrap_err().to_string();
+            assert!(e.contains(says), "{url}: {e}");
+        }
+    }
+
+    #[test]
+    fn file_names_lose_folders_and_gain_gcode() {
+        assert_eq!(file_name("/tmp/pot.gcode"), "pot.gcode");
+        assert_eq!(file_name("C:\\pots\\vase"), "vase.gcode");
+        assert_eq!(file_name("a\"b.GCODE"), "a_b.GCODE");
+        assert_eq!(file_name(""), "sweepclay.gcode");
+    }
+
+    #[test]
+    fn a_links_debug_form_hides_its_secret() {
+        let l = Link::new(Kind::OctoPrint, "http://octopi.local", Some("SECRET".into())).unwrap();
+        let s = format!("{l:?}");
+        assert!(!s.contains("SECRET") && s.contains("octopi.local"), "{s}");
+    }
+
+    #[test]
+    fn host_quotes_are_short_and_one_line() {
+        let long = "x ".repeat(500);
+        let q = quote(&long);
+        assert!(q.chars().count() <= QUOTE + 1 && !q.contains('\n'));
+        assert!(says_full("OSError: [Errno 28] No space left on device"));
+        assert!(!says_full("File not found"));
+    }
+}
