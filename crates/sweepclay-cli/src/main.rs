@@ -9,6 +9,9 @@ use sweepclay_check::{check_reader, CheckConfig};
 use sweepclay_core::{examples, printer::PRESETS, Design, Printer, PrinterRef};
 use sweepclay_plan::{plan, printer_check, Cancel, Checked, Job, Unchecked};
 
+mod calibrate;
+mod send;
+
 /// mimalloc keeps freed pages for reuse; glibc's allocator returns large
 /// blocks to the system and faults them in again, which cost a third of
 /// the time of slicing a 44k-sample design (docs/PERFORMANCE.md).
@@ -58,6 +61,14 @@ enum Command {
     /// Start the modeler: a local web page to draw, preview and print
     /// designs. Prints its URL; Ctrl+C stops it.
     Serve(ServeArgs),
+    /// Send a G-code file to the printer's print host (OctoPrint,
+    /// Moonraker or a Duet), after checking it; optionally start it and
+    /// follow the print (docs/PRINTING.md).
+    Send(send::SendArgs),
+    /// Write a calibration print, or compute E per mm³ from the walls
+    /// measured on it and save it to the printer profile
+    /// (docs/CALIBRATION.md).
+    Calibrate(calibrate::CalibrateArgs),
     /// List the printer presets: build volume, bed, extruder body,
     /// motion limits and cartridge (`--json` for every value).
     Printers {
@@ -312,6 +323,8 @@ fn run(cli: Cli) -> Result<i32> {
         Command::Check(a) => check_cmd(a),
         Command::Import(a) => import_cmd(a),
         Command::Serve(a) => serve(a),
+        Command::Send(a) => send::run(a),
+        Command::Calibrate(a) => calibrate::run(a),
         Command::Printers { json } => {
             let all: Vec<Printer> = PRESETS.iter().filter_map(|n| Printer::preset(n)).collect();
             if json {
@@ -362,6 +375,7 @@ fn run(cli: Cli) -> Result<i32> {
     }
 }
 
+/// A preset by name, or a printer JSON file.
 fn load_printer(spec: &str) -> Result<Printer> {
     if let Some(p) = Printer::preset(spec) {
         return Ok(p);
@@ -821,10 +835,11 @@ fn token_required(ip: std::net::IpAddr) -> bool {
     !ip.is_loopback()
 }
 
-fn check_cmd(a: CheckArgs) -> Result<i32> {
-    let open =
-        || std::fs::File::open(&a.file).with_context(|| format!("reading {}", a.file.display()));
-    let base = match &a.printer {
+/// The check's configuration for `file`: the printer named, else the one
+/// a sweepclay file's header names, else generic.
+fn base_check_config(file: &Path, printer: Option<&str>) -> Result<CheckConfig> {
+    let open = || std::fs::File::open(file).with_context(|| format!("reading {}", file.display()));
+    Ok(match printer {
         Some(name) => {
             let p = load_printer(name)?;
             CheckConfig {
@@ -852,7 +867,13 @@ fn check_cmd(a: CheckArgs) -> Result<i32> {
                     ..CheckConfig::default()
                 })
         }
-    };
+    })
+}
+
+fn check_cmd(a: CheckArgs) -> Result<i32> {
+    let open =
+        || std::fs::File::open(&a.file).with_context(|| format!("reading {}", a.file.display()));
+    let base = base_check_config(&a.file, a.printer.as_deref())?;
     let cfg = CheckConfig {
         firmware: a.firmware,
         nozzle_height: a.nozzle_height.unwrap_or(base.nozzle_height),

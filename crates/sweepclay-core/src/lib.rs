@@ -42,6 +42,7 @@
 
 pub mod beads;
 pub mod bspline;
+pub mod calibrate;
 pub mod correct;
 pub mod curves;
 pub mod design;

@@ -66,6 +66,77 @@ pub struct Printer {
     pub start_gcode: String,
     /// G-code sent after the last move.
     pub end_gcode: String,
+    /// The print host the machine sits behind, for `sweepclay send` and
+    /// the modeler's "Send to printer" (docs/PRINTING.md). Its key or
+    /// password is never part of the profile. Omitted: none.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub host: Option<PrintHost>,
+}
+
+/// Which print host software a printer sits behind.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, Serialize, Deserialize)]
+#[serde(rename_all = "lowercase")]
+pub enum HostKind {
+    /// OctoPrint (Marlin machines on a Raspberry Pi).
+    Octoprint,
+    /// Klipper's Moonraker.
+    Moonraker,
+    /// RepRapFirmware's own web server (Duet boards).
+    Reprap,
+}
+
+impl HostKind {
+    /// The name a profile spells it with.
+    pub fn name(self) -> &'static str {
+        match self {
+            HostKind::Octoprint => "octoprint",
+            HostKind::Moonraker => "moonraker",
+            HostKind::Reprap => "reprap",
+        }
+    }
+}
+
+/// A print host: its kind and its plain `http://` address on the studio's
+/// network, e.g. `{"kind": "octoprint", "url": "http://octopi.local"}`.
+#[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
+#[serde(deny_unknown_fields)]
+pub struct PrintHost {
+    /// The host software.
+    pub kind: HostKind,
+    /// Its address: `http://` a host name or IP address, an optional port
+    /// and path; no user name or password in it.
+    pub url: String,
+}
+
+impl PrintHost {
+    /// Checks the address's form; `key` names the field in messages.
+    pub fn validate(&self, key: &str) -> Result<()> {
+        let why = if !self.url.starts_with("http://") {
+            Some("must start with http:// (e.g. http://octopi.local); printers on the studio's network speak plain HTTP")
+        } else if self.url["http://".len()..]
+            .split('/')
+            .next()
+            .is_none_or(str::is_empty)
+        {
+            Some("has no host name after http://")
+        } else if self.url.contains('@') {
+            Some("must not carry a user name or password; the key is kept apart (docs/PRINTING.md)")
+        } else if self.url.contains(['?', '#', ' ']) || self.url.len() > 2048 {
+            Some("must be only the host, port and path")
+        } else {
+            None
+        };
+        match why {
+            Some(w) => Err(Error::invalid(
+                format!("{key}.url"),
+                format!(
+                    "{w} (got `{}`)",
+                    self.url.chars().take(80).collect::<String>()
+                ),
+            )),
+            None => Ok(()),
+        }
+    }
 }
 
 impl Default for Printer {
@@ -89,6 +160,7 @@ impl Default for Printer {
             cartridge_ml: None,
             start_gcode: "G28 ; home all axes\nG92 E0\n".into(),
             end_gcode: "M84 ; motors off\n".into(),
+            host: None,
         }
     }
 }
@@ -354,6 +426,9 @@ impl Printer {
         }
         if let Some(c) = self.cartridge_ml {
             positive(&format!("{key}.cartridge_ml"), c)?;
+        }
+        if let Some(h) = &self.host {
+            h.validate(&format!("{key}.host"))?;
         }
         if let Some(relative) = extrusion_mode(&self.start_gcode) {
             if relative != self.relative_e {

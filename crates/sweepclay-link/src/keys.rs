@@ -20,7 +20,11 @@ const MAX_BYTES: u64 = 1 << 20;
 
 /// The configuration directory, from the environment.
 pub fn config_dir() -> Option<PathBuf> {
-    let env = |k: &str| std::env::var_os(k).filter(|v| !v.is_empty()).map(PathBuf::from);
+    let env = |k: &str| {
+        std::env::var_os(k)
+            .filter(|v| !v.is_empty())
+            .map(PathBuf::from)
+    };
     env("SWEEPCLAY_CONFIG_DIR")
         .or_else(|| env("XDG_CONFIG_HOME").map(|d| d.join("sweepclay")))
         .or_else(|| env("HOME").map(|h| h.join(".config").join("sweepclay")))
@@ -76,7 +80,8 @@ pub fn save(path: &Path, url: &str, key: &str) -> Result<(), String> {
     let dir = path.parent().unwrap_or(Path::new("."));
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     // tempfile creates its files 0600 on Unix.
-    let mut tmp = tempfile::NamedTempFile::new_in(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let mut tmp =
+        tempfile::NamedTempFile::new_in(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
     let text = serde_json::to_string_pretty(&keys).map_err(|e| e.to_string())?;
     tmp.write_all(text.as_bytes())
         .and_then(|_| tmp.as_file().sync_all())
@@ -98,7 +103,10 @@ mod tests {
         save(&path, "http://octopi.local/", "K1").unwrap();
         save(&path, "http://duet.local", "K2").unwrap();
         let keys = read(&path).unwrap();
-        assert_eq!(keys.get("http://octopi.local").map(String::as_str), Some("K1"));
+        assert_eq!(
+            keys.get("http://octopi.local").map(String::as_str),
+            Some("K1")
+        );
         #[cfg(unix)]
         {
             use std::os::unix::fs::PermissionsExt;

@@ -198,8 +198,11 @@ pub fn check_url(url: &str) -> Result<reqwest::Url, LinkError> {
         url: url.to_string(),
         why: why.to_string(),
     };
-    let u = reqwest::Url::parse(&normalize_url(url))
-        .map_err(|e| bad(&format!("not an address ({e}); write it as http://octopi.local")))?;
+    let u = reqwest::Url::parse(&normalize_url(url)).map_err(|e| {
+        bad(&format!(
+            "not an address ({e}); write it as http://octopi.local"
+        ))
+    })?;
     match u.scheme() {
         "http" => {}
         "https" => return Err(bad("sweepclay talks plain http:// to printers on the studio's network; use the host's http:// address")),
@@ -296,9 +299,7 @@ impl Link {
     /// The address of `path` under the host's base.
     fn at(&self, path: &str) -> reqwest::Url {
         // The base ends in `/` and `path` is relative: join cannot fail.
-        self.base
-            .join(path)
-            .unwrap_or_else(|_| self.base.clone())
+        self.base.join(path).unwrap_or_else(|_| self.base.clone())
     }
 
     /// Sends a request; a failure to connect is [`LinkError::Unreachable`].
@@ -394,8 +395,11 @@ fn quote(text: &str) -> String {
 /// Whether a host's error text says its storage is full.
 fn says_full(text: &str) -> bool {
     let t = text.to_ascii_lowercase();
-    t.contains("no space") || t.contains("disk full") || t.contains("not enough space")
-        || t.contains("insufficient storage") || t.contains("enospc")
+    t.contains("no space")
+        || t.contains("disk full")
+        || t.contains("not enough space")
+        || t.contains("insufficient storage")
+        || t.contains("enospc")
 }
 
 #[cfg(test)]
@@ -428,7 +432,12 @@ mod tests {
 
     #[test]
     fn a_links_debug_form_hides_its_secret() {
-        let l = Link::new(Kind::OctoPrint, "http://octopi.local", Some("SECRET".into())).unwrap();
+        let l = Link::new(
+            Kind::OctoPrint,
+            "http://octopi.local",
+            Some("SECRET".into()),
+        )
+        .unwrap();
         let s = format!("{l:?}");
         assert!(!s.contains("SECRET") && s.contains("octopi.local"), "{s}");
     }

@@ -21,7 +21,11 @@ fn with_key(link: &Link, req: reqwest::RequestBuilder) -> reqwest::RequestBuilde
 /// Whether Moonraker's message says Klipper is not there.
 fn says_no_klippy(text: &str) -> bool {
     let t = text.to_ascii_lowercase();
-    t.contains("klippy") && (t.contains("disconnect") || t.contains("not connected") || t.contains("not ready") || t.contains("shutdown"))
+    t.contains("klippy")
+        && (t.contains("disconnect")
+            || t.contains("not connected")
+            || t.contains("not ready")
+            || t.contains("shutdown"))
 }
 
 async fn failure(link: &Link, resp: reqwest::Response) -> LinkError {
@@ -85,8 +89,8 @@ pub(crate) async fn start(link: &Link, file: &str) -> Result<(), LinkError> {
             state: s.state,
         });
     }
-    let req = with_key(link, link.http.post(link.at("printer/print/start")))
-        .query(&[("filename", file)]);
+    let req =
+        with_key(link, link.http.post(link.at("printer/print/start"))).query(&[("filename", file)]);
     let resp = link.send(req, SHORT).await?;
     if !resp.status().is_success() {
         return Err(failure(link, resp).await);
@@ -163,8 +167,8 @@ pub(crate) async fn status(link: &Link) -> Result<Status, LinkError> {
 }
 
 pub(crate) async fn files(link: &Link) -> Result<Vec<String>, LinkError> {
-    let req = with_key(link, link.http.get(link.at("server/files/list")))
-        .query(&[("root", "gcodes")]);
+    let req =
+        with_key(link, link.http.get(link.at("server/files/list"))).query(&[("root", "gcodes")]);
     let resp = link.send(req, SHORT).await?;
     if !resp.status().is_success() {
         return Err(failure(link, resp).await);

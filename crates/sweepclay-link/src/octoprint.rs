@@ -165,8 +165,8 @@ pub(crate) async fn status(link: &Link) -> Result<Status, LinkError> {
 }
 
 pub(crate) async fn files(link: &Link) -> Result<Vec<String>, LinkError> {
-    let req = with_key(link, link.http.get(link.at("api/files/local")))
-        .query(&[("recursive", "true")]);
+    let req =
+        with_key(link, link.http.get(link.at("api/files/local"))).query(&[("recursive", "true")]);
     let resp = link.send(req, SHORT).await?;
     if !resp.status().is_success() {
         return Err(failure(link, resp, Doing::Upload).await);

@@ -244,10 +244,10 @@ pub(crate) async fn files(link: &Link) -> Result<Vec<String>, LinkError> {
         // The board pages long listings: `next` is where the next starts, 0
         // at the end. At most 100 pages.
         for _ in 0..100 {
-            let req = link.http.get(link.at("rr_filelist")).query(&[
-                ("dir", GCODES.to_string()),
-                ("first", first.to_string()),
-            ]);
+            let req = link
+                .http
+                .get(link.at("rr_filelist"))
+                .query(&[("dir", GCODES.to_string()), ("first", first.to_string())]);
             let v = answer(link, link.send(with_session(req, s), SHORT).await?).await?;
             let files = v
                 .get("files")

@@ -42,13 +42,22 @@ async fn octoprint_takes_the_file_prints_it_and_names_each_failure() {
 
     // A wrong key is one plain message, on every verb.
     let wrong = Link::new(Kind::OctoPrint, &server.url, Some("WRONG".into())).unwrap();
-    let e = wrong.upload("pot", g.clone().into_bytes()).await.unwrap_err();
+    let e = wrong
+        .upload("pot", g.clone().into_bytes())
+        .await
+        .unwrap_err();
     assert!(matches!(e, LinkError::WrongKey { .. }), "{e}");
     assert!(e.to_string().contains("refused the API key"), "{e}");
-    assert!(matches!(wrong.status().await, Err(LinkError::WrongKey { .. })));
+    assert!(matches!(
+        wrong.status().await,
+        Err(LinkError::WrongKey { .. })
+    ));
 
     let link = Link::new(Kind::OctoPrint, &server.url, Some(server.key.clone())).unwrap();
-    let stored = link.upload("/some/where/pot", g.clone().into_bytes()).await.unwrap();
+    let stored = link
+        .upload("/some/where/pot", g.clone().into_bytes())
+        .await
+        .unwrap();
     assert_eq!(stored, "pot.gcode");
     assert!(link.files().await.unwrap().contains(&stored));
     let s = link.status().await.unwrap();
@@ -97,7 +106,10 @@ async fn moonraker_takes_and_lists_the_file_and_says_klipper_is_missing() {
     };
     let link = Link::new(Kind::Moonraker, &server.url, None).unwrap();
     let g = small_gcode();
-    let stored = link.upload("pot.gcode", g.clone().into_bytes()).await.unwrap();
+    let stored = link
+        .upload("pot.gcode", g.clone().into_bytes())
+        .await
+        .unwrap();
     assert_eq!(stored, "pot.gcode");
     assert!(link.files().await.unwrap().contains(&stored));
     let on_disk = std::fs::read_to_string(server.dir.join("gcodes").join("pot.gcode")).unwrap();

@@ -59,13 +59,18 @@ async fn connect(State(s): State<Shared>, Query(q): Q) -> Json<Value> {
     }
     let key = format!("{}", 1000 + b.sessions.len());
     b.sessions.push(key.clone());
-    Json(json!({"err": 0, "sessionTimeout": 8000, "boardType": "duet3mb6hc", "apiLevel": 1,
-                "sessionKey": key.parse::<u32>().unwrap()}))
+    Json(
+        json!({"err": 0, "sessionTimeout": 8000, "boardType": "duet3mb6hc", "apiLevel": 1,
+                "sessionKey": key.parse::<u32>().unwrap()}),
+    )
 }
 
 async fn disconnect(State(s): State<Shared>, h: HeaderMap) -> Json<Value> {
     let mut b = s.lock().unwrap();
-    let key = h.get("X-Session-Key").and_then(|k| k.to_str().ok()).unwrap_or("");
+    let key = h
+        .get("X-Session-Key")
+        .and_then(|k| k.to_str().ok())
+        .unwrap_or("");
     b.sessions.retain(|s| s != key);
     Json(json!({"err": 0}))
 }
@@ -87,18 +92,32 @@ async fn upload(
     Ok(Json(json!({"err": 0})))
 }
 
-async fn gcode(State(s): State<Shared>, h: HeaderMap, Query(q): Q) -> Result<Json<Value>, StatusCode> {
+async fn gcode(
+    State(s): State<Shared>,
+    h: HeaderMap,
+    Query(q): Q,
+) -> Result<Json<Value>, StatusCode> {
     let mut b = s.lock().unwrap();
     session(&b, &h)?;
     b.log.push(format!("rr_gcode {}", q["gcode"]));
-    if let Some(file) = q["gcode"].strip_prefix("M32 \"").and_then(|f| f.strip_suffix('"')) {
-        assert!(b.files.contains_key(file), "M32 of a file the board lacks: {file}");
+    if let Some(file) = q["gcode"]
+        .strip_prefix("M32 \"")
+        .and_then(|f| f.strip_suffix('"'))
+    {
+        assert!(
+            b.files.contains_key(file),
+            "M32 of a file the board lacks: {file}"
+        );
         b.printing = Some((file.to_string(), 0));
     }
     Ok(Json(json!({"buff": 255})))
 }
 
-async fn model(State(s): State<Shared>, h: HeaderMap, Query(q): Q) -> Result<Json<Value>, StatusCode> {
+async fn model(
+    State(s): State<Shared>,
+    h: HeaderMap,
+    Query(q): Q,
+) -> Result<Json<Value>, StatusCode> {
     let mut b = s.lock().unwrap();
     session(&b, &h)?;
     let printing = b.printing.clone();
@@ -122,17 +141,25 @@ async fn model(State(s): State<Shared>, h: HeaderMap, Query(q): Q) -> Result<Jso
     }))
 }
 
-async fn filelist(State(s): State<Shared>, h: HeaderMap, Query(q): Q) -> Result<Json<Value>, StatusCode> {
+async fn filelist(
+    State(s): State<Shared>,
+    h: HeaderMap,
+    Query(q): Q,
+) -> Result<Json<Value>, StatusCode> {
     let b = s.lock().unwrap();
     session(&b, &h)?;
     assert_eq!(q["dir"], "0:/gcodes");
     let files: Vec<Value> = b
         .files
         .keys()
-        .map(|k| json!({"type": "f", "name": k.trim_start_matches("0:/gcodes/"), "size": 1,
-                        "date": "2026-12-04T10:00:00"}))
+        .map(|k| {
+            json!({"type": "f", "name": k.trim_start_matches("0:/gcodes/"), "size": 1,
+                        "date": "2026-12-04T10:00:00"})
+        })
         .collect();
-    Ok(Json(json!({"dir": "0:/gcodes", "first": 0, "files": files, "next": 0})))
+    Ok(Json(
+        json!({"dir": "0:/gcodes", "first": 0, "files": files, "next": 0}),
+    ))
 }
 
 async fn board(password: &str) -> (String, Shared) {
@@ -168,16 +195,32 @@ async fn a_duet_gets_the_file_in_gcodes_starts_it_with_m32_and_reports_progress(
     assert_eq!(s.progress, Some(0.0));
     // Busy: a second start is refused, naming the file.
     let e = link.start(&stored).await.unwrap_err();
-    assert_eq!(e, LinkError::Busy { file: stored.clone() });
+    assert_eq!(
+        e,
+        LinkError::Busy {
+            file: stored.clone()
+        }
+    );
     // Two more reads and the stand-in has finished.
     let _ = link.status().await.unwrap();
     let s = link.status().await.unwrap();
     assert!(!s.printing, "{s:?}");
     let b = board.lock().unwrap();
     // Every session was closed again, and the requests had their forms.
-    assert!(b.sessions.is_empty(), "sessions left open: {:?}", b.sessions);
-    assert!(b.log.contains(&"rr_gcode M32 \"0:/gcodes/pot.gcode\"".to_string()), "{:?}", b.log);
-    assert!(b.log.contains(&"rr_upload name=0:/gcodes/pot.gcode".to_string()));
+    assert!(
+        b.sessions.is_empty(),
+        "sessions left open: {:?}",
+        b.sessions
+    );
+    assert!(
+        b.log
+            .contains(&"rr_gcode M32 \"0:/gcodes/pot.gcode\"".to_string()),
+        "{:?}",
+        b.log
+    );
+    assert!(b
+        .log
+        .contains(&"rr_upload name=0:/gcodes/pot.gcode".to_string()));
 }
 
 #[tokio::test]

@@ -70,14 +70,23 @@ fn wait(secs: u64, what: &str, log: &Path, mut ready: impl FnMut() -> bool) {
 fn get(url: &str, key: &str) -> Option<(u16, String)> {
     use std::io::{Read, Write};
     let rest = url.strip_prefix("http://")?;
-    let (host, path) = rest.split_once('/').map_or((rest, "/".to_string()), |(h, p)| (h, format!("/{p}")));
+    let (host, path) = rest
+        .split_once('/')
+        .map_or((rest, "/".to_string()), |(h, p)| (h, format!("/{p}")));
     let mut s = std::net::TcpStream::connect(host).ok()?;
     s.set_read_timeout(Some(Duration::from_secs(5))).ok()?;
-    write!(s, "GET {path} HTTP/1.0\r\nHost: {host}\r\nX-Api-Key: {key}\r\n\r\n").ok()?;
+    write!(
+        s,
+        "GET {path} HTTP/1.0\r\nHost: {host}\r\nX-Api-Key: {key}\r\n\r\n"
+    )
+    .ok()?;
     let mut out = String::new();
     s.read_to_string(&mut out).ok()?;
     let status = out.split_whitespace().nth(1)?.parse().ok()?;
-    let body = out.split_once("\r\n\r\n").map_or("", |(_, b)| b).to_string();
+    let body = out
+        .split_once("\r\n\r\n")
+        .map_or("", |(_, b)| b)
+        .to_string();
     Some((status, body))
 }
 
@@ -170,7 +179,8 @@ pub fn moonraker(dir: &Path) -> Option<Server> {
 /// The commands OctoPrint's virtual printer received, in order, as
 /// `serial.log` records them (`Send: N12 G1 X1*34` → `G1 X1`).
 pub fn received(server: &Server) -> Vec<String> {
-    let text = std::fs::read_to_string(server.dir.join("logs").join("serial.log")).unwrap_or_default();
+    let text =
+        std::fs::read_to_string(server.dir.join("logs").join("serial.log")).unwrap_or_default();
     text.lines()
         .filter_map(|l| l.split_once(" - Send: ").map(|(_, c)| c))
         .map(|c| {
