@@ -25,7 +25,7 @@ pub struct SendArgs {
     /// sweepclay file's header names, for the check].
     #[arg(long)]
     printer: Option<String>,
-    /// The print host's address, e.g. http://octopi.local (instead of the
+    /// The print host's address, e.g. `http://octopi.local` (instead of the
     /// printer's `host`).
     #[arg(long, value_name = "URL")]
     host: Option<String>,

@@ -2,7 +2,7 @@
 //! cubic millimetre of clay (`e_per_mm3`), found from one short print
 //! (docs/CALIBRATION.md).
 //!
-//! [`print`] writes a round cylinder laid as one spiral, in [`BANDS`]
+//! [`print()`] writes a round cylinder laid as one spiral, in [`BANDS`]
 //! bands whose beads carry known volumes per millimetre: the bead model of
 //! the pipeline (paper Fig. 5, the cuboid L · w · Δz) at widths from the
 //! narrowest to the widest bead. The potter measures each band's wall

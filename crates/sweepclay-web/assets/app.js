@@ -39,6 +39,8 @@ const PARAMS = [
 ];
 
 const state = {
+  /** The print just sent to the printer's host and being followed: { file, kind, url }. */
+  sending: null,
   // The curves as printed where the corrections moved them (showPrinted).
   printed: {},
   meta: null,
@@ -1686,6 +1688,9 @@ function openPrinter() {
   $('pr-rel').checked = !!base.relative_e;
   $('pr-start').value = base.start_gcode || '';
   $('pr-end').value = base.end_gcode || '';
+  $('pr-host-kind').value = base.host ? base.host.kind : '';
+  $('pr-host-url').value = base.host ? base.host.url : '';
+  $('pr-host-key').value = '';
   $('pr-error').textContent = '';
   $('printer-dialog').returnValue = '';
   $('printer-dialog').showModal();
@@ -1708,6 +1713,10 @@ $('printer-form').addEventListener('submit', (e) => {
   const said = extrusionMode(printer.start_gcode);
   printer.end_gcode = $('pr-end').value;
   const h = parseFloat($('pr-h').value);
+  const hostKind = $('pr-host-kind').value;
+  const hostUrl = $('pr-host-url').value.trim().replace(/\/+$/, '');
+  if (hostKind) printer.host = { kind: hostKind, url: hostUrl };
+  else delete printer.host;
   const bad = [
     [!printer.name, 'give the printer a name'],
     [!printer.build_volume.every((v) => v > 0), 'the build volume must be positive on every axis'],
@@ -1716,6 +1725,7 @@ $('printer-form').addEventListener('submit', (e) => {
     [!(printer.e_per_mm3 > 0), 'E per mm³ must be positive'],
     [!(printer.nozzle_radius >= 0), 'the nozzle body radius must be a number of mm'],
     [!(h > 0), 'the nozzle body height must be positive'],
+    [hostKind && !/^http:\/\/[^\s/@?#]+(\/[^\s@?#]*)?$/.test(hostUrl), 'the print host address is http:// and its name or IP address, e.g. http://octopi.local (no user name or password in it)'],
     [said != null && said !== printer.relative_e, said ? 'the start code sets relative extrusion (M83) but "relative extrusion" is off: the G-code\'s own M82 would cancel it; tick it or take M83 out' : 'the start code sets absolute extrusion (M82) but "relative extrusion" is on: untick it or take M82 out'],
   ].find(([b]) => b);
   if (bad) {
@@ -1723,6 +1733,9 @@ $('printer-form').addEventListener('submit', (e) => {
     $('pr-error').textContent = bad[1];
     return;
   }
+  // The key goes to this computer's keys file, never into the design.
+  const key = $('pr-host-key').value;
+  if (hostKind && key) saveHostKey(hostUrl, key);
   const kept = keptPrinters().filter((p) => p.printer.name !== printer.name);
   kept.push({ printer, nozzle_height: h });
   try {
@@ -1792,6 +1805,80 @@ function showTab(tab) {
 }
 document.body.dataset.tab = 'editors';
 
+/** Saves a print host's key on the server's machine (docs/PRINTING.md). */
+async function saveHostKey(url, key) {
+  try {
+    const r = await postDesign('/api/host/key', JSON.stringify({ url, key }));
+    if (!r.ok) showError(`the key was not saved: ${(await r.json()).error}`);
+  } catch (e) {
+    showError(`the server did not answer: ${e.message || e}`);
+  }
+}
+
+/** Says how the print is going, beside the Send button. */
+function sendStatus(text, bad) {
+  const s = $('send-status');
+  s.textContent = text;
+  s.classList.toggle('bad-text', !!bad);
+}
+
+/**
+ * Slices, checks and sends the design to its printer's print host and
+ * starts it (the server sends exactly what "Download G-code" gives), then
+ * follows the print until it ends.
+ */
+async function sendToPrinter(button) {
+  const printer = currentPrinter(state.design);
+  if (!printer || !printer.host) {
+    sendStatus('No print host: set one in the printer dialog', true);
+    openPrinter();
+    return;
+  }
+  button.disabled = true;
+  sendStatus('slicing, checking and sending…');
+  try {
+    const r = await postDesign('/api/send?start=true', JSON.stringify(state.design));
+    const body = await r.json();
+    if (!r.ok) {
+      if (body.failures) setVerdict({ printable: false, failures: body.failures, locations: body.locations || [] });
+      sendStatus(`Not sent: ${body.error}`, true);
+      return;
+    }
+    sendStatus(`Sent ${body.file}; printing…`);
+    state.sending = body;
+    followPrint(printer.host, body.file, 0);
+  } catch (e) {
+    sendStatus(`the server did not answer: ${e.message || e}`, true);
+  } finally {
+    button.disabled = false;
+  }
+}
+
+/** Polls the host every 2 s while the print runs (at most a day). */
+async function followPrint(host, file, polls) {
+  if (state.sending?.file !== file || polls > 43200) return;
+  try {
+    const r = await postDesign('/api/host/status', JSON.stringify(host));
+    const s = await r.json();
+    if (!r.ok) {
+      sendStatus(s.error, true);
+      return;
+    }
+    const pct = s.progress == null ? '' : ` ${Math.floor(s.progress * 100)} %`;
+    if (s.printing) sendStatus(`Printing ${file}${pct} (${s.state})`);
+    else if (polls > 2) {
+      sendStatus(`${file}: ${s.state}${pct}`);
+      state.sending = null;
+      return;
+    }
+  } catch (e) {
+    sendStatus(`lost the printer: ${e.message || e}`, true);
+    return;
+  }
+  setTimeout(() => followPrint(host, file, polls + 1), 2000);
+}
+
+$('send-printer').addEventListener('click', (e) => sendToPrinter(e.currentTarget));
 $('download-gcode').addEventListener('click', (e) => downloadFrom('/api/gcode', 'gcode', e.currentTarget));
 $('download-stl').addEventListener('click', (e) => downloadFrom('/api/stl', 'stl', e.currentTarget));
 $('undo').addEventListener('click', undo);

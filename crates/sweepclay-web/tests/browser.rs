@@ -2417,3 +2417,122 @@ async fn fields_take_what_is_typed_or_say_why_beside_it() {
     );
     no_page_errors_and_close(c).await;
 }
+
+#[path = "../../sweepclay-link/tests/hosts/mod.rs"]
+mod hosts;
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_pot_is_sent_from_the_page_to_octoprint_and_printed() {
+    let host_dir = tempfile::tempdir().unwrap();
+    let Some(octo) = hosts::octoprint(&host_dir.path().join("octoprint")) else {
+        return;
+    };
+    // The server keeps the key in this run's own keys file.
+    std::env::set_var("SWEEPCLAY_CONFIG_DIR", host_dir.path().join("config"));
+    let Some(Session {
+        tmp,
+        driver: _driver,
+        c,
+        base,
+        ..
+    }) = Session::start().await
+    else {
+        return;
+    };
+    // A small cup, 20 mm tall, on a CERAMBOT Mini.
+    let mut d: Value =
+        serde_json::from_str(sweepclay_core::examples::example("cup").unwrap()).unwrap();
+    for k in ["profile_start", "profile_end"] {
+        d[k]["control_points"] = json!([[0, 0], [0.5, 8], [2, 20]]);
+    }
+    d["name"] = "pot".into();
+    let file = tmp.path().join("pot.json");
+    std::fs::write(&file, d.to_string()).unwrap();
+    c.goto(&base).await.unwrap();
+    close_guide(&c).await;
+    choose_file(&c, "open-file", &file).await;
+    wait_js(
+        &c,
+        &format!(
+            "return {IDLE} && window.sweepclay.design.name === 'pot' && {}",
+            &PRINTABLE[7..]
+        ),
+        "the pot opened, printable",
+    )
+    .await;
+    // No host yet: the button says so and opens the printer dialog.
+    click(&c, "send-printer").await;
+    wait_js(
+        &c,
+        "return document.getElementById('printer-dialog').open",
+        "the printer dialog",
+    )
+    .await;
+    let said = js(
+        &c,
+        "return document.getElementById('send-status').textContent",
+    )
+    .await;
+    assert!(said.as_str().unwrap().contains("No print host"), "{said}");
+    set_value(&c, "pr-host-kind", "octoprint").await;
+    set_value(&c, "pr-host-url", &format!("{}/", octo.url)).await;
+    set_value(&c, "pr-host-key", &octo.key).await;
+    click(&c, "pr-save").await;
+    wait_js(
+        &c,
+        &format!("return {IDLE} && window.sweepclay.design.printer.host?.kind === 'octoprint'"),
+        "the printer with its host",
+    )
+    .await;
+    // The key is on the server's machine, not in the design or the page's
+    // storage.
+    let stored = js(
+        &c,
+        "return JSON.stringify(window.sweepclay.design) + JSON.stringify(localStorage)",
+    )
+    .await;
+    assert!(
+        !stored.as_str().unwrap().contains(&octo.key),
+        "the key is in the page"
+    );
+    let keys = host_dir.path().join("config").join("host-keys.json");
+    let deadline = Instant::now() + Duration::from_secs(10);
+    while !std::fs::read_to_string(&keys).is_ok_and(|k| k.contains(&octo.key)) {
+        assert!(Instant::now() < deadline, "the key was not saved");
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    }
+
+    click(&c, "send-printer").await;
+    // The page follows the print to its end.
+    let deadline = Instant::now() + Duration::from_secs(240);
+    let mut shot = false;
+    loop {
+        let s = js(
+            &c,
+            "return document.getElementById('send-status').textContent",
+        )
+        .await;
+        let s = s.as_str().unwrap_or("").to_string();
+        assert!(!s.contains("Not sent") && !s.contains("lost"), "{s}");
+        if s.starts_with("Printing") && !shot {
+            shot = true;
+            if let Ok(path) = std::env::var("SWEEPCLAY_SEND_SCREENSHOT") {
+                std::fs::write(&path, c.screenshot().await.unwrap()).unwrap();
+            }
+        }
+        if s == "pot.gcode: Operational 100 %" {
+            break;
+        }
+        assert!(Instant::now() < deadline, "the print did not end: {s}");
+        tokio::time::sleep(Duration::from_millis(500)).await;
+    }
+    // What OctoPrint received is the checked file, every line of it.
+    let sent = std::fs::read_to_string(octo.dir.join("uploads").join("pot.gcode")).unwrap();
+    let report = sweepclay_check::check(
+        &sent,
+        &sweepclay_plan::printer_check(&sweepclay_core::Printer::preset("cerambot-mini").unwrap()),
+    );
+    assert!(report.printable, "{:?}", report.failures);
+    hosts::assert_received_in_order(&octo, &sent);
+    no_page_errors_and_close(c).await;
+}
