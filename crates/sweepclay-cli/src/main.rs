@@ -697,11 +697,27 @@ fn slice_design(a: SliceArgs, text: String, source: String) -> Result<i32> {
             say!("                     thicker than asked because {why}");
         }
         say!("  path length        {:.1} m", st.path_length_mm / 1000.0);
+        let cartridges = match (st.cartridges, printer.cartridge_ml) {
+            (Some(n), Some(c)) => format!(
+                "; {n} cartridge{} of {c:.0} ml",
+                if n == 1 { "" } else { "s" }
+            ),
+            _ => String::new(),
+        };
         say!(
-            "  clay               {:.1} ml, {:.0} g",
+            "  clay               {:.1} ml, {:.0} g{cartridges}",
             st.volume_ml,
             st.clay_g
         );
+        for r in &st.refills {
+            say!(
+                "  refill             after {:.0} ml: layer {}, {:.1} mm up, {:.0} % of the path",
+                r.after_ml,
+                r.pass,
+                r.z_mm,
+                r.share * 100.0
+            );
+        }
         if st.print_scale != [1.0, 1.0] {
             say!(
                 "  firing shrinkage   printed {:.1} % larger across and {:.1} % taller, so the fired piece has the designed size",

@@ -124,9 +124,68 @@ pub struct Stats {
     /// What a potter should know before printing: more clay than the
     /// cartridge holds, a piece that may topple or sag while wet.
     pub warnings: Vec<String>,
+    /// Where the clay runs out and a full cartridge must go in, when the
+    /// print needs more than the printer's `cartridge_ml` (empty when it
+    /// fits, or the cartridge is not known).
+    pub refills: Vec<Refill>,
+    /// Cartridges the print needs, when the printer's is known.
+    pub cartridges: Option<u32>,
     /// A vessel's floor and wall, else `None`.
     #[serde(skip_serializing_if = "Option::is_none")]
     pub vessel: Option<VesselStats>,
+}
+
+/// A point of the print where the cartridge is empty: where the potter
+/// must stop and refill (docs/PRINTING.md, "Clay budget").
+#[derive(Clone, Debug, PartialEq, serde::Serialize)]
+pub struct Refill {
+    /// The clay laid before it (ml).
+    pub after_ml: f64,
+    /// The pass (layer) it falls in, 1-based.
+    pub pass: u32,
+    /// The nozzle's height there (mm).
+    pub z_mm: f64,
+    /// How far along the path, 0 to 1.
+    pub share: f64,
+}
+
+/// Where a print of these volumes runs through each cartridge of `ml`:
+/// the first point whose clay, counted from the start, passes each whole
+/// cartridge.
+/// `volume[i]` is the clay of the move ending at `points[i]` (mm³).
+pub fn refills(points: &[toolpath::PathPoint], volume: &[f64], cartridge_ml: f64) -> Vec<Refill> {
+    let mut out = Vec::new();
+    if cartridge_ml.is_nan() || cartridge_ml <= 0.0 {
+        return out;
+    }
+    let cap = cartridge_ml * 1000.0;
+    let total_len: f64 = points
+        .windows(2)
+        .map(|w| {
+            let (p, q) = (w[1].pos, w[0].pos);
+            (p[0] - q[0]).hypot(p[1] - q[1]).hypot(p[2] - q[2])
+        })
+        .sum::<f64>()
+        .max(1e-9);
+    let (mut clay, mut len) = (0.0, 0.0);
+    for (i, p) in points.iter().enumerate().skip(1) {
+        clay += volume.get(i).copied().unwrap_or(0.0);
+        let q = points[i - 1].pos;
+        len += (p.pos[0] - q[0])
+            .hypot(p.pos[1] - q[1])
+            .hypot(p.pos[2] - q[2]);
+        // A cartridge is empty once the clay passes it (a refill per
+        // cartridge, however many a long move empties).
+        while clay > cap * (out.len() + 1) as f64 + 1e-9 {
+            out.push(Refill {
+                after_ml: cap * (out.len() + 1) as f64 / 1000.0,
+                pass: p.pass,
+                z_mm: p.pos[2],
+                share: (len / total_len).min(1.0),
+            });
+        }
+    }
+    out
 }
 
 /// The parts of a vessel (docs/ALGORITHMS.md §8).
@@ -551,7 +610,13 @@ fn stats(c: &Corrected, t: &Toolpath, e: &Extrusion) -> Stats {
         path_length_mm: e.path_length,
         volume_ml: e.total_volume / 1000.0,
         clay_g: e.total_volume / 1000.0 * pr.clay_density_g_ml,
-        warnings: warnings(pr, e)
+        refills: pr
+            .cartridge_ml
+            .map_or_else(Vec::new, |c| refills(&t.points, &e.volume, c)),
+        cartridges: pr
+            .cartridge_ml
+            .map(|c| (e.total_volume / 1000.0 / c).ceil().max(1.0) as u32),
+        warnings: warnings(pr, t, e)
             .into_iter()
             .chain(stability::warnings(t, e, c.surface.params.max_layer_height))
             .collect(),
@@ -606,13 +671,26 @@ fn planned_min(c: &Corrected, t: &Toolpath, e: &Extrusion) -> f64 {
 }
 
 /// The warnings of [`Stats::warnings`].
-fn warnings(pr: &Printer, e: &Extrusion) -> Vec<String> {
+fn warnings(pr: &Printer, t: &Toolpath, e: &Extrusion) -> Vec<String> {
     let mut w = Vec::new();
     let ml = e.total_volume / 1000.0;
     if let Some(c) = pr.cartridge_ml.filter(|&c| ml > c) {
+        let at: Vec<String> = refills(&t.points, &e.volume, c)
+            .iter()
+            .map(|r| {
+                format!(
+                    "layer {} at {:.1} mm ({:.0} % of the path)",
+                    r.pass,
+                    r.z_mm,
+                    r.share * 100.0
+                )
+            })
+            .collect();
         w.push(format!(
-            "the print needs {ml:.0} ml of clay, more than printer `{}`'s cartridge holds ({c:.0} ml): it cannot print in one continuous extrusion; make it smaller or thinner, or use a larger cartridge",
-            pr.name
+            "the print needs {ml:.0} ml of clay, more than printer `{}`'s cartridge holds ({c:.0} ml): {} cartridges, refilled at {}; a refill breaks the one continuous extrusion, so make it smaller or thinner, or use a larger cartridge",
+            pr.name,
+            at.len() + 1,
+            at.join(", ")
         ));
     }
     w
@@ -678,6 +756,46 @@ mod tests {
             "{:?}",
             small.warnings
         );
+        // Half the clay a cartridge: two cartridges, one refill half way
+        // through the clay, at the pass and height it falls in.
+        assert_eq!(small.cartridges, Some(2));
+        assert_eq!(small.refills.len(), 1, "{:?}", small.refills);
+        let r = &small.refills[0];
+        assert!((r.after_ml - st.volume_ml / 2.0).abs() < 1e-9);
+        assert!(r.pass >= 1 && r.pass <= small.passes, "{r:?}");
+        assert!(r.z_mm > 0.0 && r.z_mm < small.size_mm[2], "{r:?}");
+        assert!(
+            small.warnings[0].contains("2 cartridges, refilled at layer"),
+            "{:?}",
+            small.warnings
+        );
+        // A third of the clay: three cartridges, two refills, in order.
+        let third = with(Some(st.volume_ml / 3.0 + 1e-6));
+        assert_eq!(third.cartridges, Some(3));
+        assert_eq!(third.refills.len(), 2);
+        assert!(third.refills[0].share < third.refills[1].share);
+        assert_eq!(with(Some(st.volume_ml * 2.0)).cartridges, Some(1));
+    }
+
+    #[test]
+    fn a_refill_falls_where_the_clay_passes_the_cartridge() {
+        // Ten 1 mm moves up a column, 100 mm³ each: a 0.25 ml cartridge
+        // empties in the third move (300 > 250), the sixth (600 > 500; at
+        // 500 the second is just used up) and the eighth.
+        let points: Vec<toolpath::PathPoint> = (0..=10)
+            .map(|i| toolpath::PathPoint {
+                pos: [0.0, 0.0, f64::from(i)],
+                column: 0,
+                pass: i as u32,
+                kind: toolpath::PointKind::Pass,
+            })
+            .collect();
+        let volume: Vec<f64> = std::iter::once(0.0).chain([100.0; 10]).collect();
+        let r = refills(&points, &volume, 0.25);
+        assert_eq!(r.iter().map(|r| r.pass).collect::<Vec<_>>(), [3, 6, 8]);
+        assert_eq!(r[0].after_ml, 0.25);
+        assert!((r[1].share - 0.6).abs() < 1e-12);
+        assert!(refills(&points, &volume, 0.0).is_empty());
     }
 
     #[test]

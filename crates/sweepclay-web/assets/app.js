@@ -919,7 +919,8 @@ function render(data, fit) {
       ? [['firing shrinkage', `printed ${((s.print_scale[0] - 1) * 100).toFixed(1)} % larger across, ${((s.print_scale[1] - 1) * 100).toFixed(1)} % taller: fired, the drawn size`]]
       : []),
     ['path length', `${(s.path_length_mm / 1000).toFixed(2)} m`],
-    ['clay', `${s.volume_ml.toFixed(1)} ml, ${s.clay_g.toFixed(0)} g`],
+    ['clay', `${s.volume_ml.toFixed(1)} ml, ${s.clay_g.toFixed(0)} g${s.cartridges != null ? `, ${s.cartridges} cartridge${s.cartridges === 1 ? '' : 's'}` : ''}`],
+    ...(s.refills || []).map((r, i) => [`refill ${i + 1}`, `layer ${r.pass}, ${r.z_mm.toFixed(1)} mm up (${Math.round(r.share * 100)} %)`]),
     ['printing time', `${s.time_min.toFixed(1)} min`],
   ];
   // Rewritten only when they say something new: a drag's slices mostly
