@@ -1697,6 +1697,60 @@ function openPrinter() {
   $('printer-dialog').showModal();
 }
 
+/** The printer as the dialog's fields say now, for the calibration. */
+function dialogPrinter() {
+  const printer = { ...state.printerBase };
+  for (const [id, key, n] of PRINTER_FIELDS) printer[key] = Array.from({ length: n }, (_, k) => parseFloat($(`${id}${k}`).value));
+  const dia = $('pr-dia').value.trim();
+  if (dia) printer.bed_diameter = parseFloat(dia);
+  else delete printer.bed_diameter;
+  printer.e_per_mm3 = parseFloat($('pr-e').value);
+  printer.relative_e = $('pr-rel').checked;
+  printer.start_gcode = $('pr-start').value;
+  printer.end_gcode = $('pr-end').value;
+  delete printer.host;
+  return printer;
+}
+
+/** What the calibration routes take: the dialog's printer, the design's widths. */
+function calibrationAsk(measured) {
+  const p = { ...state.meta.params, ...(state.design.params || {}) };
+  const params = { layer_height: p.layer_height, width_min: p.width_min, width_max: p.width_max };
+  return JSON.stringify({ printer: dialogPrinter(), params, ...(measured ? { measured } : {}) });
+}
+
+$('pr-cal-print').addEventListener('click', async () => {
+  const r = await postDesign('/api/calibrate', calibrationAsk());
+  if (!r.ok) {
+    $('pr-cal-result').textContent = (await r.json()).error;
+    return;
+  }
+  download(await r.blob(), 'calibration.gcode');
+  $('pr-cal-result').textContent = `Written with E per mm³ ${$('pr-e').value}: measure before you change it.`;
+});
+
+$('pr-cal-fit').addEventListener('click', async () => {
+  const measured = [1, 2, 3, 4].map((k) => parseDecimal($(`pr-cal-${k}`).value));
+  if (!measured.every((v) => v > 0)) {
+    $('pr-cal-result').textContent = 'give the wall thickness of each of the four bands, in mm';
+    return;
+  }
+  const r = await postDesign('/api/calibrate/fit', calibrationAsk(measured));
+  const f = await r.json();
+  if (!r.ok) {
+    $('pr-cal-result').textContent = f.error;
+    return;
+  }
+  const spread = (f.spread * 100).toFixed(1);
+  if (!f.trusted) {
+    $('pr-cal-result').textContent = `The bands disagree by ${spread} %: measure again at each band's middle (nothing changed).`;
+    return;
+  }
+  const was = $('pr-e').value;
+  $('pr-e').value = f.e_per_mm3.toFixed(5);
+  $('pr-cal-result').textContent = `E per mm³ ${f.e_per_mm3.toFixed(5)} (was ${was}; the bands agree within ${spread} %). "Use" keeps it.`;
+});
+
 $('printer-form').addEventListener('submit', (e) => {
   if (e.submitter && e.submitter.value !== 'save') return;
   // Everything the dialog does not show (feedrates, relative E, a round

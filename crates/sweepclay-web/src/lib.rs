@@ -27,6 +27,7 @@ pub mod api;
 pub mod conn;
 pub mod error;
 pub mod guard;
+mod printing;
 
 use api::{ApiError, Limits};
 use axum::body::Bytes;
@@ -115,12 +116,12 @@ impl IntoResponse for ApiError {
 }
 
 /// What every handler shares: the limits and the pool of workers.
-struct AppState {
+pub(crate) struct AppState {
     limits: Limits,
     pool: guard::Pool,
 }
 
-type Shared = Arc<AppState>;
+pub(crate) type Shared = Arc<AppState>;
 
 /// The modeler's routes, with the given limits.
 pub fn router(limits: Limits) -> Router {
@@ -130,9 +131,11 @@ pub fn router(limits: Limits) -> Router {
         .route("/api/gcode", post(gcode))
         .route("/api/stl", post(stl))
         .route("/api/import/{format}", post(import))
-        .route("/api/send", post(send))
-        .route("/api/host/status", post(host_status))
-        .route("/api/host/key", post(host_key))
+        .route("/api/send", post(printing::send))
+        .route("/api/host/status", post(printing::host_status))
+        .route("/api/host/key", post(printing::host_key))
+        .route("/api/calibrate", post(printing::calibration_print))
+        .route("/api/calibrate/fit", post(printing::calibration_fit))
         .layer(DefaultBodyLimit::max(DESIGN_BODY_LIMIT));
     let check_route = Router::new()
         .route("/api/check", post(check))
@@ -203,7 +206,7 @@ async fn meta(State(limits): State<Shared>) -> Response {
 }
 
 /// The request body as text, with size and encoding errors as JSON.
-fn bytes(body: Result<Bytes, BytesRejection>) -> Result<Bytes, ApiError> {
+pub(crate) fn bytes(body: Result<Bytes, BytesRejection>) -> Result<Bytes, ApiError> {
     body.map_err(|e| {
         let status = e.status().as_u16();
         if status == 413 {
@@ -219,7 +222,7 @@ fn text(body: Result<Bytes, BytesRejection>) -> Result<String, ApiError> {
         .map_err(|e| ApiError::new(400, format!("the body is not UTF-8 text: {e}")))
 }
 
-async fn with_design<T: Send + 'static>(
+pub(crate) async fn with_design<T: Send + 'static>(
     limits: Shared,
     body: Result<Bytes, BytesRejection>,
     f: impl FnOnce(sweepclay_plan::Job, &Cancel) -> Result<T, ApiError> + Send + 'static,
@@ -348,122 +351,6 @@ async fn gcode(
         ))
     })
     .await
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct SendQuery {
-    /// Start printing once uploaded.
-    start: Option<bool>,
-}
-
-/// What `/api/send` did.
-#[derive(serde::Serialize)]
-struct Sent {
-    /// The name the host stored the file under.
-    file: String,
-    /// The host's kind and address.
-    kind: &'static str,
-    url: String,
-    /// Whether the print was started.
-    started: bool,
-}
-
-/// A link to the print host a design's printer names, with its saved key.
-fn link_for(host: &sweepclay_core::printer::PrintHost) -> Result<sweepclay_link::Link, ApiError> {
-    let kind = sweepclay_link::Kind::from_name(host.kind.name()).ok_or_else(|| {
-        ApiError::new(422, "unknown print host kind").with_key("printer.host.kind")
-    })?;
-    let keys = sweepclay_link::keys::config_dir().map(|d| sweepclay_link::keys::path_in(&d));
-    let secret = sweepclay_link::keys::lookup(keys.as_deref(), &host.url)
-        .map_err(|e| ApiError::new(500, format!("the keys file: {e}")))?;
-    sweepclay_link::Link::new(kind, &host.url, secret)
-        .map_err(|e| ApiError::new(422, e.to_string()).with_key("printer.host.url"))
-}
-
-/// A print host's refusal as the page shows it: 502, the host's sentence.
-fn host_error(e: sweepclay_link::LinkError) -> ApiError {
-    ApiError::new(502, e.to_string())
-}
-
-/// Slices the design exactly as `/api/gcode` downloads it (checked: a
-/// file that fails the check is never sent), uploads it to the print host
-/// its printer names, and starts it if asked (docs/PRINTING.md).
-async fn send(
-    State(limits): State<Shared>,
-    query: Result<Query<SendQuery>, axum::extract::rejection::QueryRejection>,
-    body: Result<Bytes, BytesRejection>,
-) -> Result<Json<Sent>, ApiError> {
-    let Query(q) = query.map_err(|e| ApiError::new(400, e.body_text()))?;
-    let (gcode, host, name) = with_design(limits, body, |d, c| {
-        let printer = d.design().printer.resolve()?;
-        let host = printer.host.clone().ok_or_else(|| {
-            ApiError::new(
-                422,
-                "the printer names no print host: add one in the printer dialog (Send to printer)",
-            )
-            .with_key("printer.host")
-        })?;
-        let text = api::gcode(&d, c)?;
-        Ok((text, host, d.design().name.clone()))
-    })
-    .await?;
-    let link = link_for(&host)?;
-    let file = link
-        .upload(&name, gcode.into_bytes())
-        .await
-        .map_err(host_error)?;
-    let start = q.start.unwrap_or(false);
-    if start {
-        link.start(&file).await.map_err(host_error)?;
-    }
-    Ok(Json(Sent {
-        file,
-        kind: host.kind.name(),
-        url: link.url(),
-        started: start,
-    }))
-}
-
-/// What the print host says the printer is doing; the body is the
-/// printer's `host` object.
-async fn host_status(
-    body: Result<Bytes, BytesRejection>,
-) -> Result<Json<sweepclay_link::Status>, ApiError> {
-    let host: sweepclay_core::printer::PrintHost = serde_json::from_slice(&bytes(body)?)
-        .map_err(|e| ApiError::new(400, format!("host: {e}")))?;
-    host.validate("host")?;
-    link_for(&host)?
-        .status()
-        .await
-        .map(Json)
-        .map_err(host_error)
-}
-
-#[derive(Deserialize)]
-#[serde(deny_unknown_fields)]
-struct HostKey {
-    url: String,
-    key: String,
-}
-
-/// Saves a print host's key in the keys file on this machine; the page
-/// never reads it back (docs/PRINTING.md, "Keys").
-async fn host_key(
-    body: Result<Bytes, BytesRejection>,
-) -> Result<Json<serde_json::Value>, ApiError> {
-    let k: HostKey = serde_json::from_slice(&bytes(body)?)
-        .map_err(|e| ApiError::new(400, format!("key: {e}")))?;
-    sweepclay_link::check_url(&k.url)
-        .map_err(|e| ApiError::new(422, e.to_string()).with_key("url"))?;
-    let dir = sweepclay_link::keys::config_dir()
-        .ok_or_else(|| ApiError::new(500, "no configuration directory (HOME is not set)"))?;
-    let path = sweepclay_link::keys::path_in(&dir);
-    tokio::task::spawn_blocking(move || sweepclay_link::keys::save(&path, &k.url, k.key.trim()))
-        .await
-        .map_err(|e| ApiError::new(500, e.to_string()))?
-        .map_err(|e| ApiError::new(500, format!("saving the key: {e}")))?;
-    Ok(Json(serde_json::json!({"saved": true})))
 }
 
 async fn stl(

@@ -2536,3 +2536,101 @@ async fn a_pot_is_sent_from_the_page_to_octoprint_and_printed() {
     hosts::assert_received_in_order(&octo, &sent);
     no_page_errors_and_close(c).await;
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_printer_dialog_calibrates_e_from_measured_walls() {
+    let Some(Session {
+        downloads,
+        driver: _driver,
+        c,
+        base,
+        ..
+    }) = Session::start().await
+    else {
+        return;
+    };
+    c.goto(&base).await.unwrap();
+    close_guide(&c).await;
+    wait_js(
+        &c,
+        &format!("return {IDLE} && {}", &PRINTABLE[7..]),
+        "the first slice",
+    )
+    .await;
+    open_printer_dialog(&c).await;
+    js(
+        &c,
+        "document.getElementById('pr-cal').open = true; return null",
+    )
+    .await;
+    let e0: f64 = js(
+        &c,
+        "return parseFloat(document.getElementById('pr-e').value)",
+    )
+    .await
+    .as_f64()
+    .unwrap();
+    click(&c, "pr-cal-print").await;
+    let deadline = Instant::now() + Duration::from_secs(30);
+    let file = loop {
+        let f = downloads.join("calibration.gcode");
+        if f.exists() && std::fs::metadata(&f).unwrap().len() > 0 {
+            break f;
+        }
+        assert!(
+            Instant::now() < deadline,
+            "no calibration print was downloaded"
+        );
+        tokio::time::sleep(Duration::from_millis(100)).await;
+    };
+    // It passes the independent check, as its own header reads it.
+    let text = std::fs::read_to_string(&file).unwrap();
+    let cfg = sweepclay_check::header::config_from_header(
+        &text,
+        &sweepclay_check::CheckConfig::default(),
+    )
+    .unwrap();
+    assert!(sweepclay_check::check(&text, &cfg).printable);
+    // Walls 10 % thick (the extruder lays 1.1 mm³ a mm³ written), one with
+    // a decimal comma, as a calliper reads them.
+    for (k, v) in ["3,30", "4.41", "5.49", "6.61"].iter().enumerate() {
+        set_value(&c, &format!("pr-cal-{}", k + 1), v).await;
+    }
+    click(&c, "pr-cal-fit").await;
+    let said = wait_js(
+        &c,
+        "const t = document.getElementById('pr-cal-result').textContent; return t.startsWith('E per mm') && t",
+        "the fit",
+    )
+    .await;
+    let e: f64 = js(
+        &c,
+        "return parseFloat(document.getElementById('pr-e').value)",
+    )
+    .await
+    .as_f64()
+    .unwrap();
+    let truth = e0 / 1.1;
+    assert!((e - truth).abs() / truth < 0.02, "{e} vs {truth}: {said}");
+    // Walls that disagree change nothing.
+    set_value(&c, "pr-cal-2", "6").await;
+    click(&c, "pr-cal-fit").await;
+    wait_js(
+        &c,
+        "return document.getElementById('pr-cal-result').textContent.includes('disagree')",
+        "the refusal",
+    )
+    .await;
+    if let Ok(path) = std::env::var("SWEEPCLAY_CALIBRATE_SCREENSHOT") {
+        std::fs::write(&path, c.screenshot().await.unwrap()).unwrap();
+    }
+    click(&c, "pr-save").await;
+    let kept = wait_js(
+        &c,
+        &format!("return {IDLE} && typeof window.sweepclay.design.printer === 'object' && window.sweepclay.design.printer.e_per_mm3"),
+        "the calibrated printer in the design",
+    )
+    .await;
+    assert!((kept.as_f64().unwrap() - e).abs() < 1e-9, "{kept}");
+    no_page_errors_and_close(c).await;
+}
