@@ -12,7 +12,10 @@ wall) are sliced by the tools potters use today, with clay settings
 - FullControl (PyPI `fullcontrol`, its WASP 2040 Clay profile),
 - a plain Python loop, as people script clay G-code by hand.
 
-Then hand-made edits of the valid files, each with one real fault. Writes
+Also a 54° cone, 4.5 mm lines on 1.25 mm layers, from each slicer, and a
+square vase whose first turn is four 63 mm moves. Then hand-made edits
+of the valid files, each with one real fault, and a seam jog on the
+cone that is short enough to print. Writes
 `crates/sweepclay-check/tests/corpus/*.gcode` (each at most 200 KB) and
 `printers/*.json`; `tests/corpus.rs` holds each file's verdict and report
 snapshot. Run from anywhere: `python3 scripts/corpus/make.py`.
@@ -184,6 +187,122 @@ def lean_files(tmp, defs):
     cura(bowl, os.path.join(OUT, "cura-bowl.gcode"), defs, **lw)
     prusa("prusa-slicer", bowl, os.path.join(OUT, "prusa-bowl.gcode"), tmp, **lw)
     prusa("slic3r", bowl, os.path.join(OUT, "slic3r-bowl.gcode"), tmp, **lw)
+
+
+def cone_r(z, t):
+    """The steep cone: 30 mm tall, radius 20 mm at the foot, its wall
+    leaning 54° out from the vertical, 3° inside the overhang limit."""
+    return 20 + z * math.tan(math.radians(54))
+
+
+CONE_WIDTH = 4.5  # mm: wide beads on thin layers, as steep walls need
+
+
+def cone_files(tmp, defs):
+    """The 54° cone spiralized by each slicer with 4.5 mm lines on 1.25 mm
+    layers: every turn leans 1.72 mm out over the one below."""
+    cone = os.path.join(tmp, "cone.stl")
+    write_stl(cone, cone_r, 30, 20, 96)
+    lw = dict(layer=LAYER, width=CONE_WIDTH)
+    cura(cone, os.path.join(OUT, "cura-cone.gcode"), defs, **lw)
+    prusa("prusa-slicer", cone, os.path.join(OUT, "prusa-cone.gcode"), tmp, **lw)
+    prusa("slic3r", cone, os.path.join(OUT, "slic3r-cone.gcode"), tmp, **lw)
+
+
+def square_file():
+    """A square spiral vase as people script it, whose flat first loop and
+    rising first turn are each four straight 63 mm moves (one bead a
+    side), the turns above cut into 2 mm moves: a first bead as long as a
+    side must be judged as the same path cut short would be."""
+    e_mm3 = 4 / (math.pi * FEED_DIA ** 2)
+    side, c = 63.0, 100.0
+    corners = [(c - side / 2, c - side / 2), (c + side / 2, c - side / 2),
+               (c + side / 2, c + side / 2), (c - side / 2, c + side / 2)]
+    lines = ["; a plain Python loop: a square vase", "G21", "G90", "M83", "G28", "G1 Z10 F3000",
+             f"G1 X{corners[0][0]:.3f} Y{corners[0][1]:.3f} Z{LAYER:.3f} F3000"]
+    prev = (corners[0][0], corners[0][1], LAYER)
+    turns = 16
+    for turn in range(turns + 1):
+        cut = 1 if turn < 2 else int(side / 2.0)
+        for k in range(4):
+            a, b = corners[k], corners[(k + 1) % 4]
+            for j in range(1, cut + 1):
+                u = (k + j / cut) / 4  # share of the turn
+                z = LAYER + (0.0 if turn == 0 else LAYER * (turn - 1 + u))
+                p = (a[0] + (b[0] - a[0]) * j / cut, a[1] + (b[1] - a[1]) * j / cut, z)
+                d = math.dist(p, prev)
+                lines.append(f"G1 X{p[0]:.3f} Y{p[1]:.3f} Z{p[2]:.3f} E{d * WIDTH * LAYER * e_mm3:.5f} F1500")
+                prev = p
+    lines += ["G1 E-1.5 F1200 ; end retraction", "G1 Z80 F3000", "G28 X Y", "M84"]
+    with open(os.path.join(OUT, "python-square.gcode"), "w") as f:
+        f.write("\n".join(lines) + "\n")
+
+
+def jog_edits():
+    """A jog on the real 54° cone (PrusaSlicer): at 15.6 mm the path
+    steps 0.3 mm out, runs along the wall and steps back, as a seam or a
+    scripted lip does. Its outer bead leans 59° over the turn below (the
+    limit is 57°; the overlap is still half the bead): one 2.6 mm move
+    long, shorter than the narrowest bead is wide, it cannot sag on its
+    own and the file prints (`overhang-jog`); four moves, 10.4 mm, it
+    sags (`fault-overhang-run`)."""
+    with open(os.path.join(OUT, "prusa-cone.gcode")) as f:
+        lines = f.read().split("\n")
+    e_per_mm = CONE_WIDTH * LAYER * 4 / (math.pi * FEED_DIA ** 2)
+
+    def xyze(line):
+        v = {}
+        for w in line.split(";")[0].split()[1:]:
+            if w[0] in "XYZE":
+                v[w[0]] = float(w[1:])
+        return v
+
+    def jogged(moves):
+        out = list(lines)
+        # The first extruding move at or above 15.6 mm: from its end the
+        # next `moves` moves are laid 0.3 mm farther out (from the cone's
+        # axis, the bed's middle), with their own clay; a short move out
+        # and one back in join them to the wall.
+        i = next(k for k, l in enumerate(out) if l.startswith("G1 Z") and " E" in l
+                 and xyze(l).get("Z", 0) >= 15.6)
+        out_mm = 0.3
+        added = 0.0
+        e_prev = xyze(out[i])["E"]
+        p = xyze(out[i])
+        first = True
+        for k in range(i + 1, i + 1 + moves):
+            v = xyze(out[k])
+            de = v["E"] - e_prev
+            e_prev = v["E"]
+            rn = math.hypot(v["X"] - 100.0, v["Y"] - 100.0)
+            x = v["X"] + out_mm * (v["X"] - 100.0) / rn
+            y = v["Y"] + out_mm * (v["Y"] - 100.0) / rn
+            jog = []
+            if first:
+                # Out from the wall at the jog's start.
+                qn = math.hypot(p["X"] - 100.0, p["Y"] - 100.0)
+                ox = p["X"] + out_mm * (p["X"] - 100.0) / qn
+                oy = p["Y"] + out_mm * (p["Y"] - 100.0) / qn
+                added += out_mm * e_per_mm
+                jog.append(f"G1 X{ox:.3f} Y{oy:.3f} E{p['E'] + added:.5f} ; jog out")
+                first = False
+            jog.append(f"G1 Z{v['Z']:.3f} X{x:.3f} Y{y:.3f} E{v['E'] + added:.5f} ; jog")
+            out[k] = "\n".join(jog)
+            last = v
+        # Back in to the wall where the jog ends.
+        added += out_mm * e_per_mm
+        out[i + moves] += f"\nG1 X{last['X']:.3f} Y{last['Y']:.3f} E{last['E'] + added:.5f} ; jog in"
+        # Absolute E: every later E grows by the jog's own clay.
+        for k in range(i + 1 + moves, len(out)):
+            m = re.search(r"E(-?[0-9.]+)", out[k].split(";")[0])
+            if m and out[k].startswith("G1"):
+                out[k] = out[k].replace(m.group(0), f"E{float(m.group(1)) + added:.5f}", 1)
+        return "\n".join(out).split("\n")
+
+    with open(os.path.join(OUT, "overhang-jog.gcode"), "w") as f:
+        f.write("\n".join(jogged(1)))
+    with open(os.path.join(OUT, "fault-overhang-run.gcode"), "w") as f:
+        f.write("\n".join(jogged(4)))
 
 
 def fullcontrol_files():
@@ -379,13 +498,16 @@ def main():
         cura(vase, os.path.join(OUT, "cura-vase.gcode"), defs)
         cura(ripple, os.path.join(OUT, "cura-ripple.gcode"), defs)
         lean_files(tmp, defs)
+        cone_files(tmp, defs)
         prusa("prusa-slicer", vase, os.path.join(OUT, "prusa-vase.gcode"), tmp)
         prusa("prusa-slicer", ripple, os.path.join(OUT, "prusa-ripple.gcode"), tmp)
         prusa("slic3r", vase, os.path.join(OUT, "slic3r-vase.gcode"), tmp)
         prusa("slic3r", ripple, os.path.join(OUT, "slic3r-ripple.gcode"), tmp)
     fullcontrol_files()
     python_loop_files()
+    square_file()
     edits()
+    jog_edits()
     big = False
     for f in sorted(glob.glob(os.path.join(OUT, "*.gcode"))):
         size = os.path.getsize(f)

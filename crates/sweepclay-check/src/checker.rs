@@ -227,11 +227,12 @@ enum Rest {
 }
 
 /// Consecutive beads overlapping the bead below by less than the least
-/// overlap, or resting over a layer gap ([`WEAK_KINDS`]). Shorter in all
-/// than half the narrowest bead, they are held up by the clay on either
-/// side (a slicer's seam bead a millimetre long, the end of a pass over
-/// the slope the pass below climbed); longer, each is a failure
-/// (docs/CHECKER.md, "Overlap", "Layer gaps").
+/// overlap, resting over a layer gap, or leaning past the overhang limit
+/// ([`WEAK_KINDS`]). Shorter in all than [`Checker::weak_length`], they
+/// are held up by the clay on either side (a slicer's seam bead a
+/// millimetre long, the end of a pass over the slope the pass below
+/// climbed); longer, each is a failure (docs/CHECKER.md, "Overlap",
+/// "Layer gaps", "Overhangs").
 #[derive(Default)]
 struct Weak {
     /// Their length in plan (mm).
@@ -241,7 +242,11 @@ struct Weak {
 }
 
 /// The findings judged by stretches of [`Weak`] beads.
-const WEAK_KINDS: [Finding; 2] = [Finding::UnderMinOverlap, Finding::LayerGap];
+const WEAK_KINDS: [Finding; 3] = [
+    Finding::UnderMinOverlap,
+    Finding::LayerGap,
+    Finding::Overhang,
+];
 
 /// A thin bead fails for its gap only beyond this many times the gap
 /// under the beads before it (docs/CHECKER.md, "Layer gaps").
@@ -264,13 +269,14 @@ struct Stretch {
     length: f64,
     volume: f64,
     excess: f64,
-    /// The gap under its first and its last bead (mm).
+    /// The gap at the start of its first bead and the end of its last
+    /// (mm).
     first_gap: f64,
     last_gap: f64,
     /// Whether some bead of it lies lower than the one before, or on a
     /// thinner gap: then it is no ramp.
     falls: bool,
-    /// Height of its last bead's middle (mm).
+    /// Height of its last bead's end (mm).
     last_z: f64,
 }
 
@@ -328,7 +334,7 @@ struct Checker<'a> {
     prev_overlap: f64,
     /// Consecutive beads under the least overlap, and over a layer gap,
     /// not yet recorded.
-    weak: [Weak; 2],
+    weak: [Weak; 3],
     /// Under-extruded moves since the last full bead (line, width, plan
     /// length): a failure once a bead follows them, the final taper if
     /// none does and they are no longer than two widest beads.
@@ -785,8 +791,21 @@ impl<'a> Checker<'a> {
 
     /// Records the beads of a stretch of [`Weak`] beads of kind `k`, if it
     /// is long enough to fail: half the narrowest bead.
+    /// How long a stretch of weak beads of kind `k` must be to fail: half
+    /// the narrowest bead for too little overlap and a layer gap (a bead
+    /// shorter than that is a blob on its neighbours); the narrowest
+    /// bead's width for an overhang, the shortest length of bead that can
+    /// sag on its own: a shorter one leans no farther than the supported
+    /// clay it joins at both ends holds it (docs/CHECKER.md, "Overhangs").
+    fn weak_length(&self, k: usize) -> f64 {
+        match WEAK_KINDS[k] {
+            Finding::Overhang => self.cfg.width_min,
+            _ => 0.5 * self.cfg.width_min,
+        }
+    }
+
     fn flush_weak(&mut self, k: usize) {
-        if self.weak[k].length < 0.5 * self.cfg.width_min {
+        if self.weak[k].length < self.weak_length(k) {
             return;
         }
         let mut pending = std::mem::take(&mut self.weak[k].pending);
@@ -866,7 +885,7 @@ impl<'a> Checker<'a> {
         }
         // For each of WEAK_KINDS, whether it was judged, and if so the
         // bead's shortfall.
-        let mut weak_bead: [Option<Option<f64>>; 2] = [None; 2];
+        let mut weak_bead: [Option<Option<f64>>; 3] = [None; 3];
         // What it rests on, if its support was sought, and the gap
         // above what it rests on.
         let mut rest = None;
@@ -898,7 +917,7 @@ impl<'a> Checker<'a> {
             ..
         } = self;
         // Its failures, recorded once the borrows below end (at most one
-        // each of: no clay below, too little overlap, overhang, more clay
+        // each of: no clay below, more clay
         // than fits).
         let mut held = [(Finding::Unsupported, 0.0); 5];
         let mut n_held = 0;
@@ -1008,16 +1027,24 @@ impl<'a> Checker<'a> {
                 r.support.on_clay += 1;
                 let gap = (mid[2] - z_own).max(0.0);
                 let room = len * gap * (1.0 + WIDTH_TOLERANCE) * cfg.width_max;
+                // The gap at the bead's two ends, over the clay under its
+                // middle: a ramp's rise is read the same whether it is one
+                // 63 mm move or thirty 2 mm ones (docs/CHECKER.md,
+                // "Cutting").
+                let (gap_from, gap_to) = ((m.from[2] - z_own).max(0.0), (m.to[2] - z_own).max(0.0));
                 if stretch.length == 0.0 {
                     stretch.first_line = m.line;
-                    stretch.first_gap = gap;
-                } else if gap < stretch.last_gap - RAMP_SLACK_MM
-                    || mid[2] < stretch.last_z - RAMP_SLACK_MM
+                    stretch.first_gap = gap_from;
+                } else if gap_from < stretch.last_gap - RAMP_SLACK_MM
+                    || m.from[2] < stretch.last_z - RAMP_SLACK_MM
                 {
                     stretch.falls = true;
                 }
-                stretch.last_gap = gap;
-                stretch.last_z = mid[2];
+                if gap_to < gap_from - RAMP_SLACK_MM {
+                    stretch.falls = true;
+                }
+                stretch.last_gap = gap_to;
+                stretch.last_z = m.to[2];
                 stretch.length += len;
                 stretch.volume += volume;
                 stretch.excess += (volume - room).max(0.0);
@@ -1160,6 +1187,8 @@ impl<'a> Checker<'a> {
                     // no 80° overhang). An arc tangent only when it can
                     // matter: a new steepest or one near the limit.
                     let ratio = offset / dz.max(below_h);
+                    // Judged, and within the limit unless found past it.
+                    weak_bead[2] = Some(None);
                     if !(ratio <= *steepest && ratio < *overhang_near) {
                         *steepest = steepest.max(ratio);
                         let angle = ratio.atan().to_degrees();
@@ -1172,7 +1201,7 @@ impl<'a> Checker<'a> {
                             let lean = crate::support::gentlest_lean(beads, grid, &q, gap_limit);
                             let angle = angle.min(lean.atan().to_degrees());
                             if angle > cfg.max_overhang_deg + cfg.overhang_tolerance_deg {
-                                hold(Finding::Overhang, angle);
+                                weak_bead[2] = Some(Some(angle));
                             }
                         }
                     }
@@ -1205,11 +1234,16 @@ impl<'a> Checker<'a> {
             }
             *last_width = w;
         }
+        // Its footprint: no wider than the widest bead a nozzle can lay,
+        // with the widths' tolerance. Clay past that has no room under the
+        // nozzle and goes up, not out (docs/CHECKER.md, "Clay on clay"): a
+        // first turn pressed 0.3 mm over its flat loop is no 17.6 mm shelf
+        // for the turn above to rest on ("Footprints").
         let mut bead = Bead::new(
             m.from,
             m.to,
             if width.is_finite() {
-                width.clamp(0.0, 1e3)
+                width.clamp(0.0, cfg.width_max * (1.0 + WIDTH_TOLERANCE))
             } else {
                 cfg.width_min
             },

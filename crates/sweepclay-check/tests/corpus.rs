@@ -64,7 +64,7 @@ fn snapshot(file: &str, r: &Report) {
     );
 }
 
-const VALID: [&str; 13] = [
+const VALID: [&str; 18] = [
     // Leaning vase starts: a 35° bowl, 4.5 mm lines on 1.8 mm layers,
     // whose first turn rises from the flat first loop at full flow.
     "cura-bowl.gcode",
@@ -80,6 +80,18 @@ const VALID: [&str; 13] = [
     "fullcontrol-wall.gcode",
     "python-vase.gcode",
     "python-wall.gcode",
+    // Steep walls: a 54° cone, 4.5 mm lines on 1.25 mm layers, 3° inside
+    // the overhang limit; PrusaSlicer's and Slic3r's first turns lie over
+    // their flat loop.
+    "cura-cone.gcode",
+    "prusa-cone.gcode",
+    "slic3r-cone.gcode",
+    // A jog of one 2.6 mm move leaning 58° on PrusaSlicer's cone: too
+    // short to sag on its own (docs/CHECKER.md, "Overhangs").
+    "overhang-jog.gcode",
+    // A square vase whose first turn is four 63 mm moves: the ramp read
+    // as it is read cut into 2 mm moves (docs/CHECKER.md, "Cutting").
+    "python-square.gcode",
 ];
 
 #[test]
@@ -140,6 +152,8 @@ fn each_hand_made_fault_fails_for_its_fault() {
         ),
         // `M83` half way through PrusaSlicer's absolute-E vase.
         ("fault-m83.gcode", "more clay than fits", &[][..]),
+        // The cone's 58° jog run on for four moves, 10.4 mm: it sags.
+        ("fault-overhang-run.gcode", "overhang", &[][..]),
     ] {
         println!("{file}");
         let r = report(file);
@@ -299,5 +313,100 @@ fn verdicts_do_not_depend_on_how_moves_are_cut() {
             }
         }
     }
+    assert!(differ.is_empty(), "{}", differ.join("\n"));
+}
+
+/// The line (0-based) that sets the height of the first bead of the print
+/// above `share` of its top, and the line of its first bead: where a file
+/// is cut into halves at a layer.
+fn layer_cut(text: &str, share: f64) -> Option<(usize, usize)> {
+    let (mut z, mut z_line) = (0.0f64, 0usize);
+    let mut beads = Vec::new();
+    for (i, line) in text.lines().enumerate() {
+        let code = line.split(';').next().unwrap_or("").trim();
+        let word = |c: char| {
+            code.split_whitespace()
+                .find(|w| w.len() > 1 && w.starts_with(c))
+                .and_then(|w| w[1..].parse::<f64>().ok())
+        };
+        if !(code.starts_with("G1 ") || code.starts_with("G0 ")) {
+            continue;
+        }
+        if let Some(v) = word('Z') {
+            z = v;
+            z_line = i;
+        }
+        if word('E').is_some_and(|e| e > 0.0) && (word('X').is_some() || word('Y').is_some()) {
+            beads.push((i, z, z_line));
+        }
+    }
+    // From the first bead near the bed (a purge in the air before it is
+    // no layer).
+    let k0 = beads.iter().position(|b| b.1 < 5.0)?;
+    let beads = &beads[k0..];
+    let top = beads.iter().map(|b| b.1).fold(0.0, f64::max);
+    let cut = beads.iter().find(|b| b.1 > share * top)?.2;
+    Some((cut, beads[0].0))
+}
+
+#[test]
+fn a_file_cut_at_a_layer_is_judged_as_its_halves() {
+    // The first half of a file, judged alone, fails where the whole file
+    // fails before the cut, and nowhere else: what is printed later never
+    // changes how earlier clay is judged (docs/CHECKER.md, "Halves"),
+    // finding by finding and line by line. The second half
+    // alone (the start code, then the print from the cut) starts in the
+    // air: never printable, however the first half was supported.
+    let mut files: Vec<String> = std::fs::read_dir(corpus())
+        .unwrap()
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter(|f| f.ends_with(".gcode"))
+        .collect();
+    files.sort();
+    let mut differ = Vec::new();
+    let mut cuts = 0;
+    for file in &files {
+        let text = std::fs::read_to_string(corpus().join(file)).unwrap();
+        let lines: Vec<&str> = text.lines().collect();
+        let whole = check(&text, &printer(file));
+        for share in [0.3, 0.5, 0.7] {
+            let Some((cut, first_bead)) = layer_cut(&text, share) else {
+                continue;
+            };
+            cuts += 1;
+            let half = check(&(lines[..cut].join("\n") + "\n"), &printer(file));
+            for f in sweepclay_check::Finding::ALL {
+                let (w, h) = (&whole.findings[f], &half.findings[f]);
+                // The whole file's lines of this finding before the cut
+                // (1-based lines; the kept lines are the first 256).
+                let before: Vec<usize> = w.lines.iter().copied().filter(|&l| l <= cut).collect();
+                let complete = w.lines.len() < sweepclay_check::Count::LINES_KEPT;
+                let b = &h.lines;
+                let same = if complete {
+                    &before == b
+                } else {
+                    b.starts_with(&before) || before.starts_with(b)
+                };
+                if !same {
+                    differ.push(format!(
+                        "{file} cut at line {cut}: {f:?} whole {before:?} half {b:?}"
+                    ));
+                }
+            }
+            let second = lines[..first_bead]
+                .iter()
+                .chain(&lines[cut..])
+                .copied()
+                .collect::<Vec<_>>()
+                .join("\n");
+            let r = check(&second, &printer(file));
+            if r.printable {
+                differ.push(format!(
+                    "{file}: its second half from line {cut} alone passed"
+                ));
+            }
+        }
+    }
+    assert!(cuts > 60, "{cuts} cuts");
     assert!(differ.is_empty(), "{}", differ.join("\n"));
 }
