@@ -45,6 +45,11 @@ pub mod parse;
 pub mod replay;
 mod report;
 mod support;
+#[cfg(test)]
+mod testkit;
+// The shared test helpers name this crate as its tests outside do.
+#[cfg(test)]
+extern crate self as sweepclay_check;
 mod tops;
 mod verdict;
 

@@ -5,11 +5,12 @@
 //! snapshot (`NAME.report.txt`, read by a person; `UPDATE_SNAPSHOTS=1`
 //! rewrites them).
 
-mod common;
+#[path = "../src/testkit.rs"]
+mod testkit;
 
-use common::fails_for;
 use std::path::{Path, PathBuf};
 use sweepclay_check::{check, CheckConfig, Report};
+use testkit::fails_for;
 
 fn corpus() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/corpus")
