@@ -305,6 +305,59 @@ def jog_edits():
         f.write("\n".join(jogged(4)))
 
 
+# Cura 5's Eazao Zero start and end code (Ultimaker/Cura,
+# resources/definitions/eazao_zero.def.json at commit 07076dc): the end
+# code lifts the nozzle by declaring a new origin (`G92 Z0`, then
+# `G1 Z10`). Debian's CuraEngine 4.13 ships the older definition.
+EAZAO_START = ("G21 \nG90 ;absolute positioning\nM82 ;set extruder to absolute mode\nG28 ;Home \n"
+               "G1 Z15.0 F1500 ;move the platform down 15mm\nG92 E0 \nG1 F1500 E2\nG92 E0\nM302\n"
+               "M163 S0 P0.8; Set Mix Factor\nM163 S1 P0.2; Set Mix Factor\nM164 S0\n")
+EAZAO_END = "G92 Z0 E0\nG1 F1500 E-2\nG1 F1500 Z10\nG28 X0;move X Y to min endstops\nM82\nM84 ;steppers off\n"
+
+
+def firmware_files(tmp, defs, vase):
+    """Files whose firmware commands the checker must read as firmware
+    does (docs/CHECKER.md, "Firmwares"), made by the slicers themselves:
+    CuraEngine with the Eazao Zero's definition and Cura 5's Eazao start
+    and end code (`G92 Z0` before the lift); PrusaSlicer with firmware
+    retraction (`G10`/`G11`); PrusaSlicer's layer-change G-code writing
+    `G4 P0` (a planner sync) at every layer, then `G4 S5` (a 5 s pause) at
+    one layer, then `M221 S10` (10 % flow) from one layer on."""
+    out = os.path.join(OUT, "cura-eazao.gcode")
+    clay = cura_settings()
+    cmd = ["CuraEngine", "slice", "-j", os.path.join(defs, "eazao_zero.def.json")]
+    extra = [f"machine_start_gcode={EAZAO_START}", f"machine_end_gcode={EAZAO_END}",
+             "machine_width=150", "machine_depth=150", "machine_height=240"]
+    for group in (clay + extra,):
+        for s in group:
+            cmd += ["-s", s]
+    cmd += ["-e0"]
+    for s in clay:
+        cmd += ["-s", s]
+    cmd += ["-l", vase, "-o", out]
+    run(cmd)
+
+    def prusa_with(name, *more):
+        path = os.path.join(OUT, name + ".gcode")
+        prusa("prusa-slicer", vase, path, tmp)
+        # The same call with the extra options (prusa() keeps its own).
+        cmd = ["prusa-slicer", "--max-print-height", "200", "--start-gcode",
+               PRUSA_START.replace("\\n", "\n"), "--export-gcode", "--spiral-vase",
+               "--perimeters", "1", "--layer-height", str(LAYER), "--first-layer-height", str(LAYER),
+               "--nozzle-diameter", str(WIDTH), "--extrusion-width", str(WIDTH),
+               "--first-layer-extrusion-width", str(WIDTH), "--filament-diameter", str(FEED_DIA),
+               "--bottom-solid-layers", "0", "--top-solid-layers", "0", "--skirts", "0",
+               "--fill-density", "0", "--center", "100,100", "--bed-shape", "0x0,200x0,200x200,0x200",
+               "--perimeter-speed", "30", "--first-layer-speed", "30", "--retract-length", "2",
+               *more, "-o", path, vase]
+        run(cmd)
+
+    prusa_with("prusa-fwretract", "--use-firmware-retraction")
+    prusa_with("prusa-g4p0", "--layer-gcode", "G4 P0 ; planner sync")
+    prusa_with("fault-dwell", "--layer-gcode", "{if layer_num==12}G4 S5 ; pause for a photo{endif}")
+    prusa_with("fault-m221", "--layer-gcode", "{if layer_num==12}M221 S10 ; flow to 10 %{endif}")
+
+
 def fullcontrol_files():
     import fullcontrol as fc
 
@@ -499,6 +552,7 @@ def main():
         cura(ripple, os.path.join(OUT, "cura-ripple.gcode"), defs)
         lean_files(tmp, defs)
         cone_files(tmp, defs)
+        firmware_files(tmp, defs, vase)
         prusa("prusa-slicer", vase, os.path.join(OUT, "prusa-vase.gcode"), tmp)
         prusa("prusa-slicer", ripple, os.path.join(OUT, "prusa-ripple.gcode"), tmp)
         prusa("slic3r", vase, os.path.join(OUT, "slic3r-vase.gcode"), tmp)

@@ -65,7 +65,7 @@ fn snapshot(file: &str, r: &Report) {
     );
 }
 
-const VALID: [&str; 18] = [
+const VALID: [&str; 21] = [
     // Leaning vase starts: a 35° bowl, 4.5 mm lines on 1.8 mm layers,
     // whose first turn rises from the flat first loop at full flow.
     "cura-bowl.gcode",
@@ -93,6 +93,13 @@ const VALID: [&str; 18] = [
     // A square vase whose first turn is four 63 mm moves: the ramp read
     // as it is read cut into 2 mm moves (docs/CHECKER.md, "Cutting").
     "python-square.gcode",
+    // Firmware commands as the slicers write them (docs/CHECKER.md,
+    // "Firmwares"): Cura 5's Eazao Zero end code lifting by `G92 Z0`,
+    // PrusaSlicer's firmware retraction (`G10`/`G11`) in its start and end
+    // code, and a `G4 P0` planner sync at every layer.
+    "cura-eazao.gcode",
+    "prusa-fwretract.gcode",
+    "prusa-g4p0.gcode",
 ];
 
 #[test]
@@ -155,6 +162,16 @@ fn each_hand_made_fault_fails_for_its_fault() {
         ("fault-m83.gcode", "more clay than fits", &[][..]),
         // The cone's 58° jog run on for four moves, 10.4 mm: it sags.
         ("fault-overhang-run.gcode", "overhang", &[][..]),
+        // PrusaSlicer's layer G-code: `G4 S5` at one layer, a 5 s pause
+        // (it also splits the run)...
+        ("fault-dwell.gcode", "pause", &["extrusion runs"][..]),
+        // ... and `M221 S10` from one layer on: every bead after it a
+        // tenth of its clay, and nothing to hold the next layers up.
+        (
+            "fault-m221.gcode",
+            "under-extruded",
+            &["no clay below", "farther below", "overlapping the bead below", "overhang"][..],
+        ),
     ] {
         println!("{file}");
         let r = report(file);
@@ -355,7 +372,8 @@ fn a_file_cut_at_a_layer_is_judged_as_its_halves() {
     // The first half of a file, judged alone, fails where the whole file
     // fails before the cut, and nowhere else: what is printed later never
     // changes how earlier clay is judged (docs/CHECKER.md, "Halves"),
-    // finding by finding and line by line. The second half
+    // finding by finding and line by line, up to the half's last bead (a
+    // pause just before the cut is the half's end code). The second half
     // alone (the start code, then the print from the cut) starts in the
     // air: never printable, however the first half was supported.
     let mut files: Vec<String> = std::fs::read_dir(corpus())
@@ -376,13 +394,17 @@ fn a_file_cut_at_a_layer_is_judged_as_its_halves() {
             };
             cuts += 1;
             let half = check(&(lines[..cut].join("\n") + "\n"), &printer(file));
+            // After the first half's last bead comes its end: a dwell or
+            // a retraction there ends the print, it is not in it.
+            let end = half.end_code.as_ref().map_or(cut, |e| e.lines[0] - 1);
             for f in sweepclay_check::Finding::ALL {
                 let (w, h) = (&whole.findings[f], &half.findings[f]);
                 // The whole file's lines of this finding before the cut
                 // (1-based lines; the kept lines are the first 256).
-                let before: Vec<usize> = w.lines.iter().copied().filter(|&l| l <= cut).collect();
+                let before: Vec<usize> = w.lines.iter().copied().filter(|&l| l <= end).collect();
+                let b: Vec<usize> = h.lines.iter().copied().filter(|&l| l <= end).collect();
+                let b = &b;
                 let complete = w.lines.len() < sweepclay_check::Count::LINES_KEPT;
-                let b = &h.lines;
                 let same = if complete {
                     &before == b
                 } else {

@@ -95,8 +95,9 @@ pub struct Planned<W> {
 /// the same pass; while the check fails for a reason a correction can
 /// fix, tightens the corrections where it failed and does it again, at
 /// most [`MAX_ROUNDS`] more times (docs/ALGORITHMS.md §4, "The loop
-/// closes"). An overhang or a bead short of the overlap tightens the
-/// support-free correction round each failure, tapering along Ψ; the
+/// closes"). An overhang, a bead short of the overlap or one over clay
+/// two layers down tightens the support-free correction round each
+/// failure, tapering along Ψ; the
 /// extruder body meeting clay compresses all offsets, by steps and then
 /// by bisection, to the least compression that clears. A design that
 /// passes at once costs one slicing and one check. Returns the printable
@@ -229,14 +230,20 @@ fn run<W: Write>(
         let mut w = out()?;
         let (report, locations, lines) =
             verify_lines(&sliced, min_overlap, CancelWriter(&mut w, cancel.clone()))?;
-        let mut support: Vec<usize> = [Finding::Overhang, Finding::UnderMinOverlap]
-            .iter()
-            .flat_map(|&k| report.findings[k].lines.iter())
-            .filter_map(|&l| {
-                let i = lines.partition_point(|&x| x < l);
-                (lines.get(i) == Some(&l)).then(|| sliced.toolpath.points[i].column as usize)
-            })
-            .collect();
+        // A bead over clay two layers down has lost the pass below as an
+        // overhang has: the same tightening brings the pass back under it.
+        let mut support: Vec<usize> = [
+            Finding::Overhang,
+            Finding::UnderMinOverlap,
+            Finding::LayerGap,
+        ]
+        .iter()
+        .flat_map(|&k| report.findings[k].lines.iter())
+        .filter_map(|&l| {
+            let i = lines.partition_point(|&x| x < l);
+            (lines.get(i) == Some(&l)).then(|| sliced.toolpath.points[i].column as usize)
+        })
+        .collect();
         support.sort_unstable();
         support.dedup();
         let body = report.findings[Finding::NozzleCollision].count > 0;
