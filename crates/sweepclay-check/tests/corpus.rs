@@ -16,6 +16,17 @@ fn corpus() -> PathBuf {
     Path::new(env!("CARGO_MANIFEST_DIR")).join("tests/corpus")
 }
 
+/// Every G-code file of the corpus, by name, sorted.
+fn corpus_files() -> Vec<String> {
+    let mut files: Vec<String> = std::fs::read_dir(corpus())
+        .unwrap()
+        .filter_map(|e| e.ok()?.file_name().into_string().ok())
+        .filter(|f| f.ends_with(".gcode"))
+        .collect();
+    files.sort();
+    files
+}
+
 /// The printer a file was made for, from the corpus's printer files.
 fn printer(file: &str) -> CheckConfig {
     let name = if file.starts_with("fullcontrol") || file == "fault-tall-layers.gcode" {
@@ -170,7 +181,12 @@ fn each_hand_made_fault_fails_for_its_fault() {
         (
             "fault-m221.gcode",
             "under-extruded",
-            &["no clay below", "farther below", "overlapping the bead below", "overhang"][..],
+            &[
+                "no clay below",
+                "farther below",
+                "overlapping the bead below",
+                "overhang",
+            ][..],
         ),
     ] {
         println!("{file}");
@@ -300,12 +316,7 @@ fn verdicts_do_not_depend_on_how_moves_are_cut() {
     // skipped moves under a quarter of a bead); PrusaSlicer's vases, cut a
     // hair from a move's end, failed for clay on clay (the sliver ended
     // the first turn's ramp three times).
-    let mut files: Vec<String> = std::fs::read_dir(corpus())
-        .unwrap()
-        .filter_map(|e| e.ok()?.file_name().into_string().ok())
-        .filter(|f| f.ends_with(".gcode"))
-        .collect();
-    files.sort();
+    let files = corpus_files();
     assert!(files.len() > 20, "{files:?}");
     let mut differ = Vec::new();
     for file in &files {
@@ -376,12 +387,7 @@ fn a_file_cut_at_a_layer_is_judged_as_its_halves() {
     // pause just before the cut is the half's end code). The second half
     // alone (the start code, then the print from the cut) starts in the
     // air: never printable, however the first half was supported.
-    let mut files: Vec<String> = std::fs::read_dir(corpus())
-        .unwrap()
-        .filter_map(|e| e.ok()?.file_name().into_string().ok())
-        .filter(|f| f.ends_with(".gcode"))
-        .collect();
-    files.sort();
+    let files = corpus_files();
     let mut differ = Vec::new();
     let mut cuts = 0;
     for file in &files {

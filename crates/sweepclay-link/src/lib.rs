@@ -347,6 +347,23 @@ impl Link {
     }
 }
 
+/// Whether a printer in state `s` may start a new print: not while it
+/// prints (or is paused in a print), not while it is not connected.
+fn ready_to_start(host: &'static str, s: Status) -> Result<(), LinkError> {
+    if s.printing {
+        return Err(LinkError::Busy {
+            file: s.file.unwrap_or_default(),
+        });
+    }
+    if !s.connected {
+        return Err(LinkError::NotConnected {
+            host,
+            state: s.state,
+        });
+    }
+    Ok(())
+}
+
 /// A file name the hosts store as G-code: no folders, `.gcode` at the end.
 fn file_name(name: &str) -> String {
     let base = name.rsplit(['/', '\\']).next().unwrap_or(name);

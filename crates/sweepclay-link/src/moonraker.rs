@@ -77,18 +77,7 @@ pub(crate) async fn upload(link: &Link, name: &str, gcode: Vec<u8>) -> Result<St
 }
 
 pub(crate) async fn start(link: &Link, file: &str) -> Result<(), LinkError> {
-    let s = status(link).await?;
-    if s.printing {
-        return Err(LinkError::Busy {
-            file: s.file.unwrap_or_default(),
-        });
-    }
-    if !s.connected {
-        return Err(LinkError::NotConnected {
-            host: HOST,
-            state: s.state,
-        });
-    }
+    crate::ready_to_start(HOST, status(link).await?)?;
     let req =
         with_key(link, link.http.post(link.at("printer/print/start"))).query(&[("filename", file)]);
     let resp = link.send(req, SHORT).await?;

@@ -74,18 +74,7 @@ pub(crate) async fn upload(link: &Link, name: &str, gcode: Vec<u8>) -> Result<St
 }
 
 pub(crate) async fn start(link: &Link, file: &str) -> Result<(), LinkError> {
-    let s = status_of(link).await?;
-    if s.printing {
-        return Err(LinkError::Busy {
-            file: s.file.unwrap_or_default(),
-        });
-    }
-    if !s.connected {
-        return Err(LinkError::NotConnected {
-            host: HOST,
-            state: s.state,
-        });
-    }
+    crate::ready_to_start(HOST, status_of(link).await?)?;
     let path = format!("api/files/local/{}", encode_path(file));
     let req = with_key(link, link.http.post(link.at(&path)))
         .json(&serde_json::json!({"command": "select", "print": true}));

@@ -207,18 +207,7 @@ async fn state(link: &Link, s: &Session) -> Result<Status, LinkError> {
 
 pub(crate) async fn start(link: &Link, file: &str) -> Result<(), LinkError> {
     in_session(link, async |s| {
-        let now = state(link, s).await?;
-        if now.printing {
-            return Err(LinkError::Busy {
-                file: now.file.unwrap_or_default(),
-            });
-        }
-        if !now.connected {
-            return Err(LinkError::NotConnected {
-                host: HOST,
-                state: now.state,
-            });
-        }
+        crate::ready_to_start(HOST, state(link, s).await?)?;
         let code = format!("M32 \"{file}\"");
         let req = link
             .http

@@ -85,11 +85,7 @@ async fn octoprint_takes_the_file_prints_it_and_names_each_failure() {
 
 #[tokio::test(flavor = "multi_thread")]
 async fn nothing_listening_is_unreachable_in_a_sentence() {
-    let port = std::net::TcpListener::bind("127.0.0.1:0")
-        .unwrap()
-        .local_addr()
-        .unwrap()
-        .port();
+    let port = hosts::free_port();
     for kind in [Kind::OctoPrint, Kind::Moonraker, Kind::RepRap] {
         let link = Link::new(kind, &format!("http://127.0.0.1:{port}"), Some("K".into())).unwrap();
         let e = link.status().await.unwrap_err();

@@ -19,6 +19,9 @@ use std::path::{Path, PathBuf};
 use std::process::{Child, Command, Stdio};
 use std::time::{Duration, Instant};
 
+#[path = "../../sweepclay-link/tests/hosts/mod.rs"]
+mod hosts;
+
 struct Driver(Child);
 
 impl Drop for Driver {
@@ -35,14 +38,6 @@ fn find(env: &str, candidates: &[&str]) -> Option<PathBuf> {
     candidates.iter().map(PathBuf::from).find(|p| p.exists())
 }
 
-fn free_port() -> u16 {
-    std::net::TcpListener::bind("127.0.0.1:0")
-        .unwrap()
-        .local_addr()
-        .unwrap()
-        .port()
-}
-
 async fn start_browser(download_dir: &Path, profile: &Path) -> Option<(Driver, Client)> {
     if std::env::var("SWEEPCLAY_SKIP_BROWSER").is_ok_and(|v| v == "1") {
         eprintln!("SWEEPCLAY_SKIP_BROWSER=1: browser test skipped");
@@ -57,7 +52,7 @@ async fn start_browser(download_dir: &Path, profile: &Path) -> Option<(Driver, C
         &["/usr/bin/chromium", "/usr/bin/chromium-browser"],
     )
     .expect(missing);
-    let port = free_port();
+    let port = hosts::free_port();
     let child = Command::new(&driver)
         .arg(format!("--port={port}"))
         .stdout(Stdio::null())
@@ -2417,9 +2412,6 @@ async fn fields_take_what_is_typed_or_say_why_beside_it() {
     );
     no_page_errors_and_close(c).await;
 }
-
-#[path = "../../sweepclay-link/tests/hosts/mod.rs"]
-mod hosts;
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_pot_is_sent_from_the_page_to_octoprint_and_printed() {
