@@ -89,13 +89,18 @@ struct ServeArgs {
     /// Refuse designs with more surface samples than this (estimated).
     #[arg(long, default_value_t = DEFAULT_MAX_SAMPLES)]
     max_samples: u64,
-    /// Longest a request may wait for a worker and run (seconds); a
-    /// connection silent for a minute longer is closed.
+    /// Longest a request may wait for a worker and run (seconds); its
+    /// answer must begin within a minute longer.
     #[arg(long, default_value_t = 60)]
     timeout: u64,
     /// Most connections open at once (more wait to be accepted).
     #[arg(long, default_value_t = 256)]
     max_connections: usize,
+    /// Longest a client may take to start a request, to send its headers,
+    /// or to fall silent while sending its body (seconds); a body must
+    /// also arrive at 64 KiB/s or faster on the whole.
+    #[arg(long, default_value_t = 10, value_parser = clap::value_parser!(u64).range(1..=3600))]
+    read_timeout: u64,
     /// Another name the server answers to in Host, besides loopback, the
     /// address given and (with 0.0.0.0) the machine's own names and any IP
     /// address (repeatable): what keeps other sites' pages out.
@@ -815,10 +820,12 @@ fn serve(a: ServeArgs) -> Result<i32> {
         let mut limits = sweepclay_web::api::Limits {
             max_samples: a.max_samples as f64,
             request_timeout: std::time::Duration::from_secs(a.timeout),
-            // Idle connections close a minute after the longest request.
+            // A client has --read-timeout to send; an answer may take a
+            // minute more than the longest request.
             connections: sweepclay_web::conn::Connections {
                 max: a.max_connections,
-                idle: std::time::Duration::from_secs(a.timeout + 60),
+                read: std::time::Duration::from_secs(a.read_timeout),
+                answer: std::time::Duration::from_secs(a.timeout + 60),
             },
             ..defaults
         };

@@ -52,9 +52,10 @@ pub struct Limits {
     /// `Content-Length` (its route's limit when it gives none) before any
     /// of it is read, and frees it with its answer; past the budget, 503.
     pub body_budget: usize,
-    /// Connections open at once and their idle timeout (default 256 and
-    /// the request timeout plus a minute, so a slice in flight is never
-    /// cut).
+    /// Connections open at once and how long a client may take (default
+    /// 256; 10 s to start a request, send its headers or fall silent in
+    /// its body; an answer may take the request timeout plus a minute, so
+    /// a slice in flight is never cut).
     pub connections: crate::conn::Connections,
 }
 
@@ -68,7 +69,8 @@ impl Default for Limits {
             request_timeout: std::time::Duration::from_secs(60),
             connections: crate::conn::Connections {
                 max: 256,
-                idle: std::time::Duration::from_secs(120),
+                read: std::time::Duration::from_secs(10),
+                answer: std::time::Duration::from_secs(120),
             },
             hosts: ["127.0.0.1", "localhost", "[::1]"]
                 .map(String::from)

@@ -415,14 +415,16 @@ async fn beyond_the_workers_and_the_queue_the_answer_is_503() {
     assert!(codes.iter().all(|c| c.0 == 200 || c.0 == 503), "{codes:?}");
 }
 
-/// A server with `run`, the connection limits included.
-async fn capped(max: usize, idle_ms: u64) -> std::net::SocketAddr {
+/// A server with `run`, the connection limits included: a client has
+/// `read_ms` to send.
+async fn capped(max: usize, read_ms: u64) -> std::net::SocketAddr {
     let listener = tokio::net::TcpListener::bind("127.0.0.1:0").await.unwrap();
     let addr = listener.local_addr().unwrap();
     let limits = Limits {
         connections: sweepclay_web::conn::Connections {
             max,
-            idle: std::time::Duration::from_millis(idle_ms),
+            read: std::time::Duration::from_millis(read_ms),
+            answer: std::time::Duration::from_secs(120),
         },
         ..Limits::default()
     };
@@ -471,9 +473,9 @@ async fn a_silent_connection_is_closed() {
 #[tokio::test]
 async fn a_request_trickled_a_byte_at_a_time_is_cut_off() {
     use tokio::io::{AsyncReadExt, AsyncWriteExt};
-    // Idle limit 400 ms, so a request must be answered within 800 ms of
-    // its first byte; this client sends a header byte every 100 ms, never
-    // silent long enough to be idle.
+    // Read limit 400 ms: a request's headers must all be in within 400 ms
+    // of its first byte; this client sends a header byte every 100 ms,
+    // never silent long enough to be idle.
     let addr = capped(8, 400).await;
     let mut s = tokio::net::TcpStream::connect(addr).await.unwrap();
     let t = std::time::Instant::now();
@@ -496,7 +498,7 @@ async fn a_request_trickled_a_byte_at_a_time_is_cut_off() {
     }
     let cut = cut.expect("the server cut the trickling request off");
     assert!(
-        cut >= std::time::Duration::from_millis(700) && cut < std::time::Duration::from_secs(3),
+        cut >= std::time::Duration::from_millis(350) && cut < std::time::Duration::from_secs(2),
         "{cut:?}"
     );
 }
@@ -718,4 +720,114 @@ async fn ambiguous_hosts_and_origins_are_refused() {
     )
     .await;
     assert!(r.starts_with("HTTP/1.1 200"), "{r}");
+}
+
+/// Reads from `s` until it closes (0 bytes or an error) or `within`
+/// passes: whether it was closed, and after how long.
+async fn closed_within(
+    s: &mut tokio::net::TcpStream,
+    within: std::time::Duration,
+) -> (bool, std::time::Duration) {
+    use tokio::io::AsyncReadExt;
+    let t = std::time::Instant::now();
+    let mut buf = [0u8; 256];
+    loop {
+        match tokio::time::timeout(within.saturating_sub(t.elapsed()), s.read(&mut buf)).await {
+            Err(_) => return (false, t.elapsed()),
+            Ok(Ok(0)) | Ok(Err(_)) => return (true, t.elapsed()),
+            // An answer (a 4xx for a cut body): keep reading to the close.
+            Ok(Ok(_)) => {}
+        }
+    }
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_body_that_stalls_or_trickles_is_cut_off_but_a_long_answer_is_not() {
+    use tokio::io::{AsyncReadExt, AsyncWriteExt};
+    let ms = std::time::Duration::from_millis;
+    // A client has 300 ms to send: to start, for its headers, and for any
+    // silence in its body.
+    let addr = capped(8, 300).await;
+    let head = |len: usize| {
+        format!(
+            "POST /api/check HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/octet-stream\r\nContent-Length: {len}\r\n\r\n"
+        )
+    };
+    // A body that stops after 10 of its 1,000 bytes.
+    let mut s = tokio::net::TcpStream::connect(addr).await.unwrap();
+    s.write_all(head(1000).as_bytes()).await.unwrap();
+    s.write_all(&[b';'; 10]).await.unwrap();
+    let (closed, after) = closed_within(&mut s, ms(5000)).await;
+    assert!(closed && after >= ms(250), "stalled body: {after:?}");
+    // A body trickled a byte every 100 ms, never silent for 300 ms: all of
+    // it must be in at 64 KiB/s after the first 300 ms.
+    let mut s = tokio::net::TcpStream::connect(addr).await.unwrap();
+    s.write_all(head(200).as_bytes()).await.unwrap();
+    let t = std::time::Instant::now();
+    let mut cut = None;
+    for _ in 0..200 {
+        if s.write_all(b";").await.is_err() {
+            cut = Some(t.elapsed());
+            break;
+        }
+        let mut buf = [0u8; 256];
+        match tokio::time::timeout(ms(100), s.read(&mut buf)).await {
+            Ok(Ok(0)) | Ok(Err(_)) => {
+                cut = Some(t.elapsed());
+                break;
+            }
+            _ => {}
+        }
+    }
+    let cut = cut.expect("the trickled body was cut off");
+    assert!(cut >= ms(250) && cut < ms(2000), "trickled body: {cut:?}");
+    // An answer that takes far longer than 300 ms (a million samples to
+    // G-code) is waited for: the server, not the client, is working.
+    let body = sweepclay_core::examples::scaled(1_000_000).to_json();
+    let mut s = tokio::net::TcpStream::connect(addr).await.unwrap();
+    let t = std::time::Instant::now();
+    s.write_all(
+        format!(
+            "POST /api/gcode HTTP/1.1\r\nHost: 127.0.0.1\r\nContent-Type: application/json\r\nContent-Length: {}\r\n\r\n",
+            body.len()
+        )
+        .as_bytes(),
+    )
+    .await
+    .unwrap();
+    s.write_all(body.as_bytes()).await.unwrap();
+    let mut buf = vec![0u8; 64];
+    let n = tokio::time::timeout(std::time::Duration::from_secs(120), s.read(&mut buf))
+        .await
+        .expect("an answer")
+        .unwrap();
+    let status = String::from_utf8_lossy(&buf[..n]).to_string();
+    assert!(status.starts_with("HTTP/1.1 200"), "{status}");
+    assert!(
+        t.elapsed() > ms(300),
+        "{:?}: too fast to show it",
+        t.elapsed()
+    );
+}
+
+#[tokio::test]
+async fn silent_connections_give_their_places_back_in_seconds() {
+    // Two places, both taken by clients that never send a byte: a third
+    // client is served once the read limit (300 ms) has closed them, not
+    // after a minute.
+    let addr = capped(2, 300).await;
+    let _a = tokio::net::TcpStream::connect(addr).await.unwrap();
+    let _b = tokio::net::TcpStream::connect(addr).await.unwrap();
+    tokio::time::sleep(std::time::Duration::from_millis(50)).await;
+    let t = std::time::Instant::now();
+    let mut c = tokio::net::TcpStream::connect(addr).await.unwrap();
+    let served = tokio::time::timeout(std::time::Duration::from_secs(5), status_line(&mut c))
+        .await
+        .expect("served once the silent ones were closed");
+    assert!(served.contains("200"), "{served}");
+    assert!(
+        t.elapsed() >= std::time::Duration::from_millis(200),
+        "{:?}",
+        t.elapsed()
+    );
 }
