@@ -1059,12 +1059,13 @@ function plainWords(msg) {
     const [, printer, axis, a, b, lo, hi] = fit;
     const over = Math.max(Number(lo) - Number(a), Number(b) - Number(hi));
     const word = { x: 'wide', y: 'deep', z: 'tall' }[axis];
-    return `${over.toFixed(1)} mm too ${word} for ${printer}: along ${axis} it spans ${Number(a).toFixed(1)} to ${Number(b).toFixed(1)} mm, the printer ${Number(lo).toFixed(1)} to ${Number(hi).toFixed(1)} mm (the part outside is violet in the 3D view)`;
+    // What came before it ("No GCODE file: ") stays: it says what was refused.
+    return `${msg.slice(0, fit.index)}${over.toFixed(1)} mm too ${word} for ${printer}: along ${axis} it spans ${Number(a).toFixed(1)} to ${Number(b).toFixed(1)} mm, the printer ${Number(lo).toFixed(1)} to ${Number(hi).toFixed(1)} mm (the part outside is violet in the 3D view)`;
   }
   const round = /the design does not fit printer `([^`]+)`: it reaches (\S+) mm from the bed's centre but the round bed is (\S+) mm across/.exec(msg);
   if (round) {
     const [, printer, reach, dia] = round;
-    return `${(Number(reach) - Number(dia) / 2).toFixed(1)} mm past the edge of ${printer}'s round bed (${dia} mm across; the part outside is violet in the 3D view)`;
+    return `${msg.slice(0, round.index)}${(Number(reach) - Number(dia) / 2).toFixed(1)} mm past the edge of ${printer}'s round bed (${dia} mm across; the part outside is violet in the 3D view)`;
   }
   return msg.replace(/params\.(\w+): must be between (\S+) and (\S+) \(got ([^)]+)\)/, (all, k, a, b, v) => {
     const p = param(k);
@@ -1089,6 +1090,7 @@ function showError(msg, key) {
   document.querySelectorAll('#params input.bad').forEach((i) => i.classList.remove('bad'));
   document.querySelectorAll('#params .field-error').forEach((p) => p.remove());
   $('side-error').textContent = '';
+  $('shape-error').textContent = '';
   if (!msg) {
     s.querySelector('.error')?.remove();
     // A good slice: the next error is nobody's earlier change.
@@ -1125,6 +1127,9 @@ function showError(msg, key) {
     div.append(out);
   }
   s.appendChild(div);
+  // On a phone's Shape tab too: the status line is on the 3D tab, and a
+  // refused download would seem to do nothing (docs/MODELER.md).
+  $('shape-error').textContent = text;
   // Beside the field too: on a phone the 3D panel with the status line is
   // hidden while the settings are shown (docs/MODELER.md).
   const field = blamed && $(`p-${blamed}`);

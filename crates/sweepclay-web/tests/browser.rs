@@ -2626,3 +2626,67 @@ async fn the_printer_dialog_calibrates_e_from_measured_walls() {
     assert!((kept.as_f64().unwrap() - e).abs() < 1e-9, "{kept}");
     no_page_errors_and_close(c).await;
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_refusal_shows_on_the_phones_shape_tab() {
+    let Some(Session {
+        driver: _driver,
+        c,
+        base,
+        ..
+    }) = Session::start().await
+    else {
+        return;
+    };
+    c.set_window_size(390, 844).await.unwrap();
+    c.goto(&base).await.unwrap();
+    close_guide(&c).await;
+    wait_js(
+        &c,
+        &format!("return {IDLE} && {}", &PRINTABLE[7..]),
+        "the first slice",
+    )
+    .await;
+    click(&c, "new-pot").await;
+    wait_js(
+        &c,
+        &format!("return {IDLE} && !window.sweepclay.design.profile_end && document.body.dataset.tab === 'editors'"),
+        "a new pot on the Shape tab",
+    )
+    .await;
+    let shown = "const e = document.getElementById('shape-error'); return e.getBoundingClientRect().height > 0 && e.textContent";
+    assert_eq!(js(&c, shown).await, json!(false), "no error yet");
+    // Twice the printer's height: refused, and said where the potter is.
+    let h = js(
+        &c,
+        "const s = window.sweepclay, p = s.design.printer; return (typeof p === 'object' ? p : s.meta.presets.find((q) => q.name === (p || 'generic'))).build_volume[2] * 2",
+    )
+    .await;
+    set_value(&c, "pot-height", &h.to_string()).await;
+    let said = wait_js(&c, shown, "the refusal on the Shape tab").await;
+    assert!(said.as_str().unwrap().contains("printer"), "{said}");
+    // "Download G-code" says why it gives nothing, on this tab too.
+    click(&c, "download-gcode").await;
+    let said = wait_js(
+        &c,
+        "const e = document.getElementById('shape-error'); const t = e.getBoundingClientRect().height > 0 && e.textContent; return t && t.startsWith('No GCODE file') && t",
+        "the download's refusal on the Shape tab",
+    )
+    .await;
+    assert!(said.as_str().unwrap().contains("printer"), "{said}");
+    if let Ok(path) = std::env::var("SWEEPCLAY_PHONE_ERROR_SCREENSHOT") {
+        std::fs::write(&path, c.screenshot().await.unwrap()).unwrap();
+    }
+    // A pot that fits clears it.
+    set_value(&c, "pot-height", "60").await;
+    wait_js(
+        &c,
+        &format!(
+            "return {IDLE} && {} && document.getElementById('shape-error').textContent === ''",
+            &PRINTABLE[7..]
+        ),
+        "the error cleared",
+    )
+    .await;
+    no_page_errors_and_close(c).await;
+}
