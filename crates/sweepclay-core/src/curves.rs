@@ -34,6 +34,10 @@ fn check_points(key: &str, pts: &[[f64; 2]], min: usize) -> Result<()> {
     Ok(())
 }
 
+/// How far a profile's row (`points`) may lie from its curve (mm): the
+/// modeler writes the curve through them to 3 decimals.
+pub const ON_CURVE_MM: f64 = 0.05;
+
 /// A profile curve sampled as horizontal offset from its start against
 /// normalised height.
 #[derive(Clone, Debug, PartialEq)]
@@ -91,7 +95,29 @@ impl Profile {
             let s = ((z - a[1]) / (b[1] - a[1])).clamp(0.0, 1.0);
             table.push(a[0] + s * (b[0] - a[0]) - first[0]);
         }
-        Ok(Profile { height, table })
+        let profile = Profile { height, table };
+        // The rows a potter typed must be where the curve is: the file
+        // says both, and they must not disagree.
+        for (i, &[x, z]) in spec.points.iter().flatten().enumerate() {
+            let pkey = format!("{key}.points[{i}]");
+            if !(x.is_finite() && z.is_finite() && (-1e-9..=height + 1e-9).contains(&z)) {
+                return Err(Error::invalid(
+                    pkey,
+                    format!("must be a point of the curve, from z = 0 to its height {height} mm (got [{x}, {z}])"),
+                ));
+            }
+            let on = first[0] + profile.offset(z / height);
+            if (on - x).abs() > ON_CURVE_MM {
+                return Err(Error::invalid(
+                    pkey,
+                    format!(
+                        "is {:.2} mm off the curve its control points draw (x = {on:.2} mm at z = {z} mm): the rows must lie on the curve; remove `points` to keep the curve as drawn",
+                        (on - x).abs()
+                    ),
+                ));
+            }
+        }
+        Ok(profile)
     }
 
     /// x(t·Z) − x(0), the horizontal offset at normalised height `t`.
@@ -168,6 +194,12 @@ impl Interpolation {
                 Interpolation::Linear
             });
         };
+        if spec.points.is_some() {
+            return Err(Error::invalid(
+                "interpolation.points",
+                "only a profile takes points (its rows); the interpolation is given by control_points",
+            ));
+        }
         let key = "interpolation.control_points";
         let pts = &spec.control_points;
         check_points(key, pts, 2)?;
@@ -619,7 +651,26 @@ mod tests {
     fn curve(p: &[[f64; 2]]) -> CurveSpec {
         CurveSpec {
             control_points: p.to_vec(),
+            points: None,
         }
+    }
+
+    #[test]
+    fn a_profiles_rows_must_lie_on_its_curve() {
+        // A quadratic through (0, 0), (5, 20) and (0, 40) at its middle
+        // parameter: control point x = 2 · 5 − (0 + 0) / 2 = 10.
+        let mut c = curve(&[[0.0, 0.0], [10.0, 20.0], [0.0, 40.0]]);
+        c.points = Some(vec![[0.0, 0.0], [5.0, 20.0], [0.0, 40.0]]);
+        assert!(Profile::new("profile_start", &c).is_ok());
+        c.points = Some(vec![[0.0, 0.0], [6.0, 20.0]]);
+        let e = Profile::new("profile_start", &c).unwrap_err().to_string();
+        assert!(
+            e.contains("profile_start.points[1]") && e.contains("1.00 mm off the curve"),
+            "{e}"
+        );
+        c.points = Some(vec![[0.0, 50.0]]);
+        let e = Profile::new("profile_start", &c).unwrap_err().to_string();
+        assert!(e.contains("from z = 0 to its height 40"), "{e}");
     }
 
     #[test]

@@ -62,6 +62,12 @@ fn is_zero(v: &f64) -> bool {
 pub struct CurveSpec {
     /// Control points; 2 give a segment, 3 a quadratic, 4 or more a cubic.
     pub control_points: Vec<[f64; 2]>,
+    /// A profile's rows as a potter typed them, `[x, z]`: points the
+    /// curve passes through (the modeler's widths at heights). Checked:
+    /// each must lie on the curve within [`crate::curves::ON_CURVE_MM`]
+    /// (docs/FORMATS.md). Omitted: none.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub points: Option<Vec<[f64; 2]>>,
 }
 
 /// The trajectory: a B-spline or an imported polyline.
@@ -581,7 +587,13 @@ impl Design {
             return d;
         }
         for c in std::iter::once(&mut d.profile_start).chain(d.profile_end.as_mut()) {
-            for p in &mut c.control_points {
+            // A scaled curve passes through its scaled rows (affine
+            // invariance).
+            for p in c
+                .control_points
+                .iter_mut()
+                .chain(c.points.iter_mut().flatten())
+            {
                 *p = [p[0] * kxy, p[1] * kz];
             }
         }
@@ -607,8 +619,10 @@ impl Design {
     pub fn end_profile(&self) -> std::borrow::Cow<'_, CurveSpec> {
         match (&self.profile_end, &self.rim) {
             (Some(end), _) => std::borrow::Cow::Borrowed(end),
+            // Stretched, the start profile's rows are no longer on it.
             (None, Some(rim)) => std::borrow::Cow::Owned(CurveSpec {
                 control_points: rim.stretched(&self.profile_start.control_points),
+                points: None,
             }),
             (None, None) => std::borrow::Cow::Borrowed(&self.profile_start),
         }

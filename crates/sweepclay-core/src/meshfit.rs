@@ -567,15 +567,17 @@ impl Candidate {
         let mut v = serde_json::json!({
             "sweepclay": 1,
             "name": name,
-            "profile_start": CurveSpec { control_points: self.start.clone() },
+            "profile_start": CurveSpec { control_points: self.start.clone(), points: None },
             "trajectory": traj,
         });
         if self.two {
             v["profile_end"] = serde_json::json!(CurveSpec {
-                control_points: self.end.clone()
+                control_points: self.end.clone(),
+                points: None,
             });
             v["interpolation"] = serde_json::json!(CurveSpec {
-                control_points: self.interp.clone()
+                control_points: self.interp.clone(),
+                points: None,
             });
         }
         v.to_string()

@@ -1026,6 +1026,7 @@ mod tests {
         d.profile_start.control_points = vec![[0.0, 0.0], [10.0, 40.0]];
         d.profile_end = Some(crate::design::CurveSpec {
             control_points: vec![[5.0, 0.0], [5.0, 40.0]],
+            points: None,
         });
         let s = sample_surface(&d).unwrap();
         let first = &s.columns[0];
@@ -1089,6 +1090,7 @@ mod tests {
         d.profile_start.control_points = vec![[0.0, 0.0], [5.0, 20.0]];
         d.profile_end = Some(crate::design::CurveSpec {
             control_points: vec![[0.0, 0.0], [5.0, 20.0]],
+            points: None,
         });
         d.params.max_overhang_deg = 60.0;
         let s = sample_surface(&d).unwrap();

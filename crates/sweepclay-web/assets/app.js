@@ -5,7 +5,7 @@
 
 import { CurveEditor, fmt, segDist } from './editor.js';
 import { View3D } from './view3d.js';
-import { sample, samplePeriodic } from './bspline.js';
+import { onCurve, rowsOnCurve, sample, samplePeriodic, throughRows } from './bspline.js';
 import { afterPaint, frameStats, onFrame } from './frame.js';
 import { fetchSlice } from './mesh.js';
 
@@ -226,7 +226,12 @@ function profilePoints(d, key) {
 function profileEditor(id, key, otherKey) {
   return new CurveEditor($(id), {
     get: () => (state.design ? profilePoints(state.design, key) : []),
-    set: (pts, final, since) => edit((d) => { d[key] = { control_points: pts }; }, final, since),
+    // A drag moves the curve; a pot's typed rows stay at their heights,
+    // on the curve (`rowsOnCurve`).
+    set: (pts, final, since) => edit((d) => {
+      const rows = d[key]?.points;
+      d[key] = rows ? { control_points: pts, points: rowsOnCurve(pts, rows).map(mm3) } : { control_points: pts };
+    }, final, since),
     curve,
     // A pot has no other profile to show faintly.
     ghost: () => (state.design?.profile_end ? profilePoints(state.design, otherKey) : null),
@@ -462,10 +467,31 @@ function baseWidth(d) {
   return Math.max(...xs) - Math.min(...xs);
 }
 
-/** The table's rows: each profile point as a height and a width across. */
+/**
+ * The table's rows: the points the profile passes through as the potter
+ * typed them (the profile's `points`), or, for a profile drawn without
+ * them, its own points one a control point (`onCurve`); each is a height
+ * and a width across. Typed rows become the control points of a curve
+ * through them (`throughRows`) and are kept as `points`, so the pot is as
+ * wide as typed at each typed height (docs/MODELER.md, "Widths at
+ * heights").
+ */
+function potRows(d) {
+  const c = d.profile_start;
+  return (c.points || onCurve(c.control_points)).map((p) => p.slice());
+}
+
+const mm3 = ([x, z]) => [+x.toFixed(3), +z.toFixed(3)];
+
+/** Sets the profile to the curve through `rows` (heights sorted). */
+function setPotRows(d, rows) {
+  rows.sort((a, b) => a[1] - b[1]);
+  d.profile_start = { control_points: throughRows(rows).map(mm3), points: rows.map(mm3) };
+}
+
 function fillPot() {
   const d = state.design;
-  const pts = d.profile_start.control_points;
+  const pts = potRows(d);
   const w0 = baseWidth(d);
   const p = { ...state.meta.params, ...(d.params || {}) };
   // Rebuilt only when it shows something else: a drag repaints no table.
@@ -502,7 +528,11 @@ function fillPot() {
       del.textContent = '×';
       del.id = `pot-del${i}`;
       del.title = 'Remove this height';
-      del.addEventListener('click', () => edit((dd) => { dd.profile_start.control_points.splice(i, 1); }, true));
+      del.addEventListener('click', () => edit((dd) => {
+        const rows = potRows(dd);
+        rows.splice(i, 1);
+        setPotRows(dd, rows);
+      }, true));
       td.appendChild(del);
     }
     tr.appendChild(td);
@@ -536,7 +566,7 @@ function potEdit(i, what, inp) {
   const v = potNumber(inp, what === 'z' ? 'height' : 'width');
   if (v == null) return;
   const d = state.design;
-  const pts = d.profile_start.control_points;
+  const pts = potRows(d);
   if (what === 'z') {
     // Any height above the base takes its place among the rows (they
     // stay sorted, each keeping its width); it may not sit on another.
@@ -550,9 +580,9 @@ function potEdit(i, what, inp) {
       return;
     }
     edit((dd) => {
-      const p = dd.profile_start.control_points;
-      p[i][1] = v;
-      p.sort((a, b) => a[1] - b[1]);
+      const rows = potRows(dd);
+      rows[i][1] = v;
+      setPotRows(dd, rows);
     }, true);
     return;
   }
@@ -570,12 +600,17 @@ function potEdit(i, what, inp) {
       const t = dd.trajectory;
       const key = t.points ? 'points' : 'control_points';
       t[key] = t[key].map(([x, y]) => [+(x * k).toFixed(3), +(y * k).toFixed(3)]);
-      const p0 = dd.profile_start.control_points;
-      for (let j = 1; j < p0.length; j++) p0[j][0] = +(p0[0][0] + (others[j] - v) / 2).toFixed(3);
+      const rows = potRows(dd);
+      for (let j = 1; j < rows.length; j++) rows[j][0] = rows[0][0] + (others[j] - v) / 2;
+      setPotRows(dd, rows);
     }, true);
     return;
   }
-  edit((dd) => { dd.profile_start.control_points[i][0] = +(pts[0][0] + (v - w0) / 2).toFixed(3); }, true);
+  edit((dd) => {
+    const rows = potRows(dd);
+    rows[i][0] = pts[0][0] + (v - w0) / 2;
+    setPotRows(dd, rows);
+  }, true);
 }
 
 /**
@@ -636,11 +671,15 @@ $('rim-width').addEventListener('change', () => rimEdit('rim-width', 'width_deg'
 // A new height goes in the middle of the largest gap between the rows
 // (type any height into it: the rows re-sort).
 $('pot-add').addEventListener('click', () => edit((d) => {
-  const p = d.profile_start.control_points;
+  const ctrl = d.profile_start.control_points;
+  const p = potRows(d);
   let k = 1;
   for (let j = 2; j < p.length; j++) if (p[j][1] - p[j - 1][1] > p[k][1] - p[k - 1][1]) k = j;
-  const [a, b] = [p[k - 1], p[k]];
-  p.splice(k, 0, [+((a[0] + b[0]) / 2).toFixed(3), +((a[1] + b[1]) / 2).toFixed(3)]);
+  // The curve's own point half way up between the two rows: the pot
+  // keeps its shape there, and passes through every row as before.
+  const z = (p[k - 1][1] + p[k][1]) / 2;
+  p.splice(k, 0, rowsOnCurve(ctrl, [[0, z]])[1] ?? [(p[k - 1][0] + p[k][0]) / 2, z]);
+  setPotRows(d, p);
 }, true));
 
 $('pot-height').addEventListener('change', () => {
@@ -662,7 +701,8 @@ $('pot-height').addEventListener('change', () => {
     return;
   }
   edit((d) => {
-    for (const p of d.profile_start.control_points) p[1] = +((p[1] * h) / top).toFixed(3);
+    const c = d.profile_start;
+    for (const p of [...c.control_points, ...(c.points || [])]) p[1] = +((p[1] * h) / top).toFixed(3);
   }, true);
 });
 

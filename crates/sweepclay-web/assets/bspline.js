@@ -61,3 +61,123 @@ export function samplePeriodic(ctrl, per = 24) {
   out.push(out[0]);
   return out;
 }
+
+/**
+ * The parameters of a clamped B-spline with `n` control points at which it
+ * passes through its rows (the Greville abscissae of its knots: one a
+ * control point, the ends included; docs/MODELER.md, "Widths at heights").
+ */
+export function greville(n) {
+  const p = Math.min(3, n - 1);
+  const kv = knots(n, p);
+  const out = [];
+  for (let i = 0; i < n; i++) {
+    let s = 0;
+    for (let j = 1; j <= p; j++) s += kv[i + j];
+    out.push(p > 0 ? s / p : 0);
+  }
+  return out;
+}
+
+/** The curve's points at [`greville`]: one on the curve for each control point. */
+export function onCurve(ctrl) {
+  const kv = knots(ctrl.length, Math.min(3, ctrl.length - 1));
+  return greville(ctrl.length).map((t) => evalAt(ctrl, t, kv));
+}
+
+/**
+ * The control points of the clamped B-spline that passes through `pts` at
+ * [`greville`] (the inverse of [`onCurve`]): the basis matrix at those
+ * parameters, solved by Gaussian elimination with partial pivoting. The
+ * Schoenberg–Whitney condition holds there, so it is never singular.
+ */
+export function through(pts) {
+  const n = pts.length;
+  if (n < 3) return pts.map((p) => p.slice());
+  const kv = knots(n, Math.min(3, n - 1));
+  const ts = greville(n);
+  // a[i][j]: basis j at t_i, read off the curve of the unit control points.
+  // Each row ends with its point's x and z, the right-hand sides.
+  const a = ts.map((t, i) => {
+    const row = [];
+    for (let j = 0; j < n; j++) {
+      const unit = Array.from({ length: n }, (_, k) => [k === j ? 1 : 0, 0]);
+      row.push(evalAt(unit, t, kv)[0]);
+    }
+    return row.concat(pts[i]);
+  });
+  for (let c = 0; c < n; c++) {
+    let best = c;
+    for (let r = c + 1; r < n; r++) if (Math.abs(a[r][c]) > Math.abs(a[best][c])) best = r;
+    [a[c], a[best]] = [a[best], a[c]];
+    for (let r = 0; r < n; r++) {
+      if (r === c || a[r][c] === 0) continue;
+      const f = a[r][c] / a[c][c];
+      for (let k = c; k < n + 2; k++) a[r][k] -= f * a[c][k];
+    }
+  }
+  return a.map((row, i) => [row[n] / row[i], row[n + 1] / row[i]]);
+}
+
+/** The curve's x at height `z` (its z rising along it), read off 800 chords. */
+export function xAt(ctrl, z) {
+  const s = sample(ctrl, 800);
+  for (let k = 0; k + 1 < s.length; k++) {
+    const [a, b] = [s[k], s[k + 1]];
+    if (z <= b[1] || k + 2 === s.length) {
+      const f = b[1] > a[1] ? Math.min(1, Math.max(0, (z - a[1]) / (b[1] - a[1]))) : 0;
+      return a[0] + f * (b[0] - a[0]);
+    }
+  }
+  return s[0][0];
+}
+
+/**
+ * Control points of a profile through `rows` (`[x, z]`, heights rising):
+ * the rows and, between them, points every `step` mm or so on a cubic
+ * Hermite curve through the rows (slopes from the neighbouring rows,
+ * upright at the foot and the lip), all
+ * passed through by [`through`]. Evenly spaced heights keep the curve's
+ * height rising evenly with its parameter, so it bulges where the rows do
+ * and nowhere else (docs/MODELER.md, "Widths at heights").
+ */
+export function throughRows(rows, step = 15) {
+  const r = rows.map((p) => p.slice()).sort((a, b) => a[1] - b[1]);
+  if (r.length <= 2) return r;
+  // The wall leaves the foot and meets the lip upright (slope 0 there), so
+  // the floor, laid under the first turn, is as wide as the foot typed.
+  const slope = r.map((p, k) => {
+    if (k === 0 || k === r.length - 1) return 0;
+    const [a, b] = [r[k - 1], r[k + 1]];
+    return (b[0] - a[0]) / (b[1] - a[1]);
+  });
+  const pts = [r[0]];
+  const last = r.length - 2;
+  for (let k = 0; k + 1 < r.length; k++) {
+    const [[x0, z0], [x1, z1]] = [r[k], r[k + 1]];
+    const h = z1 - z0;
+    const n = Math.max(1, Math.round(h / step));
+    // A third of the way into the first and last segments, one more point
+    // holds the curve upright at the foot and the lip.
+    const at = Array.from({ length: n - 1 }, (_, j) => (j + 1) / n);
+    if (k === 0) at.unshift(1 / (3 * n));
+    if (k === last) at.push(1 - 1 / (3 * n));
+    for (const s of at) {
+      const [h00, h10, h01, h11] = [2 * s ** 3 - 3 * s ** 2 + 1, s ** 3 - 2 * s ** 2 + s, -2 * s ** 3 + 3 * s ** 2, s ** 3 - s ** 2];
+      pts.push([h00 * x0 + h10 * h * slope[k] + h01 * x1 + h11 * h * slope[k + 1], z0 + s * h]);
+    }
+    pts.push(r[k + 1]);
+  }
+  return through(pts);
+}
+
+/**
+ * `rows` moved onto the curve of `ctrl` at their heights (after the curve
+ * was dragged or scaled): the base and the top follow the curve's ends,
+ * rows above its top are dropped.
+ */
+export function rowsOnCurve(ctrl, rows) {
+  const top = ctrl[ctrl.length - 1][1];
+  const inner = rows.filter(([, z]) => z > 1e-6 && z < top - 1e-6).map(([, z]) => [xAt(ctrl, z), z]);
+  return [ctrl[0].slice(), ...inner, ctrl[ctrl.length - 1].slice()];
+}

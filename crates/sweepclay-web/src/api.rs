@@ -807,6 +807,7 @@ mod tests {
         let mut d = design("t4");
         d.profile_end = Some(sweepclay_core::design::CurveSpec {
             control_points: vec![[0.0, 0.0], [45.0, 20.0], [45.0, 40.0]],
+            points: None,
         });
         let v = slice_view(&job(d.clone()), &Cancel::new()).unwrap();
         assert!(!v.corrections.is_empty());

@@ -2315,27 +2315,22 @@ async fn fields_take_what_is_typed_or_say_why_beside_it() {
     );
     // "Add a height" goes into the largest gap; any height typed there
     // takes its place among the rows, which stay sorted.
-    let before = js(
-        &c,
-        "return window.sweepclay.design.profile_start.control_points.map((p) => p[1])",
-    )
-    .await;
+    // The table's heights: the rows the profile passes through.
+    let rows_z = "return Array.from(document.querySelectorAll('#pot-rows tbody input[id^=pot-z]')).map((i) => parseFloat(i.value))";
+    let before = js(&c, rows_z).await;
     click(&c, "pot-add").await;
     let n = before.as_array().unwrap().len();
     wait_js(
         &c,
         &format!(
-            "return window.sweepclay.design.profile_start.control_points.length === {} || null",
+            "return {IDLE} && document.querySelectorAll('#pot-rows tbody tr').length === {} || null",
             n + 1
         ),
         "a height added",
     )
     .await;
-    let added = js(
-        &c,
-        "return window.sweepclay.design.profile_start.control_points.map((p) => p[1])",
-    )
-    .await;
+    wait_js(&c, &format!("return {IDLE}"), "the table refilled").await;
+    let added = js(&c, rows_z).await;
     let added: Vec<f64> = added
         .as_array()
         .unwrap()
@@ -2354,7 +2349,7 @@ async fn fields_take_what_is_typed_or_say_why_beside_it() {
     set_value(&c, &format!("pot-z{i}"), "10").await;
     let zs = wait_js(
         &c,
-        "const z = window.sweepclay.design.profile_start.control_points.map((p) => p[1]); return z.includes(10) ? z : null",
+        "const z = Array.from(document.querySelectorAll('#pot-rows tbody input[id^=pot-z]')).map((i) => parseFloat(i.value)); return z.includes(10) ? z : null",
         "the new height at 10 mm",
     )
     .await;
@@ -2688,5 +2683,149 @@ async fn a_refusal_shows_on_the_phones_shape_tab() {
         "the error cleared",
     )
     .await;
+    no_page_errors_and_close(c).await;
+}
+
+/// The path's width across (its x-extent, mm) at each of `zs` in a
+/// G-code text: the moves within 0.7 mm of that height.
+fn widths_at(gcode: &str, zs: &[f64]) -> Vec<f64> {
+    let (mut x, mut y, mut z) = (0.0f64, 0.0f64, 0.0f64);
+    let mut span = vec![(f64::MAX, f64::MIN); zs.len()];
+    for line in gcode.lines() {
+        let code = line.split(';').next().unwrap_or("");
+        if !code.starts_with("G1 ") {
+            continue;
+        }
+        for w in code.split_whitespace().skip(1) {
+            let v = w[1..].parse::<f64>().unwrap_or(f64::NAN);
+            match &w[..1] {
+                "X" => x = v,
+                "Y" => y = v,
+                "Z" => z = v,
+                _ => {}
+            }
+        }
+        let _ = y;
+        for (k, &at) in zs.iter().enumerate() {
+            if (z - at).abs() <= 0.7 {
+                span[k] = (span[k].0.min(x), span[k].1.max(x));
+            }
+        }
+    }
+    span.iter().map(|(lo, hi)| hi - lo).collect()
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_pot_typed_80_130_70_80_prints_those_widths() {
+    let Some(Session {
+        tmp: _tmp,
+        downloads,
+        driver: _driver,
+        c,
+        base,
+        ..
+    }) = Session::start().await
+    else {
+        return;
+    };
+    c.goto(&base).await.unwrap();
+    close_guide(&c).await;
+    wait_js(
+        &c,
+        &format!("return {IDLE} && {}", &PRINTABLE[7..]),
+        "the first slice",
+    )
+    .await;
+    click(&c, "new-pot").await;
+    wait_js(
+        &c,
+        &format!("return {IDLE} && !window.sweepclay.design.profile_end"),
+        "a new pot",
+    )
+    .await;
+    // Four rows: add heights or remove them.
+    loop {
+        let n = js(
+            &c,
+            "return window.sweepclay.design.profile_start.control_points.length",
+        )
+        .await
+        .as_u64()
+        .unwrap();
+        if n == 4 {
+            break;
+        }
+        if n < 4 {
+            click(&c, "pot-add").await;
+        } else {
+            click(&c, &format!("pot-del{}", n - 1)).await;
+        }
+        wait_js(
+            &c,
+            &format!(
+                "return {IDLE} && document.querySelectorAll('#pot-rows tbody tr').length !== {n}"
+            ),
+            "a row added or removed",
+        )
+        .await;
+    }
+    // As a potter measures a pot: 80 mm across at the foot, 130 at the
+    // belly (45 mm up), 70 at the neck (95 mm), 80 at the lip (120 mm).
+    set_value(&c, "pot-height", "120").await;
+    wait_js(
+        &c,
+        &format!("return {IDLE} && document.getElementById('pot-z3').value === '120'"),
+        "120 mm",
+    )
+    .await;
+    for (id, v) in [
+        ("pot-z1", "45"),
+        ("pot-z2", "95"),
+        ("pot-w0", "80"),
+        ("pot-w1", "130"),
+        ("pot-w2", "70"),
+        ("pot-w3", "80"),
+    ] {
+        set_value(&c, id, v).await;
+        wait_js(
+            &c,
+            &format!("return {IDLE} && document.getElementById('{id}').value === '{v}'"),
+            &format!("{id} = {v} in the table"),
+        )
+        .await;
+    }
+    wait_js(
+        &c,
+        &format!("return {IDLE} && {}", &PRINTABLE[7..]),
+        "the pot printable",
+    )
+    .await;
+    // The table still shows what was typed: the rows are on the curve.
+    let rows = js(
+        &c,
+        "return Array.from(document.querySelectorAll('#pot-rows tbody tr')).map((tr) => Array.from(tr.querySelectorAll('input')).map((i) => i.value))",
+    )
+    .await;
+    assert_eq!(
+        rows,
+        json!([["0", "80"], ["45", "130"], ["95", "70"], ["120", "80"]])
+    );
+    if let Ok(path) = std::env::var("SWEEPCLAY_POT_DESIGN") {
+        let d = js(&c, "return JSON.stringify(window.sweepclay.design)").await;
+        std::fs::write(&path, d.as_str().unwrap()).unwrap();
+    }
+    let (gcode, _) = download_printable(&c, &downloads, "no G-code of the pot").await;
+    // The printed path is as wide as typed (its first turn just above the
+    // foot, its last just under the lip), within 2 mm.
+    let p = js(&c, "return { ...window.sweepclay.meta.params, ...(window.sweepclay.design.params || {}) }.layer_height").await;
+    let h = p.as_f64().unwrap();
+    let at = [h, 45.0, 95.0, 120.0 - h / 2.0];
+    let got = widths_at(&gcode, &at);
+    for (w, (want, z)) in got.iter().zip([80.0, 130.0, 70.0, 80.0].iter().zip(at)) {
+        assert!(
+            (w - want).abs() <= 2.0,
+            "at z {z}: {w:.1} mm printed, {want} mm typed; all {got:?}"
+        );
+    }
     no_page_errors_and_close(c).await;
 }
