@@ -1979,6 +1979,19 @@ async function followPrint(host, file, polls) {
 }
 
 $('send-printer').addEventListener('click', (e) => sendToPrinter(e.currentTarget));
+
+// On a phone the header's extras open under "More" and close once used.
+$('more').addEventListener('click', () => {
+  const open = document.querySelector('header').classList.toggle('open');
+  $('more').setAttribute('aria-expanded', String(open));
+});
+for (const e of document.querySelectorAll('header .extra')) {
+  e.addEventListener('click', (ev) => {
+    if (ev.target.tagName === 'SELECT') return;
+    document.querySelector('header').classList.remove('open');
+    $('more').setAttribute('aria-expanded', 'false');
+  });
+}
 $('download-gcode').addEventListener('click', (e) => downloadFrom('/api/gcode', 'gcode', e.currentTarget));
 $('download-stl').addEventListener('click', (e) => downloadFrom('/api/stl', 'stl', e.currentTarget));
 $('undo').addEventListener('click', undo);

@@ -2829,3 +2829,105 @@ async fn a_pot_typed_80_130_70_80_prints_those_widths() {
     }
     no_page_errors_and_close(c).await;
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_phones_header_keeps_the_daily_buttons_and_opens_the_rest_under_more() {
+    let Some(Session {
+        driver: _driver,
+        c,
+        base,
+        ..
+    }) = Session::start().await
+    else {
+        return;
+    };
+    c.set_window_size(390, 844).await.unwrap();
+    c.goto(&base).await.unwrap();
+    close_guide(&c).await;
+    wait_js(
+        &c,
+        &format!("return {IDLE} && {}", &PRINTABLE[7..]),
+        "the first slice",
+    )
+    .await;
+    let seen = |id: &str| {
+        format!("const r = document.getElementById('{id}').getBoundingClientRect(); return r.width > 0 && r.height > 0")
+    };
+    let header_h = "return document.querySelector('header').getBoundingClientRect().height";
+    // Closed: New pot, Undo, Redo, Download G-code and More, in at most
+    // two rows of 44 px buttons; the rest waits under More.
+    let h = js(&c, header_h).await.as_f64().unwrap();
+    assert!(h <= 120.0, "the header is {h} px tall");
+    for id in ["new-pot", "undo", "redo", "download-gcode", "more"] {
+        assert_eq!(js(&c, &seen(id)).await, json!(true), "{id} hidden");
+    }
+    for id in [
+        "save",
+        "open",
+        "download-stl",
+        "send-printer",
+        "guide-open",
+        "example",
+    ] {
+        assert_eq!(
+            js(&c, &seen(id)).await,
+            json!(false),
+            "{id} shown while closed"
+        );
+    }
+    // More opens them, each at least 44 px; using one closes the menu.
+    tap_id(&c, "more").await;
+    for id in [
+        "save",
+        "open",
+        "download-stl",
+        "send-printer",
+        "guide-open",
+        "example",
+    ] {
+        assert_eq!(
+            js(&c, &seen(id)).await,
+            json!(true),
+            "{id} not shown under More"
+        );
+        let r = js(
+            &c,
+            &format!("const r = document.getElementById('{id}').getBoundingClientRect(); return [r.width, r.height]"),
+        )
+        .await;
+        assert!(
+            r[0].as_f64().unwrap() >= 44.0 && r[1].as_f64().unwrap() >= 44.0,
+            "{id}: {r}"
+        );
+    }
+    assert_eq!(
+        js(
+            &c,
+            "return document.getElementById('more').getAttribute('aria-expanded')"
+        )
+        .await,
+        json!("true")
+    );
+    if let Ok(path) = std::env::var("SWEEPCLAY_PHONE_MORE_SCREENSHOT") {
+        std::fs::write(&path, c.screenshot().await.unwrap()).unwrap();
+    }
+    tap_id(&c, "guide-open").await;
+    wait_js(
+        &c,
+        "return document.getElementById('guide').open",
+        "the guide",
+    )
+    .await;
+    assert_eq!(
+        js(&c, &seen("save")).await,
+        json!(false),
+        "the menu stayed open"
+    );
+    tap_id(&c, "guide-close").await;
+    // On a desktop there is no More: everything is in the header.
+    c.set_window_size(1440, 900).await.unwrap();
+    tokio::time::sleep(Duration::from_millis(300)).await;
+    assert_eq!(js(&c, &seen("more")).await, json!(false));
+    assert_eq!(js(&c, &seen("save")).await, json!(true));
+    no_page_errors_and_close(c).await;
+}
