@@ -119,31 +119,37 @@ export function through(pts) {
   return a.map((row, i) => [row[n] / row[i], row[n + 1] / row[i]]);
 }
 
-/** The curve's x at height `z` (its z rising along it), read off 800 chords. */
+/** The curve's x at height `z` (its z rising along it): the parameter
+ * found by bisection, to a millionth of the curve. */
 export function xAt(ctrl, z) {
-  const s = sample(ctrl, 800);
-  for (let k = 0; k + 1 < s.length; k++) {
-    const [a, b] = [s[k], s[k + 1]];
-    if (z <= b[1] || k + 2 === s.length) {
-      const f = b[1] > a[1] ? Math.min(1, Math.max(0, (z - a[1]) / (b[1] - a[1]))) : 0;
-      return a[0] + f * (b[0] - a[0]);
-    }
+  const kv = knots(ctrl.length, Math.min(3, ctrl.length - 1));
+  let [lo, hi] = [0, 1];
+  for (let i = 0; i < 40; i++) {
+    const mid = (lo + hi) / 2;
+    if (evalAt(ctrl, mid, kv)[1] < z) lo = mid;
+    else hi = mid;
   }
-  return s[0][0];
+  return evalAt(ctrl, (lo + hi) / 2, kv)[0];
 }
 
 /**
  * Control points of a profile through `rows` (`[x, z]`, heights rising):
- * the rows and, between them, points every `step` mm or so on a cubic
+ * the rows and, between them, points every `most` mm or closer on a cubic
  * Hermite curve through the rows (slopes from the neighbouring rows,
  * upright at the foot and the lip), all
  * passed through by [`through`]. Evenly spaced heights keep the curve's
  * height rising evenly with its parameter, so it bulges where the rows do
  * and nowhere else (docs/MODELER.md, "Widths at heights").
  */
-export function throughRows(rows, step = 15) {
+export function throughRows(rows, most = 15) {
   const r = rows.map((p) => p.slice()).sort((a, b) => a[1] - b[1]);
   if (r.length <= 2) return r;
+  // Points as evenly spaced in height as the rows allow: no further apart
+  // than the closest two rows (from 2 to `most` mm), or the curve's height
+  // stops rising evenly where a close pair meets a long gap.
+  let gap = most;
+  for (let k = 1; k < r.length; k++) gap = Math.min(gap, r[k][1] - r[k - 1][1]);
+  const step = Math.max(2, gap);
   // The wall leaves the foot and meets the lip upright (slope 0 there), so
   // the floor, laid under the first turn, is as wide as the foot typed.
   const slope = r.map((p, k) => {

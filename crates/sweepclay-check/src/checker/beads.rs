@@ -184,7 +184,12 @@ impl Checker<'_> {
                 // middle: a ramp's rise is read the same whether it is one
                 // 63 mm move or thirty 2 mm ones (docs/CHECKER.md,
                 // "Cutting").
-                let (gap_from, gap_to) = ((m.from[2] - z_own).max(0.0), (m.to[2] - z_own).max(0.0));
+                // Clay at or above the middle leaves no gap there; how far
+                // above is not asked (the pruned walk stops at the first
+                // such clay), so neither end reads it.
+                let z_under = z_own.min(mid[2]);
+                let (gap_from, gap_to) =
+                    ((m.from[2] - z_under).max(0.0), (m.to[2] - z_under).max(0.0));
                 if stretch.length == 0.0 {
                     stretch.first_line = m.line;
                     stretch.first_gap = gap_from;
