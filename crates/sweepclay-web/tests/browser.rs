@@ -250,6 +250,19 @@ async fn no_page_errors_and_close(c: Client) {
 /// Whether the verdict says printable.
 const PRINTABLE: &str = "return document.getElementById('verdict').dataset.printable === 'true'";
 
+/// Opens the page, closes the first-run guide and waits for the first
+/// slice to print.
+async fn open_first_slice(c: &Client, base: &str) {
+    c.goto(base).await.unwrap();
+    close_guide(c).await;
+    wait_js(
+        c,
+        &format!("return {IDLE} && {}", &PRINTABLE[7..]),
+        "the first slice",
+    )
+    .await;
+}
+
 /// Closes the first-run guide, which a fresh browser profile shows.
 async fn close_guide(c: &Client) {
     wait_js(
@@ -2536,14 +2549,7 @@ async fn the_printer_dialog_calibrates_e_from_measured_walls() {
     else {
         return;
     };
-    c.goto(&base).await.unwrap();
-    close_guide(&c).await;
-    wait_js(
-        &c,
-        &format!("return {IDLE} && {}", &PRINTABLE[7..]),
-        "the first slice",
-    )
-    .await;
+    open_first_slice(&c, &base).await;
     open_printer_dialog(&c).await;
     js(
         &c,
@@ -2634,14 +2640,7 @@ async fn a_refusal_shows_on_the_phones_shape_tab() {
         return;
     };
     c.set_window_size(390, 844).await.unwrap();
-    c.goto(&base).await.unwrap();
-    close_guide(&c).await;
-    wait_js(
-        &c,
-        &format!("return {IDLE} && {}", &PRINTABLE[7..]),
-        "the first slice",
-    )
-    .await;
+    open_first_slice(&c, &base).await;
     click(&c, "new-pot").await;
     wait_js(
         &c,
@@ -2728,14 +2727,7 @@ async fn a_pot_typed_80_130_70_80_prints_those_widths() {
     else {
         return;
     };
-    c.goto(&base).await.unwrap();
-    close_guide(&c).await;
-    wait_js(
-        &c,
-        &format!("return {IDLE} && {}", &PRINTABLE[7..]),
-        "the first slice",
-    )
-    .await;
+    open_first_slice(&c, &base).await;
     click(&c, "new-pot").await;
     wait_js(
         &c,
@@ -2842,14 +2834,7 @@ async fn the_phones_header_keeps_the_daily_buttons_and_opens_the_rest_under_more
         return;
     };
     c.set_window_size(390, 844).await.unwrap();
-    c.goto(&base).await.unwrap();
-    close_guide(&c).await;
-    wait_js(
-        &c,
-        &format!("return {IDLE} && {}", &PRINTABLE[7..]),
-        "the first slice",
-    )
-    .await;
+    open_first_slice(&c, &base).await;
     let seen = |id: &str| {
         format!("const r = document.getElementById('{id}').getBoundingClientRect(); return r.width > 0 && r.height > 0")
     };
