@@ -66,6 +66,12 @@ pub struct Printer {
     pub start_gcode: String,
     /// G-code sent after the last move.
     pub end_gcode: String,
+    /// The nozzle's bore (mm), where known. The modeler's printer dialog
+    /// sets the bead widths from it: from the bore (a bead laid without
+    /// pressing) to twice it (pressed to half its height), the paper's 3
+    /// and 6 mm for its 3 mm nozzle (docs/FORMATS.md). Omitted: not known.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub nozzle_diameter: Option<f64>,
     /// The print host the machine sits behind, for `sweepclay send` and
     /// the modeler's "Send to printer" (docs/PRINTING.md). Its key or
     /// password is never part of the profile. Omitted: none.
@@ -160,6 +166,7 @@ impl Default for Printer {
             cartridge_ml: None,
             start_gcode: "G28 ; home all axes\nG92 E0\n".into(),
             end_gcode: "M84 ; motors off\n".into(),
+            nozzle_diameter: None,
             host: None,
         }
     }
@@ -427,6 +434,14 @@ impl Printer {
         if let Some(c) = self.cartridge_ml {
             positive(&format!("{key}.cartridge_ml"), c)?;
         }
+        if let Some(d) = self.nozzle_diameter {
+            if !(d.is_finite() && d > 0.0 && d <= 100.0) {
+                return Err(Error::invalid(
+                    format!("{key}.nozzle_diameter"),
+                    format!("must be a bore from above 0 to 100 mm (got {d})"),
+                ));
+            }
+        }
         if let Some(h) = &self.host {
             h.validate(&format!("{key}.host"))?;
         }
@@ -659,5 +674,21 @@ mod tests {
         };
         let e = p.validate("printer").unwrap_err();
         assert!(e.to_string().starts_with("printer.e_per_mm3"), "{e}");
+        for d in [0.0, -3.0, 101.0, f64::NAN] {
+            let p = Printer {
+                nozzle_diameter: Some(d),
+                ..Printer::default()
+            };
+            let e = p.validate("printer").unwrap_err().to_string();
+            assert!(
+                e.starts_with("printer.nozzle_diameter") && e.contains("from above 0 to 100 mm"),
+                "{e}"
+            );
+        }
+        let p = Printer {
+            nozzle_diameter: Some(3.0),
+            ..Printer::default()
+        };
+        assert!(p.validate("printer").is_ok());
     }
 }

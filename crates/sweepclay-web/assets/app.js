@@ -1734,6 +1734,8 @@ function openPrinter() {
   $('pr-rel').checked = !!base.relative_e;
   $('pr-start').value = base.start_gcode || '';
   $('pr-end').value = base.end_gcode || '';
+  $('pr-nozzle').value = base.nozzle_diameter ?? '';
+  nozzleNote();
   $('pr-host-kind').value = base.host ? base.host.kind : '';
   $('pr-host-url').value = base.host ? base.host.url : '';
   $('pr-host-key').value = '';
@@ -1741,6 +1743,19 @@ function openPrinter() {
   $('printer-dialog').returnValue = '';
   $('printer-dialog').showModal();
 }
+
+/**
+ * What a nozzle's bore means for the beads, under the dialog's field:
+ * from the bore (a bead laid without pressing) to twice it (pressed to half
+ * its height), as "Use" sets them (docs/FORMATS.md).
+ */
+function nozzleNote() {
+  const d = parseDecimal($('pr-nozzle').value);
+  $('pr-nozzle-note').textContent = d > 0
+    ? `Beads from ${fmtMm(d)} to ${fmtMm(2 * d)} mm wide: the bore laid without pressing, and pressed to half its height. "Use" sets the bead widths to these.`
+    : 'With the bore, the bead widths follow from it.';
+}
+$('pr-nozzle').addEventListener('input', nozzleNote);
 
 /** The printer as the dialog's fields say now, for the calibration. */
 function dialogPrinter() {
@@ -1813,6 +1828,10 @@ $('printer-form').addEventListener('submit', (e) => {
   const said = extrusionMode(printer.start_gcode);
   printer.end_gcode = $('pr-end').value;
   const h = parseFloat($('pr-h').value);
+  const nozzleText = $('pr-nozzle').value.trim();
+  const nozzle = nozzleText ? parseDecimal(nozzleText) : null;
+  if (nozzle != null) printer.nozzle_diameter = nozzle;
+  else delete printer.nozzle_diameter;
   const hostKind = $('pr-host-kind').value;
   const hostUrl = $('pr-host-url').value.trim().replace(/\/+$/, '');
   if (hostKind) printer.host = { kind: hostKind, url: hostUrl };
@@ -1825,6 +1844,7 @@ $('printer-form').addEventListener('submit', (e) => {
     [!(printer.e_per_mm3 > 0), 'E per mm³ must be positive'],
     [!(printer.nozzle_radius >= 0), 'the nozzle body radius must be a number of mm'],
     [!(h > 0), 'the nozzle body height must be positive'],
+    [nozzle != null && !(nozzle > 0 && nozzle <= 100), `nozzle diameter "${nozzleText}": a bore from above 0 to 100 mm, or empty if not known`],
     [hostKind && !/^http:\/\/[^\s/@?#]+(\/[^\s@?#]*)?$/.test(hostUrl), 'the print host address is http:// and its name or IP address, e.g. http://octopi.local (no user name or password in it)'],
     [said != null && said !== printer.relative_e, said ? 'the start code sets relative extrusion (M83) but "relative extrusion" is off: the G-code\'s own M82 would cancel it; tick it or take M83 out' : 'the start code sets absolute extrusion (M82) but "relative extrusion" is on: untick it or take M82 out'],
   ].find(([b]) => b);
@@ -1847,6 +1867,8 @@ $('printer-form').addEventListener('submit', (e) => {
   edit((d) => {
     d.printer = printer;
     d.params = { ...(d.params || {}), nozzle_height: h };
+    // The bead widths follow the bore (docs/FORMATS.md).
+    if (nozzle != null) Object.assign(d.params, { width_min: nozzle, width_max: 2 * nozzle });
   }, true);
 });
 

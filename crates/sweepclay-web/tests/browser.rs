@@ -2916,3 +2916,59 @@ async fn the_phones_header_keeps_the_daily_buttons_and_opens_the_rest_under_more
     assert_eq!(js(&c, &seen("save")).await, json!(true));
     no_page_errors_and_close(c).await;
 }
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_nozzle_diameter_sets_the_bead_widths_and_says_how() {
+    let Some(Session {
+        driver: _driver,
+        c,
+        base,
+        ..
+    }) = Session::start().await
+    else {
+        return;
+    };
+    open_first_slice(&c, &base).await;
+    open_printer_dialog(&c).await;
+    // A bore that is no bore is refused in the dialog, by name.
+    set_value(&c, "pr-nozzle", "0").await;
+    click(&c, "pr-save").await;
+    let said = js(&c, "return document.getElementById('pr-error').textContent").await;
+    assert!(
+        said.as_str().unwrap().contains("nozzle diameter \"0\""),
+        "{said}"
+    );
+    // A 4 mm nozzle: the note says what follows, and Use sets it.
+    c.execute(
+        "const e = document.getElementById('pr-nozzle'); e.value = '4'; e.dispatchEvent(new Event('input'));",
+        vec![],
+    )
+    .await
+    .unwrap();
+    let note = js(
+        &c,
+        "return document.getElementById('pr-nozzle-note').textContent",
+    )
+    .await;
+    assert!(
+        note.as_str()
+            .unwrap()
+            .starts_with("Beads from 4 to 8 mm wide"),
+        "{note}"
+    );
+    click(&c, "pr-save").await;
+    let got = wait_js(
+        &c,
+        &format!("const d = window.sweepclay.design; return {IDLE} && d.printer.nozzle_diameter === 4 && [d.params.width_min, d.params.width_max]"),
+        "the widths from the bore",
+    )
+    .await;
+    assert_eq!(got, json!([4, 8]));
+    wait_js(&c, PRINTABLE, "the design printable with 4 to 8 mm beads").await;
+    // The settings show them.
+    assert_eq!(
+        js(&c, "return document.getElementById('p-width_min').value").await,
+        json!("4")
+    );
+    no_page_errors_and_close(c).await;
+}
