@@ -34,10 +34,6 @@ fn check_points(key: &str, pts: &[[f64; 2]], min: usize) -> Result<()> {
     Ok(())
 }
 
-/// How far a profile's row (`points`) may lie from its curve (mm): the
-/// modeler writes the curve through them to 3 decimals.
-pub const ON_CURVE_MM: f64 = 0.05;
-
 /// A profile curve sampled as horizontal offset from its start against
 /// normalised height.
 #[derive(Clone, Debug, PartialEq)]
@@ -107,7 +103,7 @@ impl Profile {
                 ));
             }
             let on = first[0] + profile.offset(z / height);
-            if (on - x).abs() > ON_CURVE_MM {
+            if (on - x).abs() > crate::design::ON_CURVE_MM {
                 return Err(Error::invalid(
                     pkey,
                     format!(

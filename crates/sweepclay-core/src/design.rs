@@ -56,6 +56,10 @@ fn is_zero(v: &f64) -> bool {
     *v == 0.0
 }
 
+/// How far a profile's row (`points`) may lie from its curve (mm): the
+/// modeler writes the curve through them to 3 decimals.
+pub const ON_CURVE_MM: f64 = 0.05;
+
 /// A curve given by the control points of a clamped B-spline.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
@@ -64,7 +68,7 @@ pub struct CurveSpec {
     pub control_points: Vec<[f64; 2]>,
     /// A profile's rows as a potter typed them, `[x, z]`: points the
     /// curve passes through (the modeler's widths at heights). Checked:
-    /// each must lie on the curve within [`crate::curves::ON_CURVE_MM`]
+    /// each must lie on the curve within [`ON_CURVE_MM`]
     /// (docs/FORMATS.md). Omitted: none.
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub points: Option<Vec<[f64; 2]>>,
