@@ -251,8 +251,7 @@ impl AsyncRead for Guarded {
         match Pin::new(&mut self.io).poll_read(cx, buf) {
             Poll::Ready(r) => {
                 if buf.filled().len() > before {
-                    let read = buf.filled()[before..].to_vec();
-                    self.read_bytes(&read);
+                    self.read_bytes(&buf.filled()[before..]);
                     self.arm();
                 }
                 Poll::Ready(r)
