@@ -6,7 +6,9 @@
 //! A rapid `G0` moves to the first point; after it only `G1` moves with
 //! increasing E until the printer's end code.
 
+use crate::design::Params;
 use crate::extrude::Extrusion;
+use crate::printer::Printer;
 use crate::toolpath::{PointKind, Toolpath};
 use crate::Sliced;
 use std::io::{self, Write};
@@ -50,22 +52,7 @@ pub fn emit<W: Write>(s: &Sliced, out: &mut W) -> io::Result<Vec<usize>> {
         env!("CARGO_PKG_VERSION")
     )?;
     writeln!(out, "; design: {}", one_line(&s.corrected.surface.name))?;
-    writeln!(out, "; printer: {}", one_line(&pr.name))?;
-    writeln!(
-        out,
-        "; params: layer_height={} max_layer_height={} spacing={} nozzle_height={} width_min={} width_max={} overlap={:.4} max_overhang_deg={} feedrate={}",
-        pa.layer_height, pa.max_layer_height, pa.spacing, pa.nozzle_height, pa.width_min,
-        pa.width_max, pa.overlap, pa.max_overhang_deg, pa.feedrate
-    )?;
-    writeln!(
-        out,
-        "; printer_params: build_volume={}x{}x{} bed_min={},{},{} origin={},{} e_per_mm3={} relative_e={} nozzle_radius={}",
-        pr.build_volume[0], pr.build_volume[1], pr.build_volume[2], pr.bed_min[0], pr.bed_min[1],
-        pr.bed_min[2], o[0], o[1], pr.e_per_mm3, pr.relative_e, pr.nozzle_radius
-    )?;
-    if let Some(d) = pr.bed_diameter {
-        writeln!(out, "; printer_params: bed_diameter={d}")?;
-    }
+    write_machine_header(out, pr, pa)?;
     writeln!(
         out,
         "; size_mm: {:.1} x {:.1} x {:.1}",
@@ -108,26 +95,7 @@ pub fn emit<W: Write>(s: &Sliced, out: &mut W) -> io::Result<Vec<usize>> {
     for line in s.corrected.report.summary() {
         writeln!(out, "; correction: {line}")?;
     }
-    let modes = |out: &mut Lines<W>| -> io::Result<()> {
-        writeln!(out, "G21 ; millimetres")?;
-        writeln!(out, "G90 ; absolute coordinates")?;
-        if pr.relative_e {
-            writeln!(out, "M83 ; relative extrusion")
-        } else {
-            writeln!(out, "M82 ; absolute extrusion")
-        }
-    };
-    modes(out)?;
-    out.write_all(pr.start_gcode.as_bytes())?;
-    if !pr.start_gcode.is_empty() {
-        if !pr.start_gcode.ends_with('\n') {
-            writeln!(out)?;
-        }
-        // The start code may leave any mode behind (a G91, an E): the moves
-        // need theirs.
-        modes(out)?;
-        writeln!(out, "G92 E0")?;
-    }
+    write_start(out, pr)?;
     let before = out.count;
     let points = &s.toolpath.points;
     let types = move_types(&s.toolpath);
@@ -145,8 +113,63 @@ pub fn emit<W: Write>(s: &Sliced, out: &mut W) -> io::Result<Vec<usize>> {
     } else {
         emit_typed_moves(out.inner, points.len(), pos, &s.extrusion, &format, &types)?
     };
-    // Clear of the piece before anything else the end code does: the
-    // nozzle would rest in the rim's clay (docs/FORMATS.md).
+    write_end(out, pr)?;
+    Ok(lines.into_iter().map(|l| l + before).collect())
+}
+
+/// The header lines `check` reads a file's printer and parameters from
+/// (docs/FORMATS.md): `; printer:`, `; params:` and `; printer_params:`.
+/// Every file sweepclay writes carries them: a slice, a calibration print.
+pub fn write_machine_header<W: Write>(out: &mut W, pr: &Printer, pa: &Params) -> io::Result<()> {
+    let o = pr.origin;
+    writeln!(out, "; printer: {}", one_line(&pr.name))?;
+    writeln!(
+        out,
+        "; params: layer_height={} max_layer_height={} spacing={} nozzle_height={} width_min={} width_max={} overlap={:.4} max_overhang_deg={} feedrate={}",
+        pa.layer_height, pa.max_layer_height, pa.spacing, pa.nozzle_height, pa.width_min,
+        pa.width_max, pa.overlap, pa.max_overhang_deg, pa.feedrate
+    )?;
+    writeln!(
+        out,
+        "; printer_params: build_volume={}x{}x{} bed_min={},{},{} origin={},{} e_per_mm3={} relative_e={} nozzle_radius={}",
+        pr.build_volume[0], pr.build_volume[1], pr.build_volume[2], pr.bed_min[0], pr.bed_min[1],
+        pr.bed_min[2], o[0], o[1], pr.e_per_mm3, pr.relative_e, pr.nozzle_radius
+    )?;
+    if let Some(d) = pr.bed_diameter {
+        writeln!(out, "; printer_params: bed_diameter={d}")?;
+    }
+    Ok(())
+}
+
+/// The units and modes, the printer's start code, and (after a start code,
+/// which may leave any mode behind: a G91, an E) the modes again and
+/// `G92 E0`, so the moves have theirs.
+pub fn write_start<W: Write>(out: &mut W, pr: &Printer) -> io::Result<()> {
+    let modes = |out: &mut W| -> io::Result<()> {
+        writeln!(out, "G21 ; millimetres")?;
+        writeln!(out, "G90 ; absolute coordinates")?;
+        if pr.relative_e {
+            writeln!(out, "M83 ; relative extrusion")
+        } else {
+            writeln!(out, "M82 ; absolute extrusion")
+        }
+    };
+    modes(out)?;
+    out.write_all(pr.start_gcode.as_bytes())?;
+    if !pr.start_gcode.is_empty() {
+        if !pr.start_gcode.ends_with('\n') {
+            writeln!(out)?;
+        }
+        modes(out)?;
+        writeln!(out, "G92 E0")?;
+    }
+    Ok(())
+}
+
+/// The lift clear of the piece before anything else the end code does
+/// (the nozzle would rest in the rim's clay; docs/FORMATS.md), then the
+/// printer's end code.
+pub fn write_end<W: Write>(out: &mut W, pr: &Printer) -> io::Result<()> {
     writeln!(out, "G91 ; relative")?;
     writeln!(
         out,
@@ -158,7 +181,7 @@ pub fn emit<W: Write>(s: &Sliced, out: &mut W) -> io::Result<Vec<usize>> {
     if !pr.end_gcode.is_empty() && !pr.end_gcode.ends_with('\n') {
         writeln!(out)?;
     }
-    Ok(lines.into_iter().map(|l| l + before).collect())
+    Ok(())
 }
 
 /// Where a vessel's moves change between floor and wall, for `;TYPE:`
