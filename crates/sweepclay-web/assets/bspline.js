@@ -97,12 +97,19 @@ export function through(pts) {
   const kv = knots(n, Math.min(3, n - 1));
   const ts = greville(n);
   // a[i][j]: basis j at t_i, read off the curve of the unit control points.
-  // Each row ends with its point's x and z, the right-hand sides.
+  // Each row: the basis at t_i (read off the curve of one unit control
+  // point, only the p + 1 that can be non-zero there), then its point's x
+  // and z, the right-hand sides.
+  const p = Math.min(3, n - 1);
+  const unit = Array.from({ length: n }, () => [0, 0]);
   const a = ts.map((t, i) => {
-    const row = [];
-    for (let j = 0; j < n; j++) {
-      const unit = Array.from({ length: n }, (_, k) => [k === j ? 1 : 0, 0]);
-      row.push(evalAt(unit, t, kv)[0]);
+    const row = new Array(n).fill(0);
+    let k = p;
+    while (k + 1 < n && kv[k + 1] <= t) k++;
+    for (let j = k - p; j <= k; j++) {
+      unit[j][0] = 1;
+      row[j] = evalAt(unit, t, kv)[0];
+      unit[j][0] = 0;
     }
     return row.concat(pts[i]);
   });
