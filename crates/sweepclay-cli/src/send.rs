@@ -79,7 +79,7 @@ fn host_of(a: &SendArgs) -> Result<(Kind, String)> {
 pub fn run(a: SendArgs) -> Result<i32> {
     let (kind, url) = host_of(&a)?;
     sweepclay_link::check_url(&url).map_err(|e| anyhow::anyhow!("{e}"))?;
-    let keys_file = keys::config_dir().map(|d| keys::path_in(&d));
+    let keys_file = keys::default_path();
     if a.save_key {
         let path = keys_file
             .as_ref()

@@ -35,6 +35,12 @@ pub fn path_in(dir: &Path) -> PathBuf {
     dir.join(FILE)
 }
 
+/// The keys file in the configuration directory the environment names
+/// ([`config_dir`]), if it names one.
+pub fn default_path() -> Option<PathBuf> {
+    config_dir().map(|d| path_in(&d))
+}
+
 /// Reads the keys file; a missing file is no keys.
 pub fn read(path: &Path) -> Result<BTreeMap<String, String>, String> {
     let bytes = match std::fs::metadata(path) {

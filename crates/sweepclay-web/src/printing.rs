@@ -37,7 +37,7 @@ fn link_for(host: &sweepclay_core::printer::PrintHost) -> Result<sweepclay_link:
     let kind = sweepclay_link::Kind::from_name(host.kind.name()).ok_or_else(|| {
         ApiError::new(422, "unknown print host kind").with_key("printer.host.kind")
     })?;
-    let keys = sweepclay_link::keys::config_dir().map(|d| sweepclay_link::keys::path_in(&d));
+    let keys = sweepclay_link::keys::default_path();
     let secret = sweepclay_link::keys::lookup(keys.as_deref(), &host.url)
         .map_err(|e| ApiError::new(500, format!("the keys file: {e}")))?;
     sweepclay_link::Link::new(kind, &host.url, secret)
@@ -119,9 +119,8 @@ pub(crate) async fn host_key(
         .map_err(|e| ApiError::new(400, format!("key: {e}")))?;
     sweepclay_link::check_url(&k.url)
         .map_err(|e| ApiError::new(422, e.to_string()).with_key("url"))?;
-    let dir = sweepclay_link::keys::config_dir()
+    let path = sweepclay_link::keys::default_path()
         .ok_or_else(|| ApiError::new(500, "no configuration directory (HOME is not set)"))?;
-    let path = sweepclay_link::keys::path_in(&dir);
     tokio::task::spawn_blocking(move || sweepclay_link::keys::save(&path, &k.url, k.key.trim()))
         .await
         .map_err(|e| ApiError::new(500, e.to_string()))?
