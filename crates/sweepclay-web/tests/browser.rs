@@ -205,6 +205,14 @@ async fn click(c: &Client, id: &str) {
     let deadline = Instant::now() + Duration::from_secs(5);
     loop {
         let el = c.find(fantoccini::Locator::Id(id)).await.unwrap();
+        // In view first: the printer dialog scrolls, and its buttons end
+        // it (under load, WebDriver's own scrolling once left one outside).
+        let _ = c
+            .execute(
+                "document.getElementById(arguments[0])?.scrollIntoView({block: 'center'})",
+                vec![json!(id)],
+            )
+            .await;
         match el.click().await {
             Ok(_) => return,
             Err(fantoccini::error::CmdError::Standard(e))
