@@ -49,6 +49,10 @@ const state = {
   at: -1,
   inFlight: false,
   pending: null,
+  // Slices sent to the server (a drag sends one when it rests or ends).
+  sent: 0,
+  settling: false,
+  restTimer: 0,
   lastEdit: null,
   roundTrips: [],
   // Pointer event → the painted frame with the edited curve (ms).
@@ -91,8 +95,12 @@ function interpolationPoints(d) {
   return d.trajectory.closed ? [[0, 0], [1, 0]] : [[0, 0], [1, 1]];
 }
 
-/** Replaces the design; `record` adds an undo step. */
-function setDesign(d, { record = true, fit = false } = {}) {
+/**
+ * Replaces the design; `record` adds an undo step; `live` is a move of a
+ * drag, which draws the edited curves but slices only when the pointer
+ * rests (docs/MODELER.md, "The curve follows the finger").
+ */
+function setDesign(d, { record = true, fit = false, live = false } = {}) {
   state.design = d;
   // Another design (opened, an example, a new pot): no refusal of a value
   // typed for the last one stays beside the point bar.
@@ -115,7 +123,37 @@ function setDesign(d, { record = true, fit = false } = {}) {
   $('offset').value = d.trajectory.offset === 'normal' ? 'normal' : 'radial';
   $('closed').checked = !!d.trajectory.closed;
   updateUndo();
-  requestSlice(fit);
+  if (live) sliceAtRest();
+  else requestSlice(fit);
+}
+
+/** How long the pointer rests mid-drag before the design is sliced (ms). */
+const REST_MS = 100;
+
+/**
+ * A drag's move: the edited curves are drawn now, over the last preview,
+ * greyed until the slice arrives; the slice starts when the pointer rests
+ * REST_MS or lets go (a release calls `requestSlice` at once).
+ */
+function sliceAtRest() {
+  if (view && state.design) {
+    const d = state.design;
+    view.showCurves(() => curveLines(d), state.lastEdit);
+  }
+  setSettling(true);
+  // A slice in flight is of a design the editors have left.
+  state.seq++;
+  cancelVerify();
+  setVerdict('checking');
+  clearTimeout(state.restTimer);
+  state.restTimer = setTimeout(() => requestSlice(false, { rest: true }), REST_MS);
+}
+
+/** Greys the preview while it shows a design older than the editors'. */
+function setSettling(on) {
+  if (state.settling === on) return;
+  state.settling = on;
+  $('preview').classList.toggle('settling', on);
 }
 
 /**
@@ -184,9 +222,12 @@ function edit(mutate, final, since) {
   state.lastParam = null;
   mutate(d);
   const t = since ?? performance.now();
-  state.lastEdit = Math.min(state.lastEdit ?? t, t);
+  // A slice counts from the edit that starts it: a drag's release, or the
+  // move the pointer rested after (docs/MODELER.md); moves it never
+  // sliced are not its wait.
+  state.lastEdit = t;
   state.lastEditAt = performance.now();
-  setDesign(d, { record: final });
+  setDesign(d, { record: final, live: !final });
   // From the event to the painted frame that shows the edited curve.
   if (since != null) {
     afterPaint((now) => {
@@ -784,7 +825,9 @@ function curveLines(d) {
   return out;
 }
 
-function requestSlice(fit) {
+/** Slices the design now (`rest`: the pointer rested mid-drag). */
+function requestSlice(fit, { rest = false } = {}) {
+  clearTimeout(state.restTimer);
   if (view && state.design) {
     const d = state.design;
     view.showCurves(() => curveLines(d), state.lastEdit);
@@ -793,7 +836,7 @@ function requestSlice(fit) {
   // into a waiting request keeps that request's start.
   const edit = state.pending?.edit ?? state.lastEdit;
   state.seq++;
-  state.pending = { design: JSON.stringify(state.design), edit, fit: fit || state.pending?.fit, seq: state.seq };
+  state.pending = { design: JSON.stringify(state.design), edit, fit: fit || state.pending?.fit, seq: state.seq, rest };
   state.lastEdit = null;
   // A verdict belongs to one design: the last one no longer applies.
   // The slice's answer carries the check of the very G-code it shows
@@ -805,6 +848,7 @@ function requestSlice(fit) {
 
 /** The design did not slice: the error, no verdict, the old preview greyed. */
 function sliceFailed(msg, key) {
+  setSettling(false);
   showError(msg, key);
   showPrinted({});
   cancelVerify();
@@ -860,6 +904,7 @@ function sendSlice() {
   state.pending = null;
   if (!job) return;
   state.inFlight = true;
+  state.sent++;
   setBusy(true);
   const t0 = performance.now();
   sliceDesign(job.design)
@@ -892,6 +937,7 @@ function showSlice(job, res, t0) {
   const body = res.body;
   showError(null);
   setStale(false);
+  if (current) setSettling(false);
   state.restored = false;
   const t1 = performance.now();
   render(body, job.fit);
@@ -907,6 +953,8 @@ function showSlice(job, res, t0) {
   afterPaint((now) => {
     state.roundTrips.push({
       ms: now - since,
+      // Sliced when the pointer rested mid-drag, not at the gesture's end.
+      rest: job.rest,
       request_ms: res.timing.request_ms,
       headers_ms: res.timing.headers_ms,
       worker_ms: res.timing.worker_ms,

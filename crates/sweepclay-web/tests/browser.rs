@@ -317,7 +317,8 @@ async fn import_file(c: &Client, file: &Path, shape: usize) -> String {
 }
 
 /// Whether the page is idle: no slice in flight or waiting.
-const IDLE: &str = "!window.sweepclay.inFlight && !window.sweepclay.pending";
+const IDLE: &str =
+    "!window.sweepclay.inFlight && !window.sweepclay.pending && !window.sweepclay.settling";
 
 async fn drag(c: &Client, from: (f64, f64), by: (f64, f64), steps: usize) {
     let mut m = MouseActions::new("mouse".into())
@@ -1180,7 +1181,7 @@ async fn modeler_speed_budget() {
     let rounds: usize = std::env::var("SWEEPCLAY_BENCH_DRAGS")
         .ok()
         .and_then(|v| v.parse().ok())
-        .unwrap_or(5);
+        .unwrap_or(20);
     let q = |v: &[f64], f: f64| v[((v.len() as f64 - 1.0) * f).round() as usize];
     for example in ["t1", "vase"] {
         c.goto(&format!("{base}/?example={example}")).await.unwrap();
@@ -1231,7 +1232,7 @@ async fn modeler_speed_budget() {
             .await;
             let v = js(
                 &c,
-                "const s = window.sweepclay; return [s.editTimes, s.roundTrips.map(r => r.ms), s.verdictTimes.at(-1), s.frames.input, s.frames.gap]",
+                "const s = window.sweepclay; return [s.editTimes, s.roundTrips.filter(r => !r.rest).map(r => r.ms), s.verdictTimes.at(-1), s.frames.input, s.frames.gap]",
             )
             .await;
             let nums = |k: usize| -> Vec<f64> {
@@ -1252,7 +1253,7 @@ async fn modeler_speed_budget() {
         }
         assert!(!edit.is_empty(), "the edited curve was never painted");
         eprintln!(
-            "modeler speed ({example}, {rounds} drags of 60 moves at 60 Hz, from each event's timeStamp to the painted frame): the edited curve {} frames, median {:.0} ms, 95th percentile {:.0} ms; the sliced preview {} times, median {:.0} ms, 95th percentile {:.0} ms; the verdict median {:.0} ms, max {:.0} ms; the wait before the page hears an event median {:.0} ms; between frames median {:.0} ms, 95th percentile {:.0} ms",
+            "modeler speed ({example}, {rounds} drags of 60 moves at 60 Hz, from each event's timeStamp to the painted frame): the edited curve {} frames, median {:.0} ms, 95th percentile {:.0} ms; the sliced preview after the release {} times, median {:.0} ms, 95th percentile {:.0} ms; the verdict median {:.0} ms, max {:.0} ms; the wait before the page hears an event median {:.0} ms; between frames median {:.0} ms, 95th percentile {:.0} ms",
             edit.len(),
             q(&edit, 0.5),
             q(&edit, 0.95),
@@ -1987,6 +1988,112 @@ async fn a_pot_gets_a_raised_back_from_the_rim_control() {
         (back - front - 30.0).abs() < 1.5,
         "back {back}, front {front}"
     );
+    no_page_errors_and_close(c).await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_drag_slices_only_when_the_pointer_rests_or_lets_go() {
+    // While the pointer moves, the page draws the edited curves and does
+    // not slice; the pointer resting 100 ms mid-drag slices once, the
+    // release once more (docs/MODELER.md, "The curve follows the finger").
+    let Some(Session {
+        tmp: _tmp,
+        downloads: _,
+        driver: _driver,
+        c,
+        base,
+    }) = Session::start().await
+    else {
+        return;
+    };
+    open_first_slice(&c, &base).await;
+    let sent0 = js(&c, "return window.sweepclay.sent")
+        .await
+        .as_u64()
+        .unwrap();
+    let top = point_at(&c, 1, "ed.points.length - 1").await;
+    let moves = |m: MouseActions, from: f64, to: f64| {
+        (1..=30).fold(m, |m, k| {
+            m.then(PointerAction::MoveTo {
+                duration: Some(Duration::from_millis(16)),
+                x: top.0.round(),
+                y: (top.1 + from + (to - from) * k as f64 / 30.0).round(),
+            })
+        })
+    };
+    // Thirty moves 16 ms apart, then a rest with the button still down.
+    let first = moves(
+        MouseActions::new("mouse".into())
+            .then(PointerAction::MoveTo {
+                duration: None,
+                x: top.0.round(),
+                y: top.1.round(),
+            })
+            .then(PointerAction::Down {
+                button: MOUSE_BUTTON_LEFT,
+            }),
+        0.0,
+        -15.0,
+    );
+    c.perform_actions(first).await.unwrap();
+    let moving = js(
+        &c,
+        "const s = window.sweepclay; return [s.sent, s.settling, document.getElementById('preview').classList.contains('settling')]",
+    )
+    .await;
+    wait_js(
+        &c,
+        &format!("return {IDLE} && window.sweepclay.sent > {sent0}"),
+        "the slice of the rested drag",
+    )
+    .await;
+    let rested = js(&c, "return window.sweepclay.sent")
+        .await
+        .as_u64()
+        .unwrap();
+    let rest_trip = js(&c, "return window.sweepclay.roundTrips.at(-1).rest")
+        .await
+        .as_bool();
+    // Thirty more moves and the release.
+    let second = moves(MouseActions::new("mouse".into()), -15.0, -30.0).then(PointerAction::Up {
+        button: MOUSE_BUTTON_LEFT,
+    });
+    c.perform_actions(second).await.unwrap();
+    wait_js(
+        &c,
+        &format!("return {IDLE} && window.sweepclay.sent > {rested}"),
+        "the slice of the released drag",
+    )
+    .await;
+    let end = js(
+        &c,
+        "const s = window.sweepclay; return [s.sent, s.roundTrips.at(-1).rest, document.getElementById('preview').classList.contains('settling')]",
+    )
+    .await;
+    // Any slice sent while the moves came 16 ms apart would show here.
+    assert!(
+        moving[0].as_u64().unwrap() <= sent0 + 1,
+        "slices sent during the moves: {} (before {sent0})",
+        moving[0]
+    );
+    assert_eq!(rested, sent0 + 1, "one slice when the pointer rested");
+    assert_eq!(rest_trip, Some(true), "the rested slice is marked so");
+    assert_eq!(
+        end[0].as_u64().unwrap(),
+        sent0 + 2,
+        "one more slice at the release, none during the moves"
+    );
+    assert_eq!(
+        end[1].as_bool(),
+        Some(false),
+        "the release's slice is not a rest's"
+    );
+    assert_eq!(
+        end[2].as_bool(),
+        Some(false),
+        "the preview is no longer greyed"
+    );
+    wait_js(&c, PRINTABLE, "the verdict after the drag").await;
     no_page_errors_and_close(c).await;
 }
 
