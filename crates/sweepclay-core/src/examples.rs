@@ -1,4 +1,7 @@
-//! The bundled example designs: walls modelled on the paper's Table 1
+//! The bundled example designs: six pots as potters make them (a
+//! cylinder, a belly vase, a bowl, a tumbler, a planter, a bud vase, each
+//! typed as widths at heights; `scripts/pot-examples` writes them, and the
+//! first is the modeler's cold open), walls modelled on the paper's Table 1
 //! models t1–t6 (Fig. 11), five vessels (a round vase, a flower vase
 //! whose two profiles differ, a cup for the cerambot-mini, a vase whose
 //! rim slants and a pitcher with a raised back, both with partial layers
@@ -9,6 +12,27 @@
 
 /// `(file name, design JSON)` for each bundled example.
 pub const EXAMPLES: &[(&str, &str)] = &[
+    (
+        "belly-vase.json",
+        include_str!("../../../examples/belly-vase.json"),
+    ),
+    (
+        "cylinder.json",
+        include_str!("../../../examples/cylinder.json"),
+    ),
+    ("bowl.json", include_str!("../../../examples/bowl.json")),
+    (
+        "tumbler.json",
+        include_str!("../../../examples/tumbler.json"),
+    ),
+    (
+        "planter.json",
+        include_str!("../../../examples/planter.json"),
+    ),
+    (
+        "bud-vase.json",
+        include_str!("../../../examples/bud-vase.json"),
+    ),
     ("t1.json", include_str!("../../../examples/t1.json")),
     ("t2.json", include_str!("../../../examples/t2.json")),
     ("t3.json", include_str!("../../../examples/t3.json")),

@@ -628,6 +628,10 @@ pub struct TextureFix {
     pub texture: String,
     /// The least amount kept there, 0–1.
     pub kept: f64,
+    /// The share of the textured wall reduced here, 0–1 (samples with a
+    /// texture to keep): the rest of the band may be kept whole, as the
+    /// modeler's "texture kept" colouring shows it.
+    pub share: f64,
     /// The heights between which it was reduced (mm).
     pub z_mm: [f64; 2],
     /// The normalised arc lengths between which it was reduced.
@@ -638,21 +642,35 @@ pub struct TextureFix {
 }
 
 impl TextureFix {
-    /// "ripple 2 mm reduced to 60 % (1.2 mm of 2 mm) between z 40 and 55
-    /// mm, u 0.10–0.30: overhang".
+    /// "ripple 2 mm reduced on 4 % of the wall, between z 40 and 55 mm, u
+    /// 0.10–0.30, to 60 % at the least (1.2 mm of 2 mm): overhang". The
+    /// share comes first: a band where a few spots lose the texture is not
+    /// a band without it.
     pub fn summary(&self, peak: f64) -> String {
         format!(
-            "texture {} reduced to {:.0} % ({} mm of {} mm) between z {:.0} and {:.0} mm, u {:.2}–{:.2}: {}",
+            "texture {} reduced on {} of the wall, between z {:.0} and {:.0} mm, u {:.2}–{:.2}, to {:.0} % at the least ({} mm of {} mm): {}",
             self.texture,
-            100.0 * self.kept,
-            fmt_mm(self.kept * peak),
-            fmt_mm(peak),
+            percent(self.share),
             self.z_mm[0],
             self.z_mm[1],
             self.u[0],
             self.u[1],
+            100.0 * self.kept,
+            fmt_mm(self.kept * peak),
+            fmt_mm(peak),
             self.why
         )
+    }
+}
+
+/// A share as a percentage that never rounds a reduction away: "0.4 %"
+/// below 1 %, whole percent above.
+fn percent(share: f64) -> String {
+    let p = 100.0 * share;
+    if p < 1.0 {
+        format!("{p:.1} %")
+    } else {
+        format!("{p:.0} %")
     }
 }
 
@@ -712,12 +730,14 @@ pub fn cap(b: f64, d: f64, limit: f64) -> f64 {
 
 /// Groups the samples kept below full amplitude into reports: sorted by
 /// height, a new group where two reduced samples are more than `gap` mm
-/// apart in height; each group names the commonest reason. `items` are
+/// apart in height; each group names the commonest reason and its share
+/// of the `textured` samples (those with a texture to keep). `items` are
 /// (z, u, a, why).
 pub fn report(
     mut items: Vec<(f64, f64, f64, &'static str)>,
     label: &str,
     gap: f64,
+    textured: usize,
 ) -> Vec<TextureFix> {
     items.sort_by(|a, b| a.0.total_cmp(&b.0));
     let mut out: Vec<(TextureFix, [u32; 3])> = Vec::new();
@@ -728,6 +748,7 @@ pub fn report(
                 TextureFix {
                     texture: label.to_string(),
                     kept: a,
+                    share: 0.0,
                     z_mm: [z, z],
                     u: [u, u],
                     why,
@@ -737,6 +758,7 @@ pub fn report(
         }
         let (f, counts) = out.last_mut().expect("pushed");
         f.kept = f.kept.min(a);
+        f.share += 1.0 / textured.max(1) as f64;
         f.z_mm[1] = z;
         f.u = [f.u[0].min(u), f.u[1].max(u)];
         counts[match why {
@@ -758,6 +780,29 @@ pub fn report(
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn a_report_says_what_share_of_the_wall_was_reduced() {
+        // 1,000 textured samples; 30 reduced in one band (two spots 1 mm
+        // apart), one elsewhere: the band's least is 0, its share 3 %.
+        let mut items: Vec<_> = (0..20)
+            .map(|k| (10.0, 0.1 + 0.001 * k as f64, 0.5, "overhang"))
+            .collect();
+        items.extend((0..10).map(|_| (11.0, 0.6, 0.0, "overlap")));
+        items.push((80.0, 0.3, 0.9, "overlap"));
+        let r = report(items, "flute 3 mm", 3.75, 1000);
+        assert_eq!(r.len(), 2);
+        assert!((r[0].share - 0.03).abs() < 1e-12, "{}", r[0].share);
+        assert_eq!(
+            (r[0].kept, r[0].z_mm, r[0].why),
+            (0.0, [10.0, 11.0], "overhang")
+        );
+        assert_eq!(
+            r[0].summary(3.0),
+            "texture flute 3 mm reduced on 3 % of the wall, between z 10 and 11 mm, u 0.10–0.60, to 0 % at the least (0 mm of 3 mm): overhang"
+        );
+        assert!(r[1].summary(3.0).contains("reduced on 0.1 % of the wall"));
+    }
 
     fn ripple(a: f64, p: f64) -> TextureSpec {
         serde_json::from_str(&format!(

@@ -43,6 +43,8 @@ fn impossible_textures_are_reduced_or_refused_by_name() {
     let steep = v(serde_json::json!({ "kind": "ripple", "amplitude": 4, "period": 8 }));
     let s = slice(&steep).unwrap();
     let said = s.corrected.report.summary().join("\n");
-    assert!(said.contains("texture ripple 4 mm reduced to"), "{said}");
+    assert!(said.contains("texture ripple 4 mm reduced on"), "{said}");
+    let shares: f64 = s.corrected.report.texture.iter().map(|f| f.share).sum();
+    assert!(shares > 0.0 && shares <= 1.0 + 1e-9, "{said}");
     assert!(common::check_fast(&s).printable);
 }

@@ -2110,11 +2110,22 @@ const NEW_DESIGN = {
 async function start() {
   const r = await fetch('/api/meta');
   state.meta = await r.json();
+  // Pots first (one profile, typed as widths at heights), then the
+  // paper's test pieces (t1–t6), then the other vessels and textures.
+  const groups = [['Pots', []], ["The paper's walls (Table 1)", []], ['Vessels and textures', []]];
   for (const ex of state.meta.examples) {
     const o = document.createElement('option');
     o.value = ex.name;
     o.textContent = `${ex.name}: ${ex.design.name || ''}`;
-    $('example').appendChild(o);
+    const k = /^t\d$/.test(ex.name) ? 1 : ex.design.profile_end || ex.design.texture ? 2 : 0;
+    groups[k][1].push(o);
+  }
+  for (const [label, opts] of groups) {
+    if (!opts.length) continue;
+    const g = document.createElement('optgroup');
+    g.label = label;
+    g.append(...opts);
+    $('example').appendChild(g);
   }
   buildParams();
   buildSurface();
@@ -2149,7 +2160,13 @@ async function start() {
   // What was autosaved may not slice (a key mistyped in a file opened
   // last time): the first answer then offers a way out, and undo works.
   state.restored = !asked && !!(d && d.trajectory);
-  if (asked) d = clone(asked.design);
+  if (asked) {
+    d = clone(asked.design);
+    // Opened once: a reload then keeps the edits made since (autosave),
+    // not the example again.
+    q.delete('example');
+    history.replaceState(null, '', `${location.pathname}${q.size ? `?${q}` : ''}`);
+  }
   const shown = d && d.trajectory ? d : clone(state.meta.examples[0].design);
   // The restored design is already the history's newest step.
   setDesign(shown, { fit: true, record: !(state.restored && state.history.length) });

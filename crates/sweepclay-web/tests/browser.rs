@@ -258,10 +258,10 @@ async fn no_page_errors_and_close(c: Client) {
 /// Whether the verdict says printable.
 const PRINTABLE: &str = "return document.getElementById('verdict').dataset.printable === 'true'";
 
-/// Opens the page, closes the first-run guide and waits for the first
-/// slice to print.
+/// Opens the page on t1 (the paper's first wall, which these tests were
+/// written on), closes the first-run guide and waits for it to print.
 async fn open_first_slice(c: &Client, base: &str) {
-    c.goto(base).await.unwrap();
+    c.goto(&format!("{base}/?example=t1")).await.unwrap();
     close_guide(c).await;
     wait_js(
         c,
@@ -370,9 +370,9 @@ async fn draw_preview_and_download_verified_gcode() {
         }
     };
 
-    c.goto(&base).await.unwrap();
+    c.goto(&format!("{base}/?example=t1")).await.unwrap();
     close_guide(&c).await;
-    // The first design is t1: 18,432 samples, verified printable.
+    // t1: 18,432 samples, verified printable.
     let before = wait_js(&c, SAMPLES, "the statistics").await;
     assert_eq!(before, "18,432");
     wait_js(&c, PRINTABLE, "the verdict on t1").await;
@@ -1078,6 +1078,9 @@ async fn truthful_state_imports_printers_and_phones() {
     .await;
     click(&c, "escape-example").await;
     wait_js(&c, PRINTABLE, "the first example after the way out").await;
+    // The phone's layout is measured on a design with all four editors.
+    c.goto(&format!("{base}/?example=t1")).await.unwrap();
+    wait_js(&c, &format!("return {IDLE} && {}", &PRINTABLE[7..]), "t1").await;
 
     // A phone: tabs, one panel at a time; nothing overlaps, every editor
     // and the 3D view have room, nothing is wider than the screen.
@@ -1868,6 +1871,28 @@ async fn a_texture_and_a_twist_are_added_and_their_gcode_prints() {
         legend.as_str().unwrap().contains("texture reduced"),
         "{legend}"
     );
+    // One truth: the share of the wall Corrections says was reduced is the
+    // share the "texture kept" colouring shows reduced (its wall beads).
+    let truth = js(
+        &c,
+        "const d = window.sweepclay.sliced; let n = 0;
+         for (let i = 1; i < d.surface.columns.length; i += 2) n += d.surface.columns[i];
+         let wall = 0, low = 0;
+         d.path.order.forEach((s, i) => { if (s < n) { wall++; if (d.path.texture_kept[i] < 0.99) low++; } });
+         return [document.getElementById('corrections').textContent, low / wall]",
+    )
+    .await;
+    let said = truth[0].as_str().unwrap();
+    let told: f64 = said
+        .split("reduced on ")
+        .skip(1)
+        .map(|t| t.split(" %").next().unwrap().parse::<f64>().unwrap())
+        .sum();
+    let shown = 100.0 * truth[1].as_f64().unwrap();
+    assert!(
+        told > 0.0 && (told - shown).abs() <= 2.0 + 0.25 * shown,
+        "Corrections says {told:.1} % reduced, the colouring shows {shown:.1} %: {said}"
+    );
     if let Ok(path) = std::env::var("SWEEPCLAY_TEXTURE_SCREENSHOT") {
         std::fs::write(&path, c.screenshot().await.unwrap()).unwrap();
     }
@@ -1988,6 +2013,113 @@ async fn a_pot_gets_a_raised_back_from_the_rim_control() {
         (back - front - 30.0).abs() < 1.5,
         "back {back}, front {front}"
     );
+    no_page_errors_and_close(c).await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_cold_open_is_a_pot_and_its_guide_starts_from_new_pot() {
+    // A potter's first minute: the page opens on a pot typed as widths at
+    // heights, the guide's first step is New pot, and the menu offers the
+    // shapes potters make before the paper's test pieces; each prints.
+    let Some(Session {
+        tmp: _tmp,
+        downloads: _,
+        driver: _driver,
+        c,
+        base,
+    }) = Session::start().await
+    else {
+        return;
+    };
+    c.goto(&base).await.unwrap();
+    let first = wait_js(
+        &c,
+        "const g = document.getElementById('guide'); return g.open && g.querySelector('li').textContent",
+        "the guide on a first visit",
+    )
+    .await;
+    assert!(
+        first.as_str().unwrap().starts_with("Press New pot"),
+        "the guide's first step: {first}"
+    );
+    if let Ok(path) = std::env::var("SWEEPCLAY_GUIDE_SCREENSHOT") {
+        std::fs::write(&path, c.screenshot().await.unwrap()).unwrap();
+    }
+    close_guide(&c).await;
+    wait_js(
+        &c,
+        &format!("return {IDLE} && {}", &PRINTABLE[7..]),
+        "the first slice",
+    )
+    .await;
+    let opened = js(
+        &c,
+        "const d = window.sweepclay.design; return [d.name, !!d.profile_end, [0, 1, 2, 3].map(i => document.getElementById('pot-w' + i)?.value), document.getElementById('pot-rows').offsetParent !== null]",
+    )
+    .await;
+    assert_eq!(
+        opened,
+        json!(["belly vase", false, ["70", "115", "60", "72"], true]),
+        "the cold open"
+    );
+    if let Ok(path) = std::env::var("SWEEPCLAY_COLD_OPEN_SCREENSHOT") {
+        std::fs::write(&path, c.screenshot().await.unwrap()).unwrap();
+    }
+    let menu = js(
+        &c,
+        "return [...document.querySelectorAll('#example optgroup')].map(g => [g.label, [...g.children].map(o => o.value)])",
+    )
+    .await;
+    let pots = [
+        "belly-vase",
+        "cylinder",
+        "bowl",
+        "tumbler",
+        "planter",
+        "bud-vase",
+    ];
+    assert_eq!(menu[0], json!(["Pots", pots]), "the menu: {menu}");
+    assert_eq!(
+        menu[1][1],
+        json!(["t1", "t2", "t3", "t4", "t5", "t6"]),
+        "the menu: {menu}"
+    );
+    for pot in &pots[1..] {
+        set_value(&c, "example", pot).await;
+        wait_js(
+            &c,
+            &format!(
+                "return {IDLE} && window.sweepclay.design.name.startsWith('{}') && {}",
+                pot.replace('-', " "),
+                &PRINTABLE[7..]
+            ),
+            &format!("{pot} printable"),
+        )
+        .await;
+        assert_eq!(
+            js(
+                &c,
+                "return document.getElementById('pot-rows').offsetParent !== null"
+            )
+            .await,
+            json!(true),
+            "{pot} opens in the widths table"
+        );
+    }
+    // New pot, as the guide says: a pot sized to the printer, printable.
+    click(&c, "new-pot").await;
+    wait_js(
+        &c,
+        &format!(
+            "return {IDLE} && window.sweepclay.design.name === 'new pot' && {}",
+            &PRINTABLE[7..]
+        ),
+        "the new pot printable",
+    )
+    .await;
+    if let Ok(path) = std::env::var("SWEEPCLAY_NEW_POT_SCREENSHOT") {
+        std::fs::write(&path, c.screenshot().await.unwrap()).unwrap();
+    }
     no_page_errors_and_close(c).await;
 }
 

@@ -233,5 +233,6 @@ pub(super) fn keep_texture(
         })
         .collect();
     let gap = 3.0 * s.params.max_layer_height;
-    (a, report(items, &s.texture_label.0, gap))
+    let textured = d.iter().filter(|v| v.abs() > 0.01).count();
+    (a, report(items, &s.texture_label.0, gap, textured))
 }
