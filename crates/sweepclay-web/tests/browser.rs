@@ -2139,6 +2139,14 @@ async fn a_drag_slices_only_when_the_pointer_rests_or_lets_go() {
         return;
     };
     open_first_slice(&c, &base).await;
+    // Under load the browser may hand the page two moves 100 ms apart or
+    // more: a rest. The test counts them, and allows a slice for each.
+    js(
+        &c,
+        "window.moves = []; document.addEventListener('pointermove', () => window.moves.push(performance.now()), true); return 0",
+    )
+    .await;
+    let rests = "const m = window.moves.splice(0); let n = 0; for (let i = 1; i < m.length; i++) if (m[i] - m[i - 1] >= 100) n++; return n";
     let sent0 = js(&c, "return window.sweepclay.sent")
         .await
         .as_u64()
@@ -2168,11 +2176,6 @@ async fn a_drag_slices_only_when_the_pointer_rests_or_lets_go() {
         -15.0,
     );
     c.perform_actions(first).await.unwrap();
-    let moving = js(
-        &c,
-        "const s = window.sweepclay; return [s.sent, s.settling, document.getElementById('preview').classList.contains('settling')]",
-    )
-    .await;
     wait_js(
         &c,
         &format!("return {IDLE} && window.sweepclay.sent > {sent0}"),
@@ -2183,6 +2186,7 @@ async fn a_drag_slices_only_when_the_pointer_rests_or_lets_go() {
         .await
         .as_u64()
         .unwrap();
+    let rests1 = js(&c, rests).await.as_u64().unwrap();
     let rest_trip = js(&c, "return window.sweepclay.roundTrips.at(-1).rest")
         .await
         .as_bool();
@@ -2202,18 +2206,20 @@ async fn a_drag_slices_only_when_the_pointer_rests_or_lets_go() {
         "const s = window.sweepclay; return [s.sent, s.roundTrips.at(-1).rest, document.getElementById('preview').classList.contains('settling')]",
     )
     .await;
-    // Any slice sent while the moves came 16 ms apart would show here.
+    let rests2 = js(&c, rests).await.as_u64().unwrap();
+    // A slice sent while the moves came 16 ms apart would show here: one
+    // for the rest, one for each gap the browser made a rest.
     assert!(
-        moving[0].as_u64().unwrap() <= sent0 + 1,
-        "slices sent during the moves: {} (before {sent0})",
-        moving[0]
+        rested > sent0 && rested <= sent0 + 1 + rests1,
+        "{} slices for one rest and {rests1} gaps of 100 ms or more between moves",
+        rested - sent0
     );
-    assert_eq!(rested, sent0 + 1, "one slice when the pointer rested");
     assert_eq!(rest_trip, Some(true), "the rested slice is marked so");
-    assert_eq!(
-        end[0].as_u64().unwrap(),
-        sent0 + 2,
-        "one more slice at the release, none during the moves"
+    let end_sent = end[0].as_u64().unwrap();
+    assert!(
+        end_sent > rested && end_sent <= rested + 1 + rests2,
+        "{} slices for the release and {rests2} gaps of 100 ms or more between moves",
+        end_sent - rested
     );
     assert_eq!(
         end[1].as_bool(),
