@@ -6,18 +6,24 @@
 /**
  * Triangles between adjacent transition curves, always advancing along the
  * curve whose next sample is lower (as mesh::surface_triangles in Rust).
- * `cols` is [first, count, first, count, …].
+ * `cols` is [first, count, first, count, …]; round a vessel's loop
+ * (`closed`) the last curve is joined to the first, or the seam shows
+ * as a slit.
  */
-export function zip(P, cols) {
+export function zip(P, cols, closed = false) {
+  const m = cols.length / 2;
+  const pairs = [];
+  for (let c = 0; c + 1 < m; c++) pairs.push([c, c + 1]);
+  if (closed && m > 2) pairs.push([m - 1, 0]);
   let total = 0;
-  for (let c = 0; c + 3 < cols.length; c += 2) total += cols[c + 1] + cols[c + 3] - 2;
+  for (const [a, b] of pairs) total += cols[2 * a + 1] + cols[2 * b + 1] - 2;
   const T = new Uint32Array(3 * total);
   let t = 0;
-  for (let c = 0; c + 3 < cols.length; c += 2) {
-    let i = cols[c];
-    let j = cols[c + 2];
-    const ae = i + cols[c + 1];
-    const be = j + cols[c + 3];
+  for (const [a, b] of pairs) {
+    let i = cols[2 * a];
+    let j = cols[2 * b];
+    const ae = i + cols[2 * a + 1];
+    const be = j + cols[2 * b + 1];
     while (i + 1 < ae || j + 1 < be) {
       const advanceA = i + 1 >= ae ? false : j + 1 >= be ? true : P[3 * i + 5] <= P[3 * j + 5];
       T[t++] = i;
@@ -96,7 +102,7 @@ export async function fetchSlice(design) {
     const buf = await r.arrayBuffer();
     const request = performance.now() - t0;
     const body = decode(buf);
-    const triangles = zip(body.surface.positions, body.surface.columns);
+    const triangles = zip(body.surface.positions, body.surface.columns, !!body.stats?.vessel);
     body.surface.triangles = triangles;
     body.surface.normals = normals(body.surface.positions, triangles);
     const timing = { headers_ms: headers, request_ms: request, worker_ms: performance.now() - t0 };

@@ -2124,6 +2124,103 @@ async fn the_cold_open_is_a_pot_and_its_guide_starts_from_new_pot() {
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_vessels_surface_is_closed_round_its_loop_and_its_sliders_fit() {
+    // The solid render of a vessel had a slit where the loop's last
+    // transition curve meets its first (a white seam); the texture
+    // sliders' panel was wider than the side panel, their values pushed
+    // out of sight.
+    let Some(Session {
+        tmp: _tmp,
+        downloads: _,
+        driver: _driver,
+        c,
+        base,
+    }) = Session::start().await
+    else {
+        return;
+    };
+    for (example, vessel) in [("ripple-vase", true), ("belly-vase", true), ("t1", false)] {
+        c.goto(&format!("{base}/?example={example}&path=0"))
+            .await
+            .unwrap();
+        if example == "ripple-vase" {
+            close_guide(&c).await;
+        }
+        wait_js(
+            &c,
+            &format!(
+                "return {IDLE} && window.sweepclay.design.name && {}",
+                &PRINTABLE[7..]
+            ),
+            example,
+        )
+        .await;
+        // An edge between two samples of one transition curve that only
+        // one triangle has is a slit in the surface; a wall has them at
+        // its two ends, a vessel none.
+        let slits = js(
+            &c,
+            "const s = window.sweepclay.sliced.surface; const T = s.triangles, cols = s.columns;
+             const curve = new Int32Array(s.positions.length / 3).fill(-1);
+             for (let c = 0; 2 * c < cols.length; c++) for (let k = 0; k < cols[2 * c + 1]; k++) curve[cols[2 * c] + k] = c;
+             const seen = new Map();
+             for (let t = 0; t < T.length; t += 3) for (const [a, b] of [[T[t], T[t + 1]], [T[t + 1], T[t + 2]], [T[t + 2], T[t]]]) {
+               const k = a < b ? a * 4294967296 + b : b * 4294967296 + a;
+               seen.set(k, (seen.get(k) || 0) + 1);
+             }
+             let n = 0;
+             for (const [k, count] of seen) {
+               const a = Math.floor(k / 4294967296), b = k % 4294967296;
+               if (count === 1 && curve[a] === curve[b] && curve[a] >= 0) n++;
+             }
+             return [n, cols.length / 2]",
+        )
+        .await;
+        let n = slits[0].as_u64().unwrap();
+        if vessel {
+            assert_eq!(n, 0, "{example}: {n} slit edges in its surface");
+        } else {
+            assert!(n > 0, "{example}: a wall's two ends are open");
+        }
+    }
+    // The ripple's sliders, on a desktop and on a phone's Settings tab.
+    c.goto(&format!("{base}/?example=ripple-vase"))
+        .await
+        .unwrap();
+    wait_js(
+        &c,
+        &format!("return {IDLE} && {}", &PRINTABLE[7..]),
+        "the ripple",
+    )
+    .await;
+    let fits = "const s = document.getElementById('side'); const r = s.getBoundingClientRect();
+        const outs = [...document.querySelectorAll('#surface-panel output')].map(o => o.getBoundingClientRect());
+        return [s.scrollWidth - s.clientWidth, outs.length, outs.every(o => o.right <= r.left + s.clientWidth + 0.5 && o.width > 0)]";
+    let desk = js(&c, fits).await;
+    assert_eq!(
+        desk,
+        json!([0, 5, true]),
+        "desktop: overflow, outputs, all in sight"
+    );
+    c.set_window_size(390, 844).await.unwrap();
+    c.execute(
+        "document.querySelector('#tabs button[data-tab=side]').click()",
+        vec![],
+    )
+    .await
+    .unwrap();
+    tokio::time::sleep(Duration::from_millis(300)).await;
+    let phone = js(
+        &c,
+        "const outs = [...document.querySelectorAll('#surface-panel output')].map(o => o.getBoundingClientRect());
+         return [document.documentElement.scrollWidth - window.innerWidth, outs.every(o => o.right <= window.innerWidth && o.width > 0)]",
+    )
+    .await;
+    assert_eq!(phone, json!([0, true]), "phone: overflow, all in sight");
+    no_page_errors_and_close(c).await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_drag_slices_only_when_the_pointer_rests_or_lets_go() {
     // While the pointer moves, the page draws the edited curves and does
     // not slice; the pointer resting 100 ms mid-drag slices once, the
