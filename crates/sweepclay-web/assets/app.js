@@ -372,6 +372,11 @@ function showPoint(ed, user = true) {
   const a = state.activeEditor;
   const k = editors.indexOf(a);
   const p = a && a.selected >= 0 ? a.points[a.selected] : null;
+  // On a phone the editors stand one under another: the bar follows the
+  // editor of the selected point, just under it (style.css, `--bar`).
+  const figs = [...$('editors').querySelectorAll(':scope > figure')];
+  const at = figs.indexOf(a?.canvas.closest('figure'));
+  $('editors').style.setProperty('--bar', String(at >= 0 ? 2 * at + 3 : 20));
   $('pb-what').textContent = p ? `${EDITOR_NAMES[k]}, point ${a.selected + 1} of ${a.points.length}:` : 'Click or tap a point to select it.';
   for (const [id, v, axis] of [['pb-x', p && p[0], k >= 0 ? AXES[k][0] : 'x'], ['pb-y', p && p[1], k >= 0 ? AXES[k][1] : 'y']]) {
     const inp = $(id);

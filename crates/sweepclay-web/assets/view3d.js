@@ -622,6 +622,12 @@ export class View3D {
       const before = Math.hypot(last[0] - other[0], last[1] - other[1]);
       const after = Math.hypot(now[0] - other[0], now[1] - other[1]);
       if (before > 0 && after > 0) this.dist *= before / after;
+      // Two fingers moving together pan: their midpoint moves by half of
+      // this finger's move (a pinch alone leaves it in place).
+      const k = this.dist / this.canvas.clientHeight;
+      const [r, u] = this.screenAxes();
+      const [mx, my] = [(now[0] - last[0]) / 2, (now[1] - last[1]) / 2];
+      for (let i = 0; i < 3; i++) this.target[i] += (-mx * r[i] + my * u[i]) * k;
     } else {
       const dx = now[0] - last[0];
       const dy = now[1] - last[1];

@@ -2221,6 +2221,174 @@ async fn a_vessels_surface_is_closed_round_its_loop_and_its_sliders_fit() {
 }
 
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn two_fingers_pan_the_3d_view_on_a_phone_and_the_hint_says_so() {
+    // On a touch screen there is no right button and no shift key: two
+    // fingers moving together pan the 3D view, apart they zoom.
+    let Some(Session {
+        tmp: _tmp,
+        downloads: _,
+        driver: _driver,
+        c,
+        base,
+    }) = Session::start().await
+    else {
+        return;
+    };
+    c.set_window_size(390, 844).await.unwrap();
+    c.goto(&format!("{base}/?example=vase")).await.unwrap();
+    close_guide(&c).await;
+    wait_js(
+        &c,
+        &format!("return {IDLE} && {}", &PRINTABLE[7..]),
+        "the vase",
+    )
+    .await;
+    c.execute(
+        "document.querySelector('#tabs button[data-tab=preview]').click()",
+        vec![],
+    )
+    .await
+    .unwrap();
+    tokio::time::sleep(Duration::from_millis(300)).await;
+    let hint = js(
+        &c,
+        "return document.getElementById('view-hint').textContent",
+    )
+    .await;
+    assert!(
+        hint.as_str().unwrap().contains("two fingers: pan"),
+        "{hint}"
+    );
+    let mid = js(
+        &c,
+        "const r = document.getElementById('view3d').getBoundingClientRect(); return [r.left + r.width / 2, r.top + r.height / 2]",
+    )
+    .await;
+    let (x, y) = (mid[0].as_f64().unwrap(), mid[1].as_f64().unwrap());
+    let view =
+        "const v = window.sweepclay.view; return [v.target[0], v.target[1], v.target[2], v.dist]";
+    // Each finger from its start by `by` (px) in 10 moves.
+    let gesture = |starts: [(f64, f64); 2], by: [(f64, f64); 2]| {
+        let finger = |name: &str, from: (f64, f64), by: (f64, f64)| {
+            let mut t = TouchActions::new(name.into())
+                .then(PointerAction::MoveTo {
+                    duration: None,
+                    x: from.0.round(),
+                    y: from.1.round(),
+                })
+                .then(PointerAction::Down {
+                    button: MOUSE_BUTTON_LEFT,
+                });
+            for k in 1..=10 {
+                let f = k as f64 / 10.0;
+                t = t.then(PointerAction::MoveTo {
+                    duration: Some(Duration::from_millis(16)),
+                    x: (from.0 + by.0 * f).round(),
+                    y: (from.1 + by.1 * f).round(),
+                });
+            }
+            t.then(PointerAction::Up {
+                button: MOUSE_BUTTON_LEFT,
+            })
+        };
+        fantoccini::actions::Actions::from(vec![
+            finger("one", starts[0], by[0]),
+            finger("two", starts[1], by[1]),
+        ])
+    };
+    let num = |v: &serde_json::Value, i: usize| v[i].as_f64().unwrap();
+    let before = js(&c, view).await;
+    // Together 80 px to the right: the view pans, its distance stays.
+    c.perform_actions(gesture(
+        [(x - 40.0, y), (x + 40.0, y)],
+        [(80.0, 0.0), (80.0, 0.0)],
+    ))
+    .await
+    .unwrap();
+    let panned = js(&c, view).await;
+    let moved = (0..3)
+        .map(|i| (num(&panned, i) - num(&before, i)).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    assert!(
+        moved > 5.0,
+        "two fingers moved the target {moved:.1} mm: {before} → {panned}"
+    );
+    assert!(
+        (num(&panned, 3) / num(&before, 3) - 1.0).abs() < 0.05,
+        "two fingers together zoomed: {before} → {panned}"
+    );
+    // Apart: the view zooms in, and the target stays.
+    c.perform_actions(gesture(
+        [(x - 30.0, y), (x + 30.0, y)],
+        [(-40.0, 0.0), (40.0, 0.0)],
+    ))
+    .await
+    .unwrap();
+    let pinched = js(&c, view).await;
+    assert!(
+        num(&pinched, 3) < 0.8 * num(&panned, 3),
+        "a pinch: {panned} → {pinched}"
+    );
+    let moved = (0..3)
+        .map(|i| (num(&pinched, i) - num(&panned, i)).powi(2))
+        .sum::<f64>()
+        .sqrt();
+    assert!(
+        moved < 0.25 * num(&pinched, 3),
+        "a pinch panned {moved:.1} mm: {panned} → {pinched}"
+    );
+    no_page_errors_and_close(c).await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_point_bar_stands_under_the_selected_points_editor_on_a_phone() {
+    // On a phone the editors stand one under another, 320 px each: the
+    // bar to type a point's coordinates was below all four, up to 1,000 px
+    // from the point tapped.
+    let Some(Session {
+        tmp: _tmp,
+        downloads: _,
+        driver: _driver,
+        c,
+        base,
+    }) = Session::start().await
+    else {
+        return;
+    };
+    c.set_window_size(390, 844).await.unwrap();
+    open_first_slice(&c, &base).await;
+    for (editor, canvas) in [(0, "ed-start"), (2, "ed-traj"), (1, "ed-end")] {
+        js(
+            &c,
+            &format!(
+                "document.getElementById('{canvas}').scrollIntoView({{block: 'center'}}); return 0"
+            ),
+        )
+        .await;
+        tokio::time::sleep(Duration::from_millis(200)).await;
+        let p = point_at(&c, editor, "1").await;
+        tap(&c, p).await;
+        let gap = wait_js(
+            &c,
+            &format!(
+                "const a = document.getElementById('{canvas}').getBoundingClientRect();
+                 const b = document.getElementById('point-bar').getBoundingClientRect();
+                 return document.getElementById('pb-x').disabled ? null : [b.top - a.bottom, b.height]"
+            ),
+            "the point selected",
+        )
+        .await;
+        let below = gap[0].as_f64().unwrap();
+        assert!(
+            (0.0..=60.0).contains(&below),
+            "{canvas}: the point bar is {below:.0} px below the editor"
+        );
+    }
+    no_page_errors_and_close(c).await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn a_drag_slices_only_when_the_pointer_rests_or_lets_go() {
     // While the pointer moves, the page draws the edited curves and does
     // not slice; the pointer resting 100 ms mid-drag slices once, the
