@@ -1,8 +1,8 @@
 //! How long `check` takes on large files: a meandering clay wall of about
 //! 44 thousand and about 1 million moves (0.5 mm moves, 0.9 mm layers);
 //! and clay stacked at one height (one ring laid 320 and 640 times at one
-//! Z), whose ratio shows the cost is linear there too. Run with
-//! `cargo bench -p sweepclay-check`.
+//! Z, and the same rising 1e-9 mm a move), whose ratios show the cost is
+//! linear there too. Run with `cargo bench -p sweepclay-check`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::fmt::Write;
@@ -58,16 +58,18 @@ fn meander(lines: usize, layers: usize) -> (String, usize) {
     (g, moves)
 }
 
-/// One ring of radius 30 mm in 90 beads, laid `repeats` times at one Z.
-fn stacked(repeats: usize) -> String {
+/// One ring of radius 30 mm in 90 beads, laid `repeats` times from Z 1.2,
+/// each move `rise` mm higher than the last.
+fn stacked(repeats: usize, rise: f64) -> String {
     let mut g = String::from("G21\nG90\nM82\nG92 E0\nG0 X130 Y100 Z1.2\n");
-    let mut e = 0.0;
+    let (mut e, mut z) = (0.0, 1.2);
     for _ in 0..repeats {
         for i in 1..=90 {
             let a = std::f64::consts::TAU * i as f64 / 90.0;
             e += 2.09 * 3.2 * 1.2 * 0.13;
+            z += rise;
             let (x, y) = (100.0 + 30.0 * a.cos(), 100.0 + 30.0 * a.sin());
-            writeln!(g, "G1 X{x:.3} Y{y:.3} Z1.2 E{e:.4}").unwrap();
+            writeln!(g, "G1 X{x:.3} Y{y:.3} Z{z:.9} E{e:.4}").unwrap();
         }
     }
     g
@@ -90,12 +92,14 @@ fn bench(c: &mut Criterion) {
             b.iter(|| check(std::hint::black_box(&text), &cfg))
         });
     }
-    for repeats in [320, 640] {
-        let text = stacked(repeats);
-        assert!(!check(&text, &cfg).printable, "a stack is clay on clay");
-        group.bench_function(format!("stacked_{repeats}"), |b| {
-            b.iter(|| check(std::hint::black_box(&text), &cfg))
-        });
+    for (name, rise) in [("stacked", 0.0), ("rising", 1e-9)] {
+        for repeats in [320, 640] {
+            let text = stacked(repeats, rise);
+            assert!(!check(&text, &cfg).printable, "a stack is clay on clay");
+            group.bench_function(format!("{name}_{repeats}"), |b| {
+                b.iter(|| check(std::hint::black_box(&text), &cfg))
+            });
+        }
     }
     group.finish();
 }

@@ -72,6 +72,10 @@ pub(crate) fn pick_support(
     }
 }
 
+/// Heights closer than this are one height (mm): below any printer's Z
+/// step (docs/CHECKER.md, "Heights a micrometre apart").
+pub(crate) const SAME_HEIGHT_MM: f64 = 1e-3;
+
 /// What an earlier bead is to a new one.
 pub(crate) enum Class {
     /// Clay below that may support it.
@@ -149,7 +153,15 @@ impl Query<'_> {
             // not laid on it.
             && b.spans(mid)
         {
-            return Class::Double(z);
+            // Clay less than a micrometre below the middle is at its
+            // height: no printer steps that finely, and a stack of such
+            // beads is then found at its first, not walked whole
+            // (docs/CHECKER.md, "Heights a micrometre apart").
+            return Class::Double(if z >= mid[2] - SAME_HEIGHT_MM {
+                mid[2]
+            } else {
+                z
+            });
         }
         Class::Neither
     }

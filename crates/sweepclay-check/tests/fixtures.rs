@@ -405,6 +405,48 @@ fn a_scribble_is_judged_alike_by_both_walks() {
     );
 }
 
+/// A ring laid `repeats` times from Z 1.2, each move `rise` mm higher.
+fn ring_stack(repeats: usize, rise: f64) -> String {
+    use std::fmt::Write;
+    let mut g = String::from("G21\nG90\nM82\nG92 E0\nG0 X130 Y100 Z1.2\n");
+    let (mut e, mut z) = (0.0, 1.2);
+    for _ in 0..repeats {
+        for i in 1..=90 {
+            let a = std::f64::consts::TAU * f64::from(i) / 90.0;
+            e += 2.09 * 3.2 * 1.2 * 0.13;
+            z += rise;
+            let (x, y) = (100.0 + 30.0 * a.cos(), 100.0 + 30.0 * a.sin());
+            writeln!(g, "G1 X{x:.3} Y{y:.3} Z{z:.9} E{e:.4}").unwrap();
+        }
+    }
+    g
+}
+
+/// Clay laid on itself rising a nanometre a move is clay laid on itself
+/// at one height (docs/CHECKER.md, "Heights a micrometre apart"): the same
+/// findings as the flat stack, from both walks.
+#[test]
+fn a_stack_rising_a_nanometre_a_move_is_judged_as_a_flat_one() {
+    let cfg = CheckConfig::default();
+    let json = |r: &Report| serde_json::to_string(r).unwrap();
+    let flat = verdict(&ring_stack(40, 0.0));
+    let rising = ring_stack(40, 1e-9);
+    let pruned = sweepclay_check::check_pruned(&rising, &cfg);
+    assert!(!pruned.printable);
+    assert_eq!(
+        pruned.findings[Finding::DoubleDeposition].count,
+        flat.findings[Finding::DoubleDeposition].count,
+        "{}\n{}",
+        pruned.render(),
+        flat.render()
+    );
+    assert_eq!(pruned.failures, flat.failures);
+    assert_eq!(
+        json(&pruned),
+        json(&sweepclay_check::check_exhaustive(&rising, &cfg))
+    );
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 300, failure_persistence: None, rng_seed: seed(), .. ProptestConfig::default() })]
 
