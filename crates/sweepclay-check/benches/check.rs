@@ -1,8 +1,9 @@
 //! How long `check` takes on large files: a meandering clay wall of about
 //! 44 thousand and about 1 million moves (0.5 mm moves, 0.9 mm layers);
 //! and clay stacked at one height (one ring laid 320 and 640 times at one
-//! Z, and the same rising 1e-9 mm a move), whose ratios show the cost is
-//! linear there too. Run with `cargo bench -p sweepclay-check`.
+//! Z, and the same rising 1e-9 mm a move; one 20 mm line laid back and
+//! forth 100,000 and 200,000 times at one Z), whose ratios show the cost
+//! is linear there too. Run with `cargo bench -p sweepclay-check`.
 
 use criterion::{criterion_group, criterion_main, Criterion};
 use std::fmt::Write;
@@ -75,6 +76,18 @@ fn stacked(repeats: usize, rise: f64) -> String {
     g
 }
 
+/// One 20 mm line laid back and forth `passes` times at one Z.
+fn back_and_forth(passes: usize) -> String {
+    let mut g = String::from("G21\nG90\nM82\nG92 E0\nG0 X90 Y100 Z1.2\n");
+    let mut e = 0.0;
+    for i in 0..passes {
+        e += 20.0 * 3.2 * 1.2 * 0.13;
+        let x = if i % 2 == 0 { 110 } else { 90 };
+        writeln!(g, "G1 X{x} Y100 Z1.2 E{e:.3}").unwrap();
+    }
+    g
+}
+
 fn bench(c: &mut Criterion) {
     let cfg = CheckConfig::default();
     let mut group = c.benchmark_group("check");
@@ -100,6 +113,13 @@ fn bench(c: &mut Criterion) {
                 b.iter(|| check(std::hint::black_box(&text), &cfg))
             });
         }
+    }
+    for passes in [100_000, 200_000] {
+        let text = back_and_forth(passes);
+        assert!(!check(&text, &cfg).printable, "a stack is clay on clay");
+        group.bench_function(format!("back_and_forth_{passes}"), |b| {
+            b.iter(|| check(std::hint::black_box(&text), &cfg))
+        });
     }
     group.finish();
 }

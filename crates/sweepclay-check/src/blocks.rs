@@ -1,8 +1,11 @@
 //! Bounds of runs of consecutive beads, for searches whose cost must not
 //! grow with how finely the path is sampled.
 //!
-//! The beads of a print are indexed in path order. Blocks of 8, 64 and
-//! 512 consecutive beads (aligned on their size) each keep the box that
+//! The beads of a print are indexed in path order. Blocks of 8, 64, 512,
+//! 4,096, 32,768 and 262,144 consecutive beads (aligned on their size;
+//! the coarse ones so that a run of a million beads, clay laid again and
+//! again over one place, is a few dozen blocks to ask, not two thousand:
+//! docs/PERFORMANCE.md) each keep the box that
 //! holds their centrelines and their widest half-width. A search that
 //! walks a run of beads asks each block first and skips it whole when
 //! its bounds show that no bead in it can matter (see
@@ -49,7 +52,7 @@ impl Bound {
 }
 
 /// log2 of the block sizes, finest first.
-const SHIFTS: [u32; 3] = [3, 6, 9];
+const SHIFTS: [u32; 6] = [3, 6, 9, 12, 15, 18];
 
 /// What a scan hands its visitor.
 pub(crate) enum Visit<'a> {
@@ -63,7 +66,7 @@ pub(crate) enum Visit<'a> {
 /// The bounds of every block of beads `0..len`, at each size.
 #[derive(Default)]
 pub(crate) struct Blocks {
-    levels: [Vec<Bound>; 3],
+    levels: [Vec<Bound>; SHIFTS.len()],
     len: usize,
 }
 
@@ -230,10 +233,13 @@ mod tests {
             });
             let want: Vec<u32> = (first..=last.min(1299))
                 .filter(|&j| {
-                    SHIFTS
-                        .iter()
-                        .enumerate()
-                        .all(|(level, shift)| !rejected(&blocks.levels[level][j as usize >> shift]))
+                    SHIFTS.iter().enumerate().all(|(level, shift)| {
+                        // As the scan: a coarse block still taking
+                        // beads is not asked.
+                        let k = j as usize >> shift;
+                        let last_fine = ((k + 1) << shift).min(blocks.len) - 1;
+                        !blocks.complete(level, last_fine) || !rejected(&blocks.levels[level][k])
+                    })
                 })
                 .collect();
             assert_eq!(seen, want, "run {first}..={last}");

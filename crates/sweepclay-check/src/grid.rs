@@ -19,7 +19,7 @@ pub(crate) const CELL_Z: f64 = 2.0;
 /// as clay on clay from its second pass. Reading only the newest keeps
 /// every question's cost bounded, so such a file checks in linear time
 /// (docs/CHECKER.md, "Bounded cost").
-pub(crate) const MAX_CELL_RUNS: usize = 64;
+pub(crate) const MAX_CELL_RUNS: usize = 32;
 
 /// Cells are indexed over the build volume with a margin of this many
 /// cells a side; clay beyond is counted in the border cells, whose lists
