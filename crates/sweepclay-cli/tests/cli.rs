@@ -496,6 +496,102 @@ fn serve_prints_its_url_and_answers() {
         )));
 }
 
+/// A PNG of `w` × `h` black grey pixels: a few kilobytes that decode to
+/// w·h bytes.
+fn black_png(w: u32, h: u32) -> Vec<u8> {
+    let mut out = Vec::new();
+    {
+        let mut enc = png::Encoder::new(&mut out, w, h);
+        enc.set_color(png::ColorType::Grayscale);
+        enc.set_compression(png::Compression::Best);
+        let mut wr = enc.write_header().unwrap();
+        wr.write_image_data(&vec![0u8; (w * h) as usize]).unwrap();
+    }
+    out
+}
+
+#[test]
+fn a_server_held_to_2_gib_refuses_400_pictures_by_their_cap_and_stays_up() {
+    // The request: 400 texture entries, each a small PNG that
+    // decodes to megapixels (4 Mpx there: 1.65 GB resident at 100 copies,
+    // an abort at 400 under 6 GiB; 1 Mpx here, to stay under the 4 MiB
+    // body cap). Under `prlimit --as` 2 GiB the server answers 4xx naming
+    // the cap, and answers the next request.
+    if std::process::Command::new("prlimit")
+        .arg("--version")
+        .output()
+        .is_err()
+    {
+        eprintln!("prlimit (util-linux) is not installed: not run");
+        return;
+    }
+    use std::io::BufRead;
+    let child = std::process::Command::new("prlimit")
+        .arg("--as=2147483648")
+        .arg(assert_cmd::cargo::cargo_bin("sweepclay"))
+        .args(["serve", "--port", "0"])
+        .stdout(std::process::Stdio::piped())
+        .spawn()
+        .unwrap();
+    let mut server = Server(child);
+    let mut line = String::new();
+    std::io::BufReader::new(server.0.stdout.take().unwrap())
+        .read_line(&mut line)
+        .unwrap();
+    let url = line
+        .split_whitespace()
+        .find(|w| w.starts_with("http://127.0.0.1:"))
+        .unwrap_or_else(|| panic!("no loopback URL in {line:?}"));
+    let addr = url.trim_start_matches("http://").trim_end_matches('/');
+    use base64::Engine;
+    let picture = base64::engine::general_purpose::STANDARD.encode(black_png(1000, 1000));
+    let mut design: serde_json::Value =
+        serde_json::from_str(sweepclay_core::examples::example("vase").unwrap()).unwrap();
+    let post = |design: &serde_json::Value| {
+        use std::io::{Read, Write};
+        let body = design.to_string();
+        let mut s = std::net::TcpStream::connect(addr).unwrap();
+        // The server may answer before it has read the whole body (a
+        // refusal from the header): what it said is read either way.
+        let _ = write!(
+            s,
+            "POST /api/slice HTTP/1.1\r\nHost: {addr}\r\nContent-Type: application/json\r\nContent-Length: {}\r\nConnection: close\r\n\r\n{body}",
+            body.len()
+        );
+        let mut out = Vec::new();
+        let _ = s.read_to_end(&mut out);
+        let out = String::from_utf8_lossy(&out).into_owned();
+        out
+    };
+    for (entries, kind, cap) in [
+        (400, "image", "at most 16"),
+        (400, "ripple", "at most 16"),
+        (16, "image", "pixels in all"),
+    ] {
+        design["texture"] = (0..entries)
+            .map(|_| {
+                let mut t =
+                    serde_json::json!({"kind": kind, "amplitude": 1, "png_base64": picture});
+                if kind == "ripple" {
+                    t["period"] = 8.into();
+                }
+                t
+            })
+            .collect();
+        let answer = post(&design);
+        assert!(
+            answer.starts_with("HTTP/1.1 4") && answer.contains(cap),
+            "{entries} {kind} textures: {}",
+            &answer[..answer.len().min(600)]
+        );
+    }
+    let meta = http_get(addr, "/api/meta");
+    assert!(
+        meta.starts_with("HTTP/1.1 200"),
+        "the server is gone: {meta}"
+    );
+}
+
 #[test]
 fn streamed_output_is_the_gcode_the_library_writes() {
     // `slice` streams the G-code through a buffered temporary file and the
@@ -806,6 +902,7 @@ fn outputs_keep_the_design_the_mode_and_no_leftovers() {
     {
         let mut enc = png::Encoder::new(&mut bytes, 2, 2);
         enc.set_color(png::ColorType::Grayscale);
+        enc.set_compression(png::Compression::Best);
         enc.set_depth(png::BitDepth::Eight);
         enc.write_header()
             .unwrap()
