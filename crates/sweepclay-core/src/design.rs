@@ -429,7 +429,14 @@ impl Design {
                 )
             } else {
                 Error::Parse {
-                    message,
+                    // An unknown key says where it sits ("texture[0].colour:
+                    // unknown field `colour`"): a line of a one-line
+                    // file the page sent says nothing.
+                    message: if known || path == "." {
+                        message
+                    } else {
+                        format!("{path}: {message}")
+                    },
                     line: inner.line(),
                     column: inner.column(),
                 }
@@ -686,6 +693,26 @@ impl Design {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    #[test]
+    fn an_unknown_key_says_where_it_sits() {
+        let mut v: serde_json::Value =
+            serde_json::from_str(crate::examples::example("cup").unwrap()).unwrap();
+        v["texture"] =
+            serde_json::json!([{ "kind": "ripple", "amplitude": 1, "period": 8, "colour": 1 }]);
+        let e = Design::from_json(&v.to_string()).unwrap_err().to_string();
+        assert!(
+            e.contains("texture[0].colour: unknown field `colour`"),
+            "{e}"
+        );
+        v["texture"] = serde_json::json!([]);
+        v["colour"] = serde_json::json!(1);
+        let e = Design::from_json(&v.to_string()).unwrap_err().to_string();
+        assert!(
+            e.contains("line 1 column") && e.contains("colour: unknown field `colour`"),
+            "{e}"
+        );
+    }
 
     const MINIMAL: &str = r#"{
         "sweepclay": 1,
