@@ -455,13 +455,16 @@ fn http_get(addr: &str, path: &str) -> String {
 /// Starts `sweepclay serve` with `args`; the server and the first line it
 /// prints (its URL).
 fn serve(args: &[&str]) -> (Server, String) {
+    let mut cmd = std::process::Command::new(assert_cmd::cargo::cargo_bin("sweepclay"));
+    cmd.arg("serve").args(args);
+    serve_by(cmd)
+}
+
+/// Starts the server `cmd` runs (`sweepclay serve`, or it under a
+/// wrapper); the server and the first line it prints.
+fn serve_by(mut cmd: std::process::Command) -> (Server, String) {
     use std::io::BufRead;
-    let child = std::process::Command::new(assert_cmd::cargo::cargo_bin("sweepclay"))
-        .arg("serve")
-        .args(args)
-        .stdout(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
+    let child = cmd.stdout(std::process::Stdio::piped()).spawn().unwrap();
     let mut server = Server(child);
     let mut line = String::new();
     std::io::BufReader::new(server.0.stdout.take().unwrap())
@@ -525,19 +528,11 @@ fn a_server_held_to_2_gib_refuses_400_pictures_by_their_cap_and_stays_up() {
         eprintln!("prlimit (util-linux) is not installed: not run");
         return;
     }
-    use std::io::BufRead;
-    let child = std::process::Command::new("prlimit")
-        .arg("--as=2147483648")
+    let mut cmd = std::process::Command::new("prlimit");
+    cmd.arg("--as=2147483648")
         .arg(assert_cmd::cargo::cargo_bin("sweepclay"))
-        .args(["serve", "--port", "0"])
-        .stdout(std::process::Stdio::piped())
-        .spawn()
-        .unwrap();
-    let mut server = Server(child);
-    let mut line = String::new();
-    std::io::BufReader::new(server.0.stdout.take().unwrap())
-        .read_line(&mut line)
-        .unwrap();
+        .args(["serve", "--port", "0"]);
+    let (_server, line) = serve_by(cmd);
     let url = line
         .split_whitespace()
         .find(|w| w.starts_with("http://127.0.0.1:"))
