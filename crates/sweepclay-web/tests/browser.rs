@@ -198,11 +198,12 @@ async fn download_printable(
     (text, printer)
 }
 
-/// Clicks the element with id `id`, waiting up to 5 s for it to take
-/// clicks (a panel the page is still laying out under load is "not
-/// interactable" for a moment).
+/// Clicks the element with id `id`, waiting up to 15 s for it to take
+/// clicks (a panel or dialog the page is still laying out is "not
+/// interactable" for a moment; with the whole suite on 2 cores, once for
+/// more than 5 s).
 async fn click(c: &Client, id: &str) {
-    let deadline = Instant::now() + Duration::from_secs(5);
+    let deadline = Instant::now() + Duration::from_secs(15);
     loop {
         let el = c.find(fantoccini::Locator::Id(id)).await.unwrap();
         // In view first: the printer dialog scrolls, and its buttons end
