@@ -95,6 +95,94 @@ impl Bead {
     }
 }
 
+/// Beads per chunk of [`Beads`]: the unit the store lets go of.
+pub(crate) const CHUNK: usize = 1 << 16;
+
+/// Every bead laid, by its index in path order, in chunks of [`CHUNK`];
+/// the oldest chunks may be let go once the path has risen far above them
+/// ([`Beads::evict_oldest`], docs/CHECKER.md "Bounded memory"), their
+/// indices staying those of the beads after them.
+#[derive(Default)]
+pub(crate) struct Beads {
+    chunks: Vec<Option<Vec<Bead>>>,
+    len: usize,
+    /// Chunks `..first_chunk` are let go.
+    first_chunk: usize,
+}
+
+impl Beads {
+    /// How many beads were laid (the let-go ones included).
+    #[inline]
+    pub(crate) fn len(&self) -> usize {
+        self.len
+    }
+
+    /// The first bead still kept.
+    #[inline]
+    pub(crate) fn first_kept(&self) -> usize {
+        self.first_chunk * CHUNK
+    }
+
+    /// How many beads are kept.
+    pub(crate) fn kept(&self) -> usize {
+        self.len - self.first_kept()
+    }
+
+    pub(crate) fn push(&mut self, b: Bead) {
+        let c = self.len / CHUNK;
+        if c == self.chunks.len() {
+            self.chunks.push(Some(Vec::with_capacity(CHUNK)));
+        }
+        self.chunks[c].as_mut().expect("the newest chunk is kept").push(b);
+        self.len += 1;
+    }
+
+    /// Bead `i`, if it was laid and is kept.
+    #[inline]
+    pub(crate) fn get(&self, i: usize) -> Option<&Bead> {
+        self.chunks.get(i / CHUNK)?.as_ref()?.get(i % CHUNK)
+    }
+
+    pub(crate) fn get_mut(&mut self, i: usize) -> Option<&mut Bead> {
+        self.chunks.get_mut(i / CHUNK)?.as_mut()?.get_mut(i % CHUNK)
+    }
+
+    /// Beads `from..` (from the first kept one at the earliest), with
+    /// their indices.
+    pub(crate) fn since(&self, from: usize) -> impl Iterator<Item = (usize, &Bead)> {
+        let from = from.max(self.first_kept());
+        (from..self.len).map(move |i| (i, &self[i]))
+    }
+
+    /// The oldest kept chunk's beads and their first index, or `None`
+    /// while fewer than two chunks are laid (the newest is never let go).
+    pub(crate) fn oldest(&self) -> Option<(usize, &[Bead])> {
+        (self.first_chunk + 1 < self.chunks.len()).then(|| {
+            let c = self.chunks[self.first_chunk].as_deref().expect("kept");
+            (self.first_kept(), c)
+        })
+    }
+
+    /// Lets the oldest kept chunk go (see [`Beads::oldest`]).
+    pub(crate) fn evict_oldest(&mut self) {
+        if self.oldest().is_some() {
+            self.chunks[self.first_chunk] = None;
+            self.first_chunk += 1;
+        }
+    }
+}
+
+impl std::ops::Index<usize> for Beads {
+    type Output = Bead;
+
+    /// Bead `i`; a question never asks one let go (it is refused before:
+    /// docs/CHECKER.md, "Bounded memory").
+    #[inline]
+    fn index(&self, i: usize) -> &Bead {
+        self.get(i).expect("a bead laid and kept")
+    }
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
@@ -110,5 +198,23 @@ mod tests {
         assert_eq!(b.height(), 0.0);
         b.set_height(1e9);
         assert!((b.height() - 65.535).abs() < 1e-9);
+    }
+
+    #[test]
+    fn beads_keep_their_indices_when_the_oldest_go() {
+        let mut beads = Beads::default();
+        for k in 0..(2 * CHUNK + 5) {
+            beads.push(Bead::new([k as f64, 0.0, 0.0], [k as f64 + 1.0, 0.0, 0.0], 3.0, k as f64, false));
+        }
+        assert_eq!((beads.len(), beads.kept(), beads.first_kept()), (2 * CHUNK + 5, 2 * CHUNK + 5, 0));
+        assert_eq!(beads.oldest().map(|(i, c)| (i, c.len())), Some((0, CHUNK)));
+        beads.evict_oldest();
+        beads.evict_oldest();
+        // The newest chunk stays.
+        beads.evict_oldest();
+        assert_eq!((beads.first_kept(), beads.kept()), (2 * CHUNK, 5));
+        assert!(beads.get(CHUNK).is_none());
+        assert_eq!(beads[2 * CHUNK + 3].from()[0], (2 * CHUNK + 3) as f64);
+        assert_eq!(beads.since(0).map(|(i, _)| i).collect::<Vec<_>>(), (2 * CHUNK..2 * CHUNK + 5).collect::<Vec<_>>());
     }
 }

@@ -4,7 +4,7 @@
 //! clay near it. Clay laid in the last r + w_max of path is the bead just
 //! laid, not an obstacle.
 
-use crate::bead::Bead;
+use crate::bead::Beads;
 use crate::grid::BeadGrid;
 use crate::replay::Move;
 use crate::report::Finding;
@@ -19,7 +19,7 @@ use crate::CheckConfig;
 #[inline]
 pub(crate) fn probe(
     grid: &mut BeadGrid,
-    beads: &[Bead],
+    beads: &Beads,
     top_z: f64,
     cfg: &CheckConfig,
     (m, len, s_start, s_end): (&Move, f64, f64, f64),

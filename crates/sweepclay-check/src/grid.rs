@@ -4,7 +4,7 @@
 //! neighbourhood reads a few cells, not every earlier bead
 //! (docs/CHECKER.md, "Speed").
 
-use crate::bead::Bead;
+use crate::bead::{Bead, Beads};
 use crate::geom::cell;
 use crate::tops::TopGrid;
 use crate::CheckConfig;
@@ -153,7 +153,7 @@ impl BeadGrid {
     /// up keeps its settled clay below the nozzle's tip, so its probes
     /// never read the columns, which saves a raise a bead
     /// (docs/PERFORMANCE.md, "The checker's micro-choices").
-    pub(crate) fn settle(&mut self, beads: &[Bead], done: impl Fn(&Bead) -> bool) {
+    pub(crate) fn settle(&mut self, beads: &Beads, done: impl Fn(&Bead) -> bool) {
         let top = &mut self.settled_top;
         settle(beads, &mut self.settled, done, |_, b| {
             *top = top.max(b.top32());
@@ -173,7 +173,7 @@ impl BeadGrid {
     /// are all the beads).
     pub(crate) fn settled_near(
         &mut self,
-        beads: &[Bead],
+        beads: &Beads,
         p: [f64; 3],
         r: f64,
         zlo: f64,
@@ -185,7 +185,7 @@ impl BeadGrid {
         if f64::from(self.settled_top) < zlo {
             return;
         }
-        for b in &beads[self.raised..self.settled] {
+        for (_, b) in beads.since(self.raised).take(self.settled.saturating_sub(self.raised)) {
             self.settled_max.raise(b);
         }
         self.raised = self.settled;
@@ -259,7 +259,7 @@ impl BeadGrid {
 /// Moves a settled frontier on: hands each bead from `*next` on that is
 /// `done` (they are in path order) to `f` with its index.
 pub(crate) fn settle(
-    beads: &[Bead],
+    beads: &Beads,
     next: &mut usize,
     done: impl Fn(&Bead) -> bool,
     mut f: impl FnMut(u32, &Bead),

@@ -3,7 +3,7 @@
 //! pruned by blocks of beads) or by the shortcut that follows the pass
 //! below, and the recent path that tells when the shortcut holds.
 
-use crate::bead::Bead;
+use crate::bead::{Bead, Beads};
 use crate::blocks::{Blocks, Bound, Visit};
 use crate::geom::{len2, rect_distance, turn_bound};
 use crate::grid::BeadGrid;
@@ -171,11 +171,10 @@ impl Query<'_> {
     /// since clay below in the last stretch of path (the end of the pass
     /// before a reversal) is usually its oldest part.
     #[inline]
-    pub(crate) fn none_below(&self, beads: &[Bead], first: usize) -> bool {
+    pub(crate) fn none_below(&self, beads: &Beads, first: usize) -> bool {
         beads
-            .iter()
-            .zip(first as u32..)
-            .all(|(b, j)| !matches!(self.classify(b, j), Class::Below(_)))
+            .since(first)
+            .all(|(j, b)| !matches!(self.classify(b, j as u32), Class::Below(_)))
     }
 }
 
@@ -287,7 +286,7 @@ const LOOK_PAST: usize = 8;
 /// nearer.
 #[inline]
 fn alone(
-    beads: &[Bead],
+    beads: &Beads,
     bent_before: &[u32],
     settled: usize,
     best: &Candidate,
@@ -313,7 +312,7 @@ fn alone(
 #[cold]
 #[inline(never)]
 fn alone_past_bends(
-    beads: &[Bead],
+    beads: &Beads,
     best: &Candidate,
     q: &Query,
     mid: [f64; 3],
@@ -360,7 +359,7 @@ fn alone_past_bends(
 /// finely the path is sampled.
 #[inline]
 pub(crate) fn follow_support(
-    beads: &[Bead],
+    beads: &Beads,
     grid: &BeadGrid,
     bent_before: &[u32],
     settled: usize,
@@ -481,7 +480,7 @@ const NEAR_BEND: f64 = 0.1;
 #[cold]
 #[inline(never)]
 fn any_near(
-    beads: &[Bead],
+    beads: &Beads,
     grid: &BeadGrid,
     q: &Query,
     (r, zlo, zhi): (f64, f64, f64),
@@ -497,7 +496,7 @@ fn any_near(
 /// Whether a bead below other than `best` covers the middle and is
 /// nearer to it ([`Candidate::nearer`]): then the full search starts from
 /// that one.
-fn nearer_below(beads: &[Bead], grid: &BeadGrid, q: &Query, best: &Candidate) -> bool {
+fn nearer_below(beads: &Beads, grid: &BeadGrid, q: &Query, best: &Candidate) -> bool {
     let (mid, cfg) = (q.mid, q.cfg);
     let window = (best.d, mid[2] - cfg.max_gap_mm, mid[2] - cfg.min_layer_mm);
     any_near(
@@ -516,7 +515,7 @@ fn nearer_below(beads: &[Bead], grid: &BeadGrid, q: &Query, best: &Candidate) ->
 /// climbed to: a bead pressed on a thin top-edge bead beside it may still
 /// sit squarely on the full bead under its middle (docs/CHECKER.md,
 /// "Overhang").
-pub(crate) fn gentlest_lean(beads: &[Bead], grid: &BeadGrid, q: &Query, max_gap: f64) -> f64 {
+pub(crate) fn gentlest_lean(beads: &Beads, grid: &BeadGrid, q: &Query, max_gap: f64) -> f64 {
     let (mid, cfg) = (q.mid, q.cfg);
     let mut best = f64::INFINITY;
     let r = cfg.width_max;
@@ -538,7 +537,7 @@ pub(crate) fn gentlest_lean(beads: &[Bead], grid: &BeadGrid, q: &Query, max_gap:
 /// with such clay under it is no bead over a layer gap, whatever the
 /// support walk settled on (docs/CHECKER.md, "Layer gaps"). Asked only
 /// of a bead about to fail for its gap.
-pub(crate) fn clay_within_gap(beads: &[Bead], grid: &BeadGrid, q: &Query, gap: f64) -> bool {
+pub(crate) fn clay_within_gap(beads: &Beads, grid: &BeadGrid, q: &Query, gap: f64) -> bool {
     let (mid, cfg) = (q.mid, q.cfg);
     let (lo, hi) = (mid[2] - gap, mid[2] - cfg.min_layer_mm);
     let mut found = false;
@@ -560,7 +559,7 @@ pub(crate) fn clay_within_gap(beads: &[Bead], grid: &BeadGrid, q: &Query, gap: f
 /// ([`Class::Double`]): asked of the beads themselves where a cell too
 /// coarse to tell holds clay that high near it (beside the rings of a
 /// floor's layer, the next ring of the same layer).
-fn laid_twice(beads: &[Bead], grid: &BeadGrid, q: &Query) -> bool {
+fn laid_twice(beads: &Beads, grid: &BeadGrid, q: &Query) -> bool {
     let (mid, ml) = (q.mid, q.cfg.min_layer_mm);
     let window = (0.5 * q.cfg.width_min, mid[2] - ml, mid[2] + ml);
     any_near(beads, grid, q, window, |c| matches!(c, Class::Double(_)))
@@ -572,7 +571,7 @@ fn laid_twice(beads: &[Bead], grid: &BeadGrid, q: &Query) -> bool {
 /// below it. The caller asks first, as for [`follow_support`], that none
 /// of the clay laid in the last 2 w_max of path is below.
 #[inline]
-pub(crate) fn on_bare_bed(beads: &[Bead], grid: &BeadGrid, tops: &TopGrid, q: &Query) -> bool {
+pub(crate) fn on_bare_bed(beads: &Beads, grid: &BeadGrid, tops: &TopGrid, q: &Query) -> bool {
     let (mid, cfg) = (q.mid, q.cfg);
     let r = cfg.width_max.max(f64::from(tops.widest) / 2.0);
     if mid[2] > cfg.first_layer_max_mm || r > 2.0 * cfg.width_max {
@@ -628,7 +627,7 @@ const PLAIN_MAX: usize = 64;
 /// finely sampled path) are asked questions instead ([`Walk::Pruned`],
 /// [`search_pruned`]), whose cost does not grow with the sampling.
 pub(crate) fn search_support(
-    beads: &[Bead],
+    beads: &Beads,
     grid: &BeadGrid,
     blocks: &mut Blocks,
     scratch: &mut Scratch,
@@ -656,7 +655,7 @@ pub(crate) fn search_support(
         > PLAIN_MAX;
     if walk == Walk::Pruned || (walk == Walk::Auto && many) {
         // The blocks take the beads laid since the last such search.
-        for b in &beads[blocks.len()..] {
+        for (_, b) in beads.since(blocks.len()) {
             blocks.push(&Bound::bead(b.from32, b.to32, b.width32));
         }
         return search_pruned(beads, blocks, runs, q, wider);
@@ -722,7 +721,7 @@ fn merge_runs(runs: &mut Vec<[u32; 2]>) {
 /// The bounds are widened by a margin far above rounding, so a skip never
 /// drops an answer.
 fn search_pruned(
-    beads: &[Bead],
+    beads: &Beads,
     blocks: &Blocks,
     runs: &mut Vec<[u32; 2]>,
     q: &Query,
@@ -798,7 +797,7 @@ fn search_pruned(
 
 /// The questions of [`search_pruned`] over runs of beads.
 struct Nearest<'a> {
-    pub(crate) beads: &'a [Bead],
+    pub(crate) beads: &'a Beads,
     pub(crate) blocks: &'a Blocks,
     pub(crate) q: &'a Query<'a>,
     /// Margin on every bound.

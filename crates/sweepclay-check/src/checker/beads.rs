@@ -151,7 +151,7 @@ impl Checker<'_> {
             let fast = (*walk == Walk::Auto
                 && (prev_support.is_some() || near_bed)
                 && (recent.clear_of(m, mid, cfg.min_layer_mm, turn, xy)
-                    || q.none_below(&beads[*support_settled..], *support_settled)))
+                    || q.none_below(beads, *support_settled)))
             .then(|| match *prev_support {
                 Some(j) => follow_support(
                     beads,
@@ -288,7 +288,7 @@ impl Checker<'_> {
             // A bead into the bed has no layer height or width to speak of.
             if dz.is_finite() && low_z >= cfg.first_layer_min_mm {
                 height = dz;
-                layer_heights.push(dz);
+                layer_heights.add(dz);
                 minmax(&mut r.support.layer_height, dz, m.line);
                 // A gap under two thinnest layers (a vase ramp's first
                 // millimetres) gives a width no one could measure on the
@@ -423,6 +423,18 @@ impl Checker<'_> {
             *top_z = top_z.max(m.from[2].max(m.to[2]));
         }
         bent_before.push(bent_before.last().copied().unwrap_or(0) + u32::from(bead.bent));
+        // The piece's size is kept as it goes: its first beads may be let
+        // go before the end (docs/CHECKER.md, "Bounded memory").
+        let bounds = match lead.runs.last_mut().filter(|_| lead.print_run.is_none()) {
+            Some(run) => &mut run.bounds,
+            None => &mut lead.after,
+        };
+        for p in [bead.from(), bead.to()] {
+            for a in 0..3 {
+                bounds.0[a] = bounds.0[a].min(p[a]);
+                bounds.1[a] = bounds.1[a].max(p[a]);
+            }
+        }
         beads.push(bead);
         // A stub (under a quarter of the narrowest bead in plan: where a
         // move was cut a hair from its end, its middle lies between two

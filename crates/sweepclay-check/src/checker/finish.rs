@@ -75,27 +75,19 @@ impl Checker<'_> {
         let first = self
             .lead
             .print_run
-            .and_then(|k| self.lead.runs.get(k))
-            .map_or(0, |run| run.first_bead as usize);
-        let (mut lo, mut hi) = ([f64::MAX; 3], [f64::MIN; 3]);
-        for b in self.beads.get(first..).unwrap_or_default() {
-            for p in [b.from(), b.to()] {
-                for a in 0..3 {
-                    lo[a] = lo[a].min(p[a]);
-                    hi[a] = hi[a].max(p[a]);
-                }
+            .filter(|&k| k < self.lead.runs.len())
+            .unwrap_or(0);
+        let (mut lo, mut hi) = self.lead.after;
+        for run in self.lead.runs.get(first..).unwrap_or_default() {
+            for a in 0..3 {
+                lo[a] = lo[a].min(run.bounds.0[a]);
+                hi[a] = hi[a].max(run.bounds.1[a]);
             }
         }
         if r.extruding_moves > 0 {
             r.size_mm = [hi[0] - lo[0], hi[1] - lo[1], hi[2].max(0.0)];
         }
-        if !self.layer_heights.is_empty() {
-            // The element a sort would put in the middle, in linear time
-            // (a total order: the same value as sorting).
-            let mid = self.layer_heights.len() / 2;
-            let (_, &mut median, _) = self
-                .layer_heights
-                .select_nth_unstable_by(mid, f64::total_cmp);
+        if let Some(median) = self.layer_heights.median() {
             if median > 0.0 {
                 r.layers = (hi[2] / median).round() as usize;
             }
@@ -112,6 +104,42 @@ impl Checker<'_> {
             .map(|(line, message)| Diagnostic { line, message });
         verdict(r, self.cfg);
         self.r
+    }
+}
+
+/// Layer heights counted in 1 µm bins up to 65.535 mm (higher ones in the
+/// last): the median of millions of beads' heights in 256 KB.
+#[derive(Default)]
+pub(super) struct Heights {
+    bins: Vec<u32>,
+    n: u64,
+}
+
+impl Heights {
+    /// Counts a layer height (mm; a NaN or negative one is not counted).
+    pub(super) fn add(&mut self, dz: f64) {
+        if !(dz >= 0.0) {
+            return;
+        }
+        if self.bins.is_empty() {
+            self.bins = vec![0; 1 << 16];
+        }
+        let k = ((dz * 1000.0).round() as usize).min(self.bins.len() - 1);
+        self.bins[k] = self.bins[k].saturating_add(1);
+        self.n += 1;
+    }
+
+    /// The element a sort would put in the middle (index n / 2), to the
+    /// micrometre; `None` before any.
+    pub(super) fn median(&self) -> Option<f64> {
+        let mut left = self.n / 2;
+        for (k, &c) in self.bins.iter().enumerate() {
+            if left < u64::from(c) {
+                return Some(k as f64 / 1000.0);
+            }
+            left -= u64::from(c);
+        }
+        None
     }
 }
 

@@ -7,7 +7,7 @@
 //! `beads` (what each bead rests on), `finish` (the end of the file and
 //! the verdict). This file reads the lines and replays the moves.
 
-use crate::bead::Bead;
+use crate::bead::{Bead, Beads};
 use crate::blocks::Blocks;
 use crate::collide;
 use crate::geom::{larger, len2, minmax, overlap_fraction};
@@ -229,7 +229,7 @@ struct Checker<'a> {
     /// The gap under the beads judged for it so far, a running mean
     /// (mm; 0 before the first): the layers the print lays.
     typical_gap: f64,
-    beads: Vec<Bead>,
+    beads: Beads,
     /// `bent_before[k + 1]`: how many of beads `0..=k` are bent (a
     /// prefix count, so "any bent bead in this stretch?" is two loads).
     bent_before: Vec<u32>,
@@ -239,7 +239,10 @@ struct Checker<'a> {
     scratch: Scratch,
     s: f64,
     top_z: f64,
-    layer_heights: Vec<f64>,
+    /// The beads' layer heights, counted to the micrometre: their median
+    /// says how many layers the print has, in memory that does not grow
+    /// with the moves.
+    layer_heights: finish::Heights,
     /// Clay tops of the beads laid more than 2 w_max of path back, in
     /// finer cells, for the support's fast path (`follow_support`).
     support_tops: TopGrid,
@@ -283,7 +286,10 @@ impl<'a> Checker<'a> {
             in_run: false,
             runs: 0,
             pending: Vec::new(),
-            lead: Lead::default(),
+            lead: Lead {
+                after: runs::EMPTY,
+                ..Lead::default()
+            },
             last_bead: (0, 0),
             min_area: 0.01 * cfg.width_min * cfg.min_layer_mm,
             failures: 0,
@@ -297,14 +303,14 @@ impl<'a> Checker<'a> {
             under: Vec::new(),
             last_feed: 0.0,
             typical_gap: 0.0,
-            beads: Vec::new(),
+            beads: Beads::default(),
             bent_before: vec![0],
             grid: BeadGrid::new(cfg),
             blocks: Blocks::default(),
             scratch: Scratch::default(),
             s: 0.0,
             top_z: f64::MIN,
-            layer_heights: Vec::new(),
+            layer_heights: finish::Heights::default(),
             support_tops: TopGrid::layered(
                 [cfg.build_volume[0], cfg.build_volume[1]],
                 2.0,
@@ -329,9 +335,7 @@ impl<'a> Checker<'a> {
     /// (3 million samples), too wide a range to guess.
     fn reserve(&mut self, moves: usize) {
         // A failed reservation only leaves the growing to `push`.
-        let _ = self.beads.try_reserve_exact(moves);
         let _ = self.bent_before.try_reserve_exact(moves);
-        let _ = self.layer_heights.try_reserve_exact(moves);
         self.blocks.reserve(moves);
     }
 

@@ -39,7 +39,15 @@ pub(super) struct LeadRun {
     pub(super) air: usize,
     /// Beads resting on the bed.
     pub(super) on_bed: usize,
+    /// The box of its beads' centrelines (low and high corners).
+    pub(super) bounds: Bounds,
 }
+
+/// A box of centrelines, low and high corners; empty as `EMPTY`.
+pub(super) type Bounds = ([f64; 3], [f64; 3]);
+
+/// The box of no bead.
+pub(super) const EMPTY: Bounds = ([f64::MAX; 3], [f64::MIN; 3]);
 
 /// Where the print begins (docs/CHECKER.md, "Start and end code"): the
 /// first run that clay is laid on. Runs before it that nothing rests on
@@ -56,6 +64,9 @@ pub(super) struct Lead {
     pub(super) air: Vec<u32>,
     /// What the start code holds, once decided.
     pub(super) start: Segment,
+    /// The box of the beads laid once the print's first run is known
+    /// (`EMPTY` at the start: `Checker::new` sets it).
+    pub(super) after: Bounds,
 }
 
 /// What a bead was found to rest on.
@@ -193,6 +204,7 @@ impl Checker<'_> {
             beads: 0,
             air: 0,
             on_bed: 0,
+            bounds: EMPTY,
         });
     }
 }
