@@ -96,7 +96,7 @@ impl Bead {
 }
 
 /// Beads per chunk of [`Beads`]: the unit the store lets go of.
-pub(crate) const CHUNK: usize = 1 << 16;
+pub(crate) const CHUNK: usize = 1 << 12;
 
 /// Every bead laid, by its index in path order, in chunks of [`CHUNK`];
 /// the oldest chunks may be let go once the path has risen far above them
@@ -133,7 +133,10 @@ impl Beads {
         if c == self.chunks.len() {
             self.chunks.push(Some(Vec::with_capacity(CHUNK)));
         }
-        self.chunks[c].as_mut().expect("the newest chunk is kept").push(b);
+        self.chunks[c]
+            .as_mut()
+            .expect("the newest chunk is kept")
+            .push(b);
         self.len += 1;
     }
 
@@ -204,9 +207,18 @@ mod tests {
     fn beads_keep_their_indices_when_the_oldest_go() {
         let mut beads = Beads::default();
         for k in 0..(2 * CHUNK + 5) {
-            beads.push(Bead::new([k as f64, 0.0, 0.0], [k as f64 + 1.0, 0.0, 0.0], 3.0, k as f64, false));
+            beads.push(Bead::new(
+                [k as f64, 0.0, 0.0],
+                [k as f64 + 1.0, 0.0, 0.0],
+                3.0,
+                k as f64,
+                false,
+            ));
         }
-        assert_eq!((beads.len(), beads.kept(), beads.first_kept()), (2 * CHUNK + 5, 2 * CHUNK + 5, 0));
+        assert_eq!(
+            (beads.len(), beads.kept(), beads.first_kept()),
+            (2 * CHUNK + 5, 2 * CHUNK + 5, 0)
+        );
         assert_eq!(beads.oldest().map(|(i, c)| (i, c.len())), Some((0, CHUNK)));
         beads.evict_oldest();
         beads.evict_oldest();
@@ -215,6 +227,9 @@ mod tests {
         assert_eq!((beads.first_kept(), beads.kept()), (2 * CHUNK, 5));
         assert!(beads.get(CHUNK).is_none());
         assert_eq!(beads[2 * CHUNK + 3].from()[0], (2 * CHUNK + 3) as f64);
-        assert_eq!(beads.since(0).map(|(i, _)| i).collect::<Vec<_>>(), (2 * CHUNK..2 * CHUNK + 5).collect::<Vec<_>>());
+        assert_eq!(
+            beads.since(0).map(|(i, _)| i).collect::<Vec<_>>(),
+            (2 * CHUNK..2 * CHUNK + 5).collect::<Vec<_>>()
+        );
     }
 }

@@ -50,6 +50,8 @@ pub(crate) struct BeadGrid {
     /// ([`BeadGrid::settled_near`]).
     pub(crate) settled_max: TopGrid,
     pub(crate) raised: usize,
+    /// Beads before it are let go.
+    pub(crate) first_kept: u32,
 }
 
 /// Cell ranges of a bead: plan x, plan y, z (inclusive).
@@ -57,6 +59,7 @@ type Span = ([i32; 2], [i32; 2], [i32; 2]);
 
 /// An entry of a cell's list: beads `first..=last` and the index of the
 /// next entry in `BeadGrid::links` (`u32::MAX` ends the list).
+#[derive(Clone, Copy)]
 pub(crate) struct Run {
     pub(crate) first: u32,
     pub(crate) last: u32,
@@ -84,7 +87,25 @@ impl BeadGrid {
             settled_top: f32::NEG_INFINITY,
             settled_max: TopGrid::new(plate, CELL_XY),
             raised: 0,
+            first_kept: 0,
         }
+    }
+
+    /// Beads before `first` are let go (docs/CHECKER.md, "Bounded
+    /// memory"): no run hands them out again.
+    pub(crate) fn forget_before(&mut self, first: u32) {
+        self.first_kept = first;
+    }
+
+    /// Raises the settled beads not yet in the settled column tops into
+    /// them (before the oldest beads are let go, so the tops keep them).
+    pub(crate) fn raise_settled(&mut self, beads: &Beads) {
+        for k in self.raised..self.settled {
+            if let Some(b) = beads.get(k) {
+                self.settled_max.raise(b);
+            }
+        }
+        self.raised = self.raised.max(self.settled);
     }
 
     /// The cells a bead spans: plan x and y ranges and z range, or
@@ -185,10 +206,7 @@ impl BeadGrid {
         if f64::from(self.settled_top) < zlo {
             return;
         }
-        for (_, b) in beads.since(self.raised).take(self.settled.saturating_sub(self.raised)) {
-            self.settled_max.raise(b);
-        }
-        self.raised = self.settled;
+        self.raise_settled(beads);
         let (z0, z1) = (cell(zlo, CELL_Z), cell(zhi, CELL_Z));
         let (lo, hi) = ([p[0] - r, p[1] - r], [p[0] + r, p[1] + r]);
         let tops = &self.settled_max;
@@ -243,10 +261,18 @@ impl BeadGrid {
                     let mut e = head;
                     let mut n = 0;
                     while let Some(run) = self.links.get(e as usize) {
-                        if n == MAX_CELL_RUNS {
+                        // Newest first: past a run of beads let go, all are.
+                        if n == MAX_CELL_RUNS || run.last < self.first_kept {
                             break;
                         }
-                        f(run);
+                        if run.first < self.first_kept {
+                            f(&Run {
+                                first: self.first_kept,
+                                ..*run
+                            });
+                        } else {
+                            f(run);
+                        }
                         e = run.next;
                         n += 1;
                     }

@@ -55,7 +55,7 @@ mod verdict;
 
 pub use checker::{check, check_reader, CheckWriter};
 #[doc(hidden)]
-pub use checker::{check_exhaustive, check_pruned};
+pub use checker::{check_exhaustive, check_kept, check_pruned};
 pub use parse::Diagnostic;
 pub use report::{
     Count, Finding, Findings, Report, Segment, SupportStats, OVERFLOW_SECTIONS, TURN_FACTOR,

@@ -447,6 +447,67 @@ fn a_stack_rising_a_nanometre_a_move_is_judged_as_a_flat_one() {
     );
 }
 
+/// A vase spiral of radius `r` about (`cx`, `cy`), `turns` turns of
+/// about 1 mm beads rising `LAYER` a turn, from the bed.
+fn spiral(g: &mut G, (cx, cy): (f64, f64), r: f64, turns: usize) {
+    let per = (std::f64::consts::TAU * r).round() as usize;
+    for k in 1..=turns * per {
+        let a = std::f64::consts::TAU * k as f64 / per as f64;
+        let z = LAYER * (1.0 + k as f64 / per as f64);
+        g.bead([cx + r * a.cos(), cy + r * a.sin(), z], W, LAYER);
+    }
+}
+
+/// Letting old clay go (docs/CHECKER.md, "Bounded memory"): a tall spiral
+/// of 16,000 beads reads the same keeping one chunk of beads as keeping
+/// all; a second spiral beside it after, from the bed, too; a ring laid
+/// back down over the first spiral's let-go clay gets no verdict, naming
+/// why, where keeping all finds the nozzle in the clay.
+#[test]
+fn clay_let_go_changes_no_report_until_the_path_comes_back_down() {
+    let cfg = CheckConfig::default();
+    let json = |r: &Report| serde_json::to_string(r).unwrap();
+    let mut g = G::new([120.0, 60.0, LAYER]);
+    spiral(&mut g, (100.0, 60.0), 20.0, 127);
+    let tall = g.out.clone();
+    let all = check(&tall, &cfg);
+    assert!(all.printable, "{}", all.render());
+    let kept = sweepclay_check::check_kept(&tall, &cfg, 1);
+    assert_eq!(json(&kept), json(&all));
+    // Beside it: a travel up and over, then a second spiral from the bed
+    // 60 mm away.
+    g.line("G0 Z170");
+    g.line("G0 X60 Y140");
+    g.line("G0 Z1.2");
+    g.at = [60.0, 140.0, LAYER];
+    spiral(&mut g, (40.0, 140.0), 20.0, 20);
+    let two = g.out.clone();
+    let all = check(&two, &cfg);
+    let kept = sweepclay_check::check_kept(&two, &cfg, 1);
+    assert!(kept.cannot_judge.is_none(), "{}", kept.render());
+    assert_eq!(json(&kept), json(&all));
+    // Back down over the first spiral's foot.
+    g.line("G0 Z170");
+    g.line("G0 X120 Y60");
+    g.line("G0 Z1.2");
+    g.at = [120.0, 60.0, LAYER];
+    g.run([120.0, 80.0, LAYER], W, LAYER);
+    let down = g.out;
+    let all = check(&down, &cfg);
+    assert!(
+        !all.printable && all.cannot_judge.is_none(),
+        "{}",
+        all.render()
+    );
+    let kept = sweepclay_check::check_kept(&down, &cfg, 1);
+    let why = kept
+        .cannot_judge
+        .as_ref()
+        .expect("no verdict over clay let go");
+    assert!(why.message.contains("memory bounded"), "{}", why.message);
+    assert!(!kept.printable);
+}
+
 proptest! {
     #![proptest_config(ProptestConfig { cases: 300, failure_persistence: None, rng_seed: seed(), .. ProptestConfig::default() })]
 

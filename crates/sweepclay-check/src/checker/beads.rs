@@ -430,9 +430,9 @@ impl Checker<'_> {
             None => &mut lead.after,
         };
         for p in [bead.from(), bead.to()] {
-            for a in 0..3 {
-                bounds.0[a] = bounds.0[a].min(p[a]);
-                bounds.1[a] = bounds.1[a].max(p[a]);
+            for (a, v) in p.into_iter().enumerate() {
+                bounds.0[a] = bounds.0[a].min(v);
+                bounds.1[a] = bounds.1[a].max(v);
             }
         }
         beads.push(bead);

@@ -118,7 +118,7 @@ pub(super) struct Heights {
 impl Heights {
     /// Counts a layer height (mm; a NaN or negative one is not counted).
     pub(super) fn add(&mut self, dz: f64) {
-        if !(dz >= 0.0) {
+        if dz.is_nan() || dz < 0.0 {
             return;
         }
         if self.bins.is_empty() {

@@ -23,6 +23,7 @@ use crate::CheckConfig;
 
 mod beads;
 mod finish;
+mod memory;
 mod runs;
 mod stretches;
 
@@ -54,6 +55,17 @@ pub fn check(text: &str, cfg: &CheckConfig) -> Report {
 fn check_with(text: &str, cfg: &CheckConfig, walk: Walk) -> Report {
     let mut w = CheckWriter::new(cfg);
     w.checker.walk = walk;
+    w.feed(text.as_bytes());
+    w.finish()
+}
+
+/// [`check`] keeping at most about `kept_beads` beads in memory (the
+/// default is [`memory::KEPT_BEADS`]): the tests' way to see what letting
+/// old clay go changes on small files (docs/CHECKER.md, "Bounded memory").
+#[doc(hidden)]
+pub fn check_kept(text: &str, cfg: &CheckConfig, kept_beads: usize) -> Report {
+    let mut w = CheckWriter::new(cfg);
+    w.checker.memory = memory::Memory::new(cfg, kept_beads);
     w.feed(text.as_bytes());
     w.finish()
 }
@@ -258,6 +270,8 @@ struct Checker<'a> {
     overhang_near: f64,
     /// How supports are found (tests compare the ways).
     walk: Walk,
+    /// Letting old clay go ([`memory`]).
+    memory: memory::Memory,
 }
 
 impl<'a> Checker<'a> {
@@ -325,6 +339,7 @@ impl<'a> Checker<'a> {
                     .to_radians()
                     .tan(),
             walk: Walk::Auto,
+            memory: memory::Memory::new(cfg, memory::KEPT_BEADS),
         }
     }
 
@@ -528,11 +543,15 @@ impl<'a> Checker<'a> {
                 ),
             });
         }
+        if self.deep && self.memory.reaches_let_go(m) {
+            self.cannot_follow(m);
+        }
         if self.deep {
             self.probe(m, len, s_start, bead);
         }
         if bead {
             self.bead(m, len, s_start);
+            self.let_go(m);
         }
     }
 
