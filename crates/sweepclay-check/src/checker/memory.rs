@@ -135,3 +135,43 @@ impl Checker<'_> {
         ));
     }
 }
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+    use crate::testkit::*;
+
+    #[test]
+    fn a_tall_spiral_keeps_a_bounded_number_of_beads() {
+        // 300 turns of 126 beads (37,800), keeping at least one chunk: the
+        // beads kept stay within the cap and two chunks, and the spiral
+        // prints as it does keeping all.
+        let mut g = G::new([120.0, 60.0, LAYER]);
+        let per = 126;
+        for k in 1..=300 * per {
+            let a = std::f64::consts::TAU * k as f64 / per as f64;
+            let z = 0.5 * LAYER + 0.5 * LAYER * k as f64 / per as f64;
+            g.bead(
+                [100.0 + 20.0 * a.cos(), 60.0 + 20.0 * a.sin(), z],
+                W,
+                0.5 * LAYER,
+            );
+        }
+        let cfg = CheckConfig {
+            min_layer_mm: 0.3,
+            ..CheckConfig::default()
+        };
+        let mut w = crate::CheckWriter::new(&cfg);
+        w.checker.memory = Memory::new(&cfg, 1);
+        std::io::Write::write_all(&mut w, g.out.as_bytes()).unwrap();
+        let (laid, kept) = (w.checker.beads.len(), w.checker.beads.kept());
+        let r = w.finish();
+        assert_eq!(laid, 300 * per);
+        assert!(kept <= 3 * CHUNK, "{kept} of {laid} beads kept");
+        assert!(r.printable, "{}", r.render());
+        assert_eq!(
+            serde_json::to_string(&r).unwrap(),
+            serde_json::to_string(&check(&g.out, &cfg)).unwrap()
+        );
+    }
+}
