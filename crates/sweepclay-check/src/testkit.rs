@@ -92,6 +92,17 @@ pub(crate) fn wall_from(a: f64, b: f64, layers: usize) -> G {
     g
 }
 
+/// A vase spiral of radius `r` about `c`, `turns` turns of about 1 mm
+/// beads rising `layer` a turn from one layer up.
+pub(crate) fn spiral(g: &mut G, c: (f64, f64), r: f64, turns: usize, layer: f64) {
+    let per = (std::f64::consts::TAU * r).round() as usize;
+    for k in 1..=turns * per {
+        let a = std::f64::consts::TAU * k as f64 / per as f64;
+        let z = layer * (1.0 + k as f64 / per as f64);
+        g.bead([c.0 + r * a.cos(), c.1 + r * a.sin(), z], W, layer);
+    }
+}
+
 pub(crate) fn verdict(text: &str) -> Report {
     check(text, &CheckConfig::default())
 }

@@ -447,17 +447,6 @@ fn a_stack_rising_a_nanometre_a_move_is_judged_as_a_flat_one() {
     );
 }
 
-/// A vase spiral of radius `r` about (`cx`, `cy`), `turns` turns of
-/// about 1 mm beads rising `LAYER` a turn, from the bed.
-fn spiral(g: &mut G, (cx, cy): (f64, f64), r: f64, turns: usize) {
-    let per = (std::f64::consts::TAU * r).round() as usize;
-    for k in 1..=turns * per {
-        let a = std::f64::consts::TAU * k as f64 / per as f64;
-        let z = LAYER * (1.0 + k as f64 / per as f64);
-        g.bead([cx + r * a.cos(), cy + r * a.sin(), z], W, LAYER);
-    }
-}
-
 /// Letting old clay go (docs/CHECKER.md, "Bounded memory"): a tall spiral
 /// of 16,000 beads reads the same keeping one chunk of beads as keeping
 /// all; a second spiral beside it after, from the bed, too; a ring laid
@@ -468,7 +457,7 @@ fn clay_let_go_changes_no_report_until_the_path_comes_back_down() {
     let cfg = CheckConfig::default();
     let json = |r: &Report| serde_json::to_string(r).unwrap();
     let mut g = G::new([120.0, 60.0, LAYER]);
-    spiral(&mut g, (100.0, 60.0), 20.0, 127);
+    spiral(&mut g, (100.0, 60.0), 20.0, 127, LAYER);
     let tall = g.out.clone();
     let all = check(&tall, &cfg);
     assert!(all.printable, "{}", all.render());
@@ -480,7 +469,7 @@ fn clay_let_go_changes_no_report_until_the_path_comes_back_down() {
     g.line("G0 X60 Y140");
     g.line("G0 Z1.2");
     g.at = [60.0, 140.0, LAYER];
-    spiral(&mut g, (40.0, 140.0), 20.0, 20);
+    spiral(&mut g, (40.0, 140.0), 20.0, 20, LAYER);
     let two = g.out.clone();
     let all = check(&two, &cfg);
     let kept = sweepclay_check::check_kept(&two, &cfg, 1);

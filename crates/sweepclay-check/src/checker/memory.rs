@@ -146,17 +146,9 @@ mod tests {
         // 300 turns of 126 beads (37,800), keeping at least one chunk: the
         // beads kept stay within the cap and two chunks, and the spiral
         // prints as it does keeping all.
-        let mut g = G::new([120.0, 60.0, LAYER]);
+        let mut g = G::new([120.0, 60.0, 0.5 * LAYER]);
+        spiral(&mut g, (100.0, 60.0), 20.0, 300, 0.5 * LAYER);
         let per = 126;
-        for k in 1..=300 * per {
-            let a = std::f64::consts::TAU * k as f64 / per as f64;
-            let z = 0.5 * LAYER + 0.5 * LAYER * k as f64 / per as f64;
-            g.bead(
-                [100.0 + 20.0 * a.cos(), 60.0 + 20.0 * a.sin(), z],
-                W,
-                0.5 * LAYER,
-            );
-        }
         let cfg = CheckConfig {
             min_layer_mm: 0.3,
             ..CheckConfig::default()
