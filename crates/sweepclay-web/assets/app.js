@@ -8,6 +8,7 @@ import { View3D } from './view3d.js';
 import { onCurve, rowsOnCurve, sample, samplePeriodic, throughRows } from './bspline.js';
 import { afterPaint, frameStats, onFrame } from './frame.js';
 import { fetchSlice } from './mesh.js';
+import { curveLines, profilePoints } from './curves3d.js';
 
 const $ = (id) => document.getElementById(id);
 const STORE = 'sweepclay.design.v1';
@@ -258,11 +259,6 @@ function redo() {
 
 const curve = (pts) => (pts.length >= 2 ? sample(pts, 160) : pts);
 const MIN_DZ = 0.5;
-
-/** A profile's points; a pot's end profile is its start one (docs/FORMATS.md). */
-function profilePoints(d, key) {
-  return (d[key] || d.profile_start).control_points;
-}
 
 function profileEditor(id, key, otherKey) {
   return new CurveEditor($(id), {
@@ -791,44 +787,6 @@ try {
   showError(String(e.message || e));
 }
 state.view = view;
-
-/**
- * The edited curves in 3D, drawn at once while the slice is in flight:
- * the path on the bed and the two profiles standing at its ends, offset
- * the way the design says (from o, or to the left of the path, outward
- * round a loop; docs/FORMATS.md).
- */
-function curveLines(d) {
-  const t = d.trajectory;
-  const given = t.points || t.control_points;
-  if (!given || given.length < 2) return [];
-  const path = t.closed ? (t.points ? given.concat([given[0]]) : samplePeriodic(given)) : t.points ? given : sample(given, 160);
-  const out = [];
-  for (let i = 0; i + 1 < path.length; i++) out.push([path[i][0], path[i][1], 0], [path[i + 1][0], path[i + 1][1], 0]);
-  let area = 0;
-  for (let i = 0; i + 1 < path.length; i++) area += path[i][0] * path[i + 1][1] - path[i + 1][0] * path[i][1];
-  const outward = t.closed && area > 0 ? -1 : 1;
-  const frame = (k) => {
-    const p = path[k];
-    const q = path[Math.min(path.length - 1, k + 1)];
-    const r = path[Math.max(0, k - 1)];
-    if (t.offset === 'normal') {
-      const [dx, dy] = [q[0] - r[0], q[1] - r[1]];
-      const l = Math.hypot(dx, dy) || 1;
-      return [p, [(-dy / l) * outward, (dx / l) * outward]];
-    }
-    const l = Math.hypot(p[0], p[1]) || 1;
-    return [p, [p[0] / l, p[1] / l]];
-  };
-  for (const [key, k] of [['profile_start', 0], ['profile_end', t.closed ? 0 : path.length - 1]]) {
-    const [p, dir] = frame(k);
-    const prof = sample(profilePoints(d, key), 80);
-    for (let i = 0; i + 1 < prof.length; i++) {
-      for (const [x, z] of [prof[i], prof[i + 1]]) out.push([p[0] + x * dir[0], p[1] + x * dir[1], z]);
-    }
-  }
-  return out;
-}
 
 /** Slices the design now (`rest`: the pointer rested mid-drag). */
 function requestSlice(fit, { rest = false } = {}) {

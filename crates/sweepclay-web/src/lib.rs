@@ -96,6 +96,11 @@ pub const ASSETS: &[(&str, &str, &str)] = &[
         include_str!("../assets/mesh.js"),
     ),
     (
+        "curves3d.js",
+        "text/javascript; charset=utf-8",
+        include_str!("../assets/curves3d.js"),
+    ),
+    (
         "slice-worker.js",
         "text/javascript; charset=utf-8",
         include_str!("../assets/slice-worker.js"),
