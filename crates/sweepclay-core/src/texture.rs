@@ -3,7 +3,7 @@
 //! A texture displaces the surface along each column's offset direction:
 //! ξ'(i, z) = ξ(i, z) + a(i, z) · D(i, z), with D the sum of the design's
 //! textures (ripple, flute, spiral, image), each times its fade envelope.
-//! Sampling (`surface.rs`) stores D per sample, its spacing and layer
+//! Sampling (`surface/`) stores D per sample, its spacing and layer
 //! heights refined so each texture gets at least [`SAMPLES_PER_PERIOD`]
 //! samples a period ([`needs`], which `Design::printed` applies). The
 //! corrections (`keep_texture` in `correct/texture.rs`) then choose the amount
@@ -14,7 +14,7 @@
 //! cannot hold it and every place where it does is reported.
 //!
 //! Twist turns each cross-section about o by `twist_deg · t` (t = z / h
-//! of the column): `Column::point` (`surface.rs`) applies it.
+//! of the column): `Column::point` (`surface/mod.rs`) applies it.
 
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
