@@ -9,15 +9,9 @@ import { onCurve, rowsOnCurve, sample, samplePeriodic, throughRows } from './bsp
 import { afterPaint, frameStats, onFrame } from './frame.js';
 import { fetchSlice } from './mesh.js';
 import { curveLines, profilePoints } from './curves3d.js';
+import { HISTORY, STORE, TAB_HISTORY, clone, edit, redo, setDesign, state, subscribe, undo } from './store.js';
 
 const $ = (id) => document.getElementById(id);
-const STORE = 'sweepclay.design.v1';
-// The undo history, kept across reloads (newest 60 steps, so it stays well
-// inside the browser's few megabytes of storage).
-const HISTORY = 'sweepclay.history.v1';
-const KEPT_STEPS = 60;
-// This tab's own history (a second tab keeps its own; docs/MODELER.md).
-const TAB_HISTORY = 'sweepclay.tab-history.v1';
 const PRINTERS = 'sweepclay.printers.v1';
 const GUIDE_SEEN = 'sweepclay.guide.v1';
 
@@ -39,35 +33,6 @@ const PARAMS = [
   ['shrinkage_z', 'firing shrinkage in height', '%', 0.5, 'how much your clay body shrinks in height from wet to fired (0 to 50 %)', 100],
 ];
 
-const state = {
-  /** The print just sent to the printer's host and being followed: { file, kind, url }. */
-  sending: null,
-  // The curves as printed where the corrections moved them (showPrinted).
-  printed: {},
-  meta: null,
-  design: null,
-  history: [],
-  at: -1,
-  inFlight: false,
-  pending: null,
-  // Slices sent to the server (a drag sends one when it rests or ends).
-  sent: 0,
-  settling: false,
-  restTimer: 0,
-  lastEdit: null,
-  roundTrips: [],
-  // Pointer event → the painted frame with the edited curve (ms).
-  editTimes: [],
-  verdictTimes: [],
-  // Each design sent to slice is numbered: an answer for an older one
-  // never sets the verdict (docs/MODELER.md).
-  seq: 0,
-  verifyTimer: 0,
-  verifySeq: 0,
-  sliced: null,
-  // The point the point bar shows (its editor is `activeEditor`).
-  barPoint: -1,
-};
 // For tests and the curious: the last round trips (edit → preview drawn), ms.
 window.sweepclay = state;
 state.frames = frameStats;
@@ -82,10 +47,6 @@ function postDesign(route, json) {
 
 // ---------------------------------------------------------------- design
 
-function clone(d) {
-  return JSON.parse(JSON.stringify(d));
-}
-
 function trajectoryPoints(d) {
   return d.trajectory.points || d.trajectory.control_points;
 }
@@ -94,38 +55,6 @@ function interpolationPoints(d) {
   if (d.interpolation) return d.interpolation.control_points;
   // A vessel's default, (1 − cos 2πu)/2, is drawn as a curve (below).
   return d.trajectory.closed ? [[0, 0], [1, 0]] : [[0, 0], [1, 1]];
-}
-
-/**
- * Replaces the design; `record` adds an undo step; `live` is a move of a
- * drag, which draws the edited curves but slices only when the pointer
- * rests (docs/MODELER.md, "The curve follows the finger").
- */
-function setDesign(d, { record = true, fit = false, live = false } = {}) {
-  state.design = d;
-  // Another design (opened, an example, a new pot): no refusal of a value
-  // typed for the last one stays beside the point bar.
-  if (fit) $('pb-error').textContent = '';
-  if (record) {
-    state.history = state.history.slice(0, state.at + 1);
-    state.history.push(JSON.stringify(d));
-    if (state.history.length > 200) state.history.shift();
-    state.at = state.history.length - 1;
-  }
-  saveSoon();
-  for (const ed of editors) {
-    if (fit) ed.fitted = false;
-    if (fit) ed.fit();
-    ed.refresh();
-  }
-  fillParams();
-  fillSurface();
-  showPotMode();
-  $('offset').value = d.trajectory.offset === 'normal' ? 'normal' : 'radial';
-  $('closed').checked = !!d.trajectory.closed;
-  updateUndo();
-  if (live) sliceAtRest();
-  else requestSlice(fit);
 }
 
 /** How long the pointer rests mid-drag before the design is sliced (ms). */
@@ -157,36 +86,6 @@ function setSettling(on) {
   $('preview').classList.toggle('settling', on);
 }
 
-/**
- * Changes the design; `since` is the input event's own time (its
- * `timeStamp`), from which the speed budget counts (docs/MODELER.md).
- */
-/**
- * Keeps the design and its history in the browser, a moment after the
- * last change: a drag's moves never wait for storage.
- */
-function saveSoon() {
-  clearTimeout(state.saveTimer);
-  state.unsaved = true;
-  state.saveTimer = setTimeout(saveNow, 300);
-}
-
-function saveNow() {
-  clearTimeout(state.saveTimer);
-  if (!state.design || !state.unsaved) return;
-  state.unsaved = false;
-  try {
-    localStorage.setItem(STORE, JSON.stringify(state.design));
-    const kept = state.history.slice(-KEPT_STEPS);
-    const at = state.at - (state.history.length - kept.length);
-    const h = JSON.stringify({ history: kept, at });
-    localStorage.setItem(HISTORY, h);
-    sessionStorage.setItem(TAB_HISTORY, h);
-  } catch (e) {
-    /* private mode or full: no autosave */
-  }
-}
-
 // Another tab saved its design: this tab keeps its own, says so, and
 // offers the other one (an undoable step), never losing either.
 window.addEventListener('storage', (e) => {
@@ -214,46 +113,37 @@ window.addEventListener('storage', (e) => {
   div.append(b);
   s.appendChild(div);
 });
-window.addEventListener('pagehide', saveNow);
-
-function edit(mutate, final, since) {
-  state.restored = false;
-  const d = clone(state.design);
-  // A parameter's own change sets it again just after this.
-  state.lastParam = null;
-  mutate(d);
-  const t = since ?? performance.now();
-  // A slice counts from the edit that starts it: a drag's release, or the
-  // move the pointer rested after (docs/MODELER.md); moves it never
-  // sliced are not its wait.
-  state.lastEdit = t;
-  state.lastEditAt = performance.now();
-  setDesign(d, { record: final, live: !final });
-  // From the event to the painted frame that shows the edited curve.
-  if (since != null) {
-    afterPaint((now) => {
-      state.editTimes.push(now - since);
-      if (state.editTimes.length > 400) state.editTimes.shift();
-    });
-  }
-}
 
 function updateUndo() {
   $('undo').disabled = state.at <= 0;
   $('redo').disabled = state.at >= state.history.length - 1;
 }
 
-function undo() {
-  if (state.at <= 0) return;
-  state.at--;
-  setDesign(JSON.parse(state.history[state.at]), { record: false });
-}
+/**
+ * Shows a new design everywhere (the store's one subscriber here): the
+ * editors, the panels, the undo buttons; then slices it, or for a drag's
+ * move draws its curves and slices when the pointer rests (docs/MODELER.md,
+ * "The curve follows the finger").
+ */
+subscribe((d, { fit, live }) => {
+  // Another design (opened, an example, a new pot): no refusal of a value
+  // typed for the last one stays beside the point bar.
+  if (fit) $('pb-error').textContent = '';
+  for (const ed of editors) {
+    if (fit) ed.fitted = false;
+    if (fit) ed.fit();
+    ed.refresh();
+  }
+  fillParams();
+  fillSurface();
+  showPotMode();
+  $('offset').value = d.trajectory.offset === 'normal' ? 'normal' : 'radial';
+  $('closed').checked = !!d.trajectory.closed;
+  updateUndo();
+  if (live) sliceAtRest();
+  else requestSlice(fit);
+});
 
-function redo() {
-  if (state.at >= state.history.length - 1) return;
-  state.at++;
-  setDesign(JSON.parse(state.history[state.at]), { record: false });
-}
 
 // ---------------------------------------------------------------- editors
 

@@ -96,6 +96,11 @@ pub const ASSETS: &[(&str, &str, &str)] = &[
         include_str!("../assets/mesh.js"),
     ),
     (
+        "store.js",
+        "text/javascript; charset=utf-8",
+        include_str!("../assets/store.js"),
+    ),
+    (
         "curves3d.js",
         "text/javascript; charset=utf-8",
         include_str!("../assets/curves3d.js"),
