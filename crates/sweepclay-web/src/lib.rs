@@ -96,6 +96,11 @@ pub const ASSETS: &[(&str, &str, &str)] = &[
         include_str!("../assets/mesh.js"),
     ),
     (
+        "surface-panel.js",
+        "text/javascript; charset=utf-8",
+        include_str!("../assets/surface-panel.js"),
+    ),
+    (
         "store.js",
         "text/javascript; charset=utf-8",
         include_str!("../assets/store.js"),
