@@ -11,28 +11,12 @@ import { fetchSlice } from './mesh.js';
 import { curveLines, profilePoints } from './curves3d.js';
 import { HISTORY, STORE, TAB_HISTORY, clone, edit, redo, report, setDesign, state, subscribe, undo } from './store.js';
 import { buildSurface } from './surface-panel.js';
+import { buildParams, param } from './params-panel.js';
+import { parseDecimal } from './numbers.js';
 
 const $ = (id) => document.getElementById(id);
 const PRINTERS = 'sweepclay.printers.v1';
 const GUIDE_SEEN = 'sweepclay.guide.v1';
-
-// Each parameter: its key, its label, its unit, its input step, what it
-// does (the tooltip, with the default), and the factor between the file's
-// value and the one shown (overlap is a fraction in the file, % here).
-const PARAMS = [
-  ['layer_height', 'layer height', 'mm', 0.05, 'the thinnest layer of clay (the paper\'s Δz₀)', 1],
-  ['max_layer_height', 'max layer height', 'mm', 0.05, 'the thickest layer allowed where the two profiles differ in height', 1],
-  ['spacing', 'point spacing', 'mm', 0.05, 'distance between points along the path seen from above', 1],
-  ['nozzle_height', 'extruder body height', 'mm', 1, 'how high the extruder body reaches above the nozzle tip (the paper\'s H): no clay may rise above it', 1],
-  ['width_min', 'bead width min', 'mm', 0.1, 'the narrowest bead of clay', 1],
-  ['width_max', 'bead width max', 'mm', 0.1, 'the widest bead of clay', 1],
-  ['overlap', 'overlap with the bead below', '%', 1, 'how much of each bead rests on the bead below it', 100],
-  ['max_overhang_deg', 'steepest overhang', '°', 1, 'how far from vertical the wall may lean before it is corrected', 1],
-  ['feedrate', 'print speed', 'mm/min', 50, 'how fast the nozzle moves while printing', 1],
-  ['floor_layers', 'floor layers (vessel)', '', 1, 'flat layers of the floor of a closed vessel; 0 for bottomless', 1],
-  ['shrinkage_xy', 'firing shrinkage across', '%', 0.5, 'how much your clay body shrinks across from wet to fired (0 to 50 %): the piece is printed that much larger, so the fired piece has the drawn size', 100],
-  ['shrinkage_z', 'firing shrinkage in height', '%', 0.5, 'how much your clay body shrinks in height from wet to fired (0 to 50 %)', 100],
-];
 
 // For tests and the curious: the last round trips (edit → preview drawn), ms.
 window.sweepclay = state;
@@ -135,7 +119,6 @@ subscribe((d, { fit, live }) => {
     if (fit) ed.fit();
     ed.refresh();
   }
-  fillParams();
   showPotMode();
   $('offset').value = d.trajectory.offset === 'normal' ? 'normal' : 'radial';
   $('closed').checked = !!d.trajectory.closed;
@@ -983,12 +966,6 @@ function showNote(msg) {
   s.appendChild(div);
 }
 
-/** The label, unit and factor of parameter `key`, if it is one. */
-function param(key) {
-  const p = PARAMS.find((q) => q[0] === key);
-  return p && { label: p[1], unit: p[2], factor: p[5] };
-}
-
 /**
  * A server message about a parameter in the page's words: `params.KEY:
  * must be between A and B (got V)` becomes "KEY's label must be between
@@ -1014,16 +991,6 @@ function plainWords(msg) {
     const f = (x) => (Number.isFinite(Number(x)) ? Number((Number(x) * p.factor).toFixed(4)) : x);
     return `${p.label} must be between ${f(a)} and ${f(b)} ${p.unit} (it is ${f(v)})`;
   }).replace(/params\.(\w+)/g, (all, k) => (param(k) ? param(k).label : all));
-}
-
-/**
- * A number as a potter types it: "1.5", or with a decimal comma "1,5";
- * anything else (two separators, letters, "1,5,0") is NaN, never a
- * silent 15.
- */
-function parseDecimal(text) {
-  const t = String(text).trim().replace(/^(-?\d*),(\d+)$/, '$1.$2');
-  return /^-?(\d+\.?\d*|\.\d+)(e-?\d+)?$/i.test(t) ? Number(t) : NaN;
 }
 
 // The panels' refusals go to the status line too.
@@ -1087,82 +1054,6 @@ function showError(msg, key) {
   } else {
     $('side-error').textContent = text;
   }
-}
-
-// ---------------------------------------------------------------- parameters
-
-function buildParams() {
-  const form = $('params');
-  const printer = document.createElement('label');
-  printer.innerHTML = 'printer <select id="p-printer" title="The printer the G-code is for: its build volume, where the design lands, its extruder"></select>';
-  form.appendChild(printer);
-  const sel = printer.querySelector('select');
-  fillPrinterOptions();
-  sel.addEventListener('change', () => {
-    if (sel.value.startsWith('kept:')) {
-      const k = keptPrinters().find((p) => `kept:${p.printer.name}` === sel.value);
-      if (k) edit((d) => { d.printer = k.printer; d.params = { ...(d.params || {}), nozzle_height: k.nozzle_height }; }, true);
-    } else if (sel.value) {
-      edit((d) => { d.printer = sel.value; }, true);
-    }
-  });
-  const editPrinter = document.createElement('button');
-  editPrinter.type = 'button';
-  editPrinter.id = 'printer-edit';
-  editPrinter.textContent = 'Edit printer…';
-  editPrinter.title = 'Set up your own printer: build volume, bed_min, origin, E per mm³, nozzle body, start and end code';
-  editPrinter.addEventListener('click', openPrinter);
-  form.appendChild(editPrinter);
-  for (const [key, label, unit, step, help, factor] of PARAMS) {
-    const l = document.createElement('label');
-    l.innerHTML = `<span>${label} <small>${unit}</small></span>`;
-    const inp = document.createElement('input');
-    // Text, not a number field: a browser's number field reads "1,5" as
-    // 15 in some locales; a decimal comma is read here as a decimal.
-    inp.type = 'text';
-    inp.inputMode = 'decimal';
-    inp.dataset.step = step;
-    inp.id = `p-${key}`;
-    const def = state.meta.params[key] ?? (key === 'floor_layers' ? 2 : null);
-    const shown = def == null ? '' : ` (default ${Number((def * factor).toFixed(4))}${unit ? ` ${unit}` : ''})`;
-    inp.title = `${help}${shown}`;
-    l.title = inp.title;
-    inp.addEventListener('change', () => {
-      const v = parseDecimal(inp.value);
-      if (!Number.isFinite(v)) {
-        showError(`${label}: "${inp.value}" is not a number (write 1.5 or 1,5)`, `params.${key}`);
-        return;
-      }
-      // Layers come whole: said beside the field, the value left as it was.
-      if (key === 'floor_layers' && !(Number.isInteger(v) && v >= 0 && v <= state.meta.max_floor_layers)) {
-        showError(`${label}: "${inp.value}" is not a whole number of layers from 0 (bottomless) to ${state.meta.max_floor_layers}`, `params.${key}`);
-        return;
-      }
-      edit((d) => { d.params = { ...(d.params || {}), [key]: v / factor }; }, true);
-      state.lastParam = key;
-    });
-    l.appendChild(inp);
-    form.appendChild(l);
-  }
-  $('name').addEventListener('change', () => edit((d) => { d.name = $('name').value; }, true));
-}
-
-function fillParams() {
-  const d = state.design;
-  const p = { ...state.meta.params, ...(d.params || {}) };
-  if (p.floor_layers === undefined || p.floor_layers === null) p.floor_layers = 2;
-  for (const [key, , , , , factor] of PARAMS) {
-    const inp = $(`p-${key}`);
-    // A percentage to two decimals (2/3 is 66.67 %).
-    const v = String(Number((Number(p[key]) * factor).toFixed(factor === 1 ? 4 : 2)));
-    if (document.activeElement !== inp && inp.value !== v) inp.value = v;
-  }
-  // Only a vessel has a floor.
-  $('p-floor_layers').disabled = !d.trajectory.closed;
-  const kept = typeof d.printer === 'object' && d.printer && keptPrinters().find((k) => JSON.stringify(k.printer) === JSON.stringify(d.printer));
-  const printer = typeof d.printer === 'string' ? d.printer : kept ? `kept:${kept.printer.name}` : d.printer ? '' : 'generic';
-  $('p-printer').value = printer;
-  if (document.activeElement !== $('name')) $('name').value = d.name || '';
 }
 
 // ---------------------------------------------------------------- files
@@ -1813,7 +1704,7 @@ async function start() {
     g.append(...opts);
     $('example').appendChild(g);
   }
-  buildParams();
+  buildParams({ fillPrinterOptions, keptPrinters, openPrinter });
   buildSurface();
   // ?example=t3 opens a bundled example; ?colour=pass|stage|width picks the
   // toolpath colouring; ?surface=0 / ?path=0 hide one of the two.

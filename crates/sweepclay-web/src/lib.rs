@@ -96,6 +96,16 @@ pub const ASSETS: &[(&str, &str, &str)] = &[
         include_str!("../assets/mesh.js"),
     ),
     (
+        "params-panel.js",
+        "text/javascript; charset=utf-8",
+        include_str!("../assets/params-panel.js"),
+    ),
+    (
+        "numbers.js",
+        "text/javascript; charset=utf-8",
+        include_str!("../assets/numbers.js"),
+    ),
+    (
         "surface-panel.js",
         "text/javascript; charset=utf-8",
         include_str!("../assets/surface-panel.js"),

@@ -1,0 +1,12 @@
+// Numbers as potters type them (docs/MODELER.md): a decimal comma is a
+// decimal point; anything else that is not a plain number is refused.
+
+/**
+ * A number as a potter types it: "1.5", or with a decimal comma "1,5";
+ * anything else (two separators, letters, "1,5,0") is NaN, never a
+ * silent 15.
+ */
+export function parseDecimal(text) {
+  const t = String(text).trim().replace(/^(-?\d*),(\d+)$/, '$1.$2');
+  return /^-?(\d+\.?\d*|\.\d+)(e-?\d+)?$/i.test(t) ? Number(t) : NaN;
+}
