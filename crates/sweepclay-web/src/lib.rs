@@ -96,6 +96,11 @@ pub const ASSETS: &[(&str, &str, &str)] = &[
         include_str!("../assets/mesh.js"),
     ),
     (
+        "status.js",
+        "text/javascript; charset=utf-8",
+        include_str!("../assets/status.js"),
+    ),
+    (
         "params-panel.js",
         "text/javascript; charset=utf-8",
         include_str!("../assets/params-panel.js"),
