@@ -10,3 +10,7 @@ export function parseDecimal(text) {
   const t = String(text).trim().replace(/^(-?\d*),(\d+)$/, '$1.$2');
   return /^-?(\d+\.?\d*|\.\d+)(e-?\d+)?$/i.test(t) ? Number(t) : NaN;
 }
+
+/** A length as the page shows it: at most two decimals, no trailing zeros. */
+export const fmtMm = (v) => String(Number(v.toFixed(2)));
+

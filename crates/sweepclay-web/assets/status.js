@@ -2,7 +2,7 @@
 // page's words beside the field it blames (and on a phone's Shape tab),
 // a passing note, "slicing…", and the checker's verdict.
 
-import { param } from './params-panel.js';
+import { param } from './params.js';
 import { clone, setDesign, state } from './store.js';
 
 const $ = (id) => document.getElementById(id);

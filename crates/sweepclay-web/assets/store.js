@@ -46,11 +46,6 @@ export const state = {
 
 const listeners = [];
 
-/**
- * Where a panel reports what it refused (a picture too big): the page sets
- * `report.error` to its status line's (`showError(msg, key)`).
- */
-export const report = { error: (msg) => console.error(msg) };
 
 /** Calls `fn(design, { fit, live })` on every new design. */
 export function subscribe(fn) {

@@ -3,7 +3,8 @@
 // browser reads. It reads the design from the store and changes it through
 // `edit`; every new design refreshes it.
 
-import { edit, report, state, subscribe } from './store.js';
+import { showError } from './status.js';
+import { edit, state, subscribe } from './store.js';
 
 const $ = (id) => document.getElementById(id);
 
@@ -166,7 +167,7 @@ function textureBox(t, k) {
         const png = await pictureAsPng(file);
         edit((d) => { d.texture[k].png_base64 = png; delete d.texture[k].path; }, true);
       } catch (e) {
-        report.error(`texture[${k}]: ${e.message}`, `texture[${k}]`);
+        showError(`texture[${k}]: ${e.message}`, `texture[${k}]`);
       }
     });
     l.appendChild(f);

@@ -96,9 +96,24 @@ pub const ASSETS: &[(&str, &str, &str)] = &[
         include_str!("../assets/mesh.js"),
     ),
     (
+        "io.js",
+        "text/javascript; charset=utf-8",
+        include_str!("../assets/io.js"),
+    ),
+    (
+        "printer-dialog.js",
+        "text/javascript; charset=utf-8",
+        include_str!("../assets/printer-dialog.js"),
+    ),
+    (
         "status.js",
         "text/javascript; charset=utf-8",
         include_str!("../assets/status.js"),
+    ),
+    (
+        "params.js",
+        "text/javascript; charset=utf-8",
+        include_str!("../assets/params.js"),
     ),
     (
         "params-panel.js",
