@@ -4,14 +4,17 @@
 //! scaling series of
 //! `examples::scaled` (10 thousand to 10 million samples).
 //!
+//! `replan/*`: a vessel planned again after an edit of the printer's flow,
+//! its surface sampled afresh or kept (docs/ARCHITECTURE.md, "Stages").
+//!
 //! `cargo bench -p sweepclay-plan` (all), `-- verified/t1`, `-- verified_scaling`.
 //! `SWEEPCLAY_BENCH_MAX=1000000` stops the scaling series at 1 million.
 
 use criterion::{criterion_group, criterion_main, BenchmarkId, Criterion, Throughput};
 use std::hint::black_box;
+use sweepclay_core::printer::PrinterRef;
 use sweepclay_core::{examples, Design};
-use sweepclay_plan::slice_checked;
-use sweepclay_plan::Cancel;
+use sweepclay_plan::{plan, slice_checked, Cancel, Job, Limits, Samples};
 
 /// The allocator the `sweepclay` binary ships with (mimalloc: it keeps
 /// freed pages for reuse, where glibc's returns large blocks to the system
@@ -51,6 +54,36 @@ fn bench(c: &mut Criterion) {
     let n = sweepclay_core::slice(&v).unwrap().stats.sample_points;
     g.throughput(Throughput::Elements(n as u64));
     g.bench_function("vessel_44k", |b| b.iter(|| verified(black_box(&v))));
+    g.finish();
+    // An edit that changes only the printer's flow (stage 5): the plan
+    // from a fresh sampling, and from the surface the store kept.
+    let mut g = c.benchmark_group("replan");
+    for name in ["pitcher", "vase"] {
+        let d = Design::from_json(examples::example(name).unwrap()).unwrap();
+        let mut e = d.clone();
+        let mut p = e.printer.resolve().unwrap();
+        p.e_per_mm3 *= 1.05;
+        e.printer = PrinterRef::Inline(Box::new(p));
+        let limits = Limits::default();
+        let job = Job::new(e, &limits).unwrap();
+        let store = Samples::new();
+        store.sampled(&d).unwrap();
+        let kept = job.clone().with_samples(&store);
+        let run = |j: &Job| {
+            plan(j, &Cancel::new(), || Ok(std::io::sink()))
+                .unwrap()
+                .checked
+                .report
+                .printable
+        };
+        assert!(run(&job) && run(&kept));
+        g.bench_function(format!("{name}_flow_resampled"), |b| {
+            b.iter(|| run(black_box(&job)))
+        });
+        g.bench_function(format!("{name}_flow_kept"), |b| {
+            b.iter(|| run(black_box(&kept)))
+        });
+    }
     g.finish();
     let max: usize = std::env::var("SWEEPCLAY_BENCH_MAX")
         .ok()

@@ -4,7 +4,9 @@
 //! range, a texture, the sample cap, the build volume — the way a
 //! command line's raw flags become one validated job before work starts.
 
-use sweepclay_core::{Design, Error, Result};
+use crate::stage::Samples;
+use std::sync::Arc;
+use sweepclay_core::{surface, Design, Error, Result, Surface};
 
 /// What a job is held to.
 #[derive(Clone, Copy, Debug, PartialEq)]
@@ -41,6 +43,7 @@ pub const DEFAULT_MAX_SAMPLES: u64 = 1_500_000;
 pub struct Job {
     design: Design,
     min_overlap: f64,
+    samples: Option<Samples>,
 }
 
 impl Job {
@@ -64,13 +67,34 @@ impl Job {
             design.params.validate()?;
             design.check_texture()?;
         }
+        // A printer is resolved here, once, not left to the sampling a
+        // kept surface may spare (docs/ARCHITECTURE.md, "Stages").
+        design.printer.resolve()?;
         if limits.must_fit {
             design.check_fit()?;
         }
         Ok(Job {
             design,
             min_overlap: limits.min_overlap,
+            samples: None,
         })
+    }
+
+    /// The job drawing its sampled surface from `store` (and keeping it
+    /// there): a job whose sampling inputs equal a kept one's is not
+    /// sampled again ([`crate::Stage::first_changed`]).
+    pub fn with_samples(mut self, store: &Samples) -> Job {
+        self.samples = Some(store.clone());
+        self
+    }
+
+    /// Stage 1's output for the job: from its store if it has one, else
+    /// sampled now.
+    pub fn sampled(&self) -> Result<Arc<Surface>> {
+        match &self.samples {
+            Some(store) => store.sampled(&self.design),
+            None => surface::sample_surface(&self.design).map(Arc::new),
+        }
     }
 
     /// The design as validated.

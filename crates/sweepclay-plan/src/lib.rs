@@ -12,8 +12,10 @@ pub mod cancel;
 pub mod check;
 pub mod job;
 pub mod plan;
+pub mod stage;
 
 pub use cancel::{Cancel, CancelReader, CancelWriter};
 pub use check::{check_config, locate, printer_check, verify, verify_into, verify_until, Verified};
 pub use job::{Job, Limits};
 pub use plan::{plan, slice_checked, unfit, Checked, Planned, Unchecked, Unfit, MAX_ROUNDS};
+pub use stage::{Samples, Stage};

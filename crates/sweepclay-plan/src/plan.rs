@@ -10,6 +10,7 @@ use crate::cancel::{Cancel, CancelWriter};
 use crate::check::verify_lines;
 use crate::job::{Job, Limits};
 use std::io::{self, Write};
+use std::sync::Arc;
 use sweepclay_check::{Finding, Report};
 use sweepclay_core::correct::{correct_with, Tightening};
 use sweepclay_core::{surface, Design, Sliced};
@@ -86,8 +87,9 @@ fn go_on(cancel: &Cancel) -> Result<(), Unchecked> {
 pub struct Planned<W> {
     /// The last round, printable if any round was.
     pub checked: Checked<W>,
-    /// The drawn surface of that round.
-    pub drawn: surface::Surface,
+    /// The drawn surface of that round (shared with the job's store of
+    /// sampled surfaces, if it has one).
+    pub drawn: Arc<surface::Surface>,
 }
 
 /// Plans a job: samples its design, corrects, plans the path and the
@@ -107,7 +109,7 @@ pub fn plan<W: Write>(
     cancel: &Cancel,
     out: impl FnMut() -> io::Result<W>,
 ) -> Result<Planned<W>, Unchecked> {
-    let (mut checked, drawn) = run(job.design(), job.min_overlap(), cancel, out)?;
+    let (mut checked, drawn) = run(job.sampled()?, job.design(), job.min_overlap(), cancel, out)?;
     let twist = job.design().twist_deg;
     if !checked.report.printable && twist != 0.0 {
         checked.most_twist = most_twist(job, cancel)?;
@@ -125,7 +127,14 @@ fn most_twist(job: &Job, cancel: &Cancel) -> Result<Option<f64>, Unchecked> {
     let prints = |deg: f64| -> Result<bool, Unchecked> {
         let mut t = d.clone();
         t.twist_deg = deg;
-        match run(&t, job.min_overlap(), cancel, || Ok(io::sink())) {
+        // Sampled apart from the job's store: the bisection's designs
+        // would push the potter's out of it.
+        let Ok(sampled) = surface::sample_surface(&t) else {
+            return Ok(false);
+        };
+        match run(Arc::new(sampled), &t, job.min_overlap(), cancel, || {
+            Ok(io::sink())
+        }) {
             Ok((c, _)) => Ok(c.report.printable),
             Err(Unchecked::Design(_)) => Ok(false),
             Err(e) => Err(e),
@@ -157,14 +166,14 @@ pub struct Unfit {
     /// The stages' output, unchecked.
     pub sliced: Sliced,
     /// The surface as sampled (before the corrections).
-    pub drawn: surface::Surface,
+    pub drawn: Arc<surface::Surface>,
     /// Why it cannot be printed.
     pub why: sweepclay_core::Error,
 }
 
 /// The stages of a job whose print does not fit (see [`Unfit`]).
 pub fn unfit(job: &Job, cancel: &Cancel) -> Result<Option<Unfit>, Unchecked> {
-    let Ok(drawn) = surface::sample_surface(job.design()) else {
+    let Ok(drawn) = job.sampled() else {
         return Ok(None);
     };
     go_on(cancel)?;
@@ -196,14 +205,14 @@ pub fn slice_checked<W: Write>(
     plan(&job, cancel, out).map(|p| p.checked)
 }
 
-/// The correction loop of [`plan()`].
+/// The correction loop of [`plan()`], from `design` sampled.
 fn run<W: Write>(
+    mut sampled: Arc<surface::Surface>,
     design: &Design,
     min_overlap: f64,
     cancel: &Cancel,
     mut out: impl FnMut() -> io::Result<W>,
-) -> Result<(Checked<W>, surface::Surface), Unchecked> {
-    let mut sampled = surface::sample_surface(design)?;
+) -> Result<(Checked<W>, Arc<surface::Surface>), Unchecked> {
     go_on(cancel)?;
     let w_max = sampled.params.width_max;
     // Compressing offsets cannot help a vessel whose rim's heights are
@@ -316,8 +325,9 @@ fn run<W: Write>(
                 |i, _| radius[i],
             );
             d.trajectory.points = Some(pts);
-            sampled = surface::sample_surface(&d)?;
-            sampled.corners.extend(fixes);
+            let mut s = surface::sample_surface(&d)?;
+            s.corners.extend(fixes);
+            sampled = Arc::new(s);
             // Columns are new: the tightening starts again from here.
             tight.support.clear();
             clears = None;

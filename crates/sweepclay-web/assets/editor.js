@@ -63,7 +63,10 @@ export class CurveEditor {
         this.remove(this.selected);
       }
     });
-    new ResizeObserver(() => this.resize()).observe(canvas);
+    // Sized in the next frame, not in the observer's own callback: a
+    // canvas resized there re-lays the page out within the observation,
+    // which Chromium reports as an error ("ResizeObserver loop").
+    new ResizeObserver(() => requestAnimationFrame(() => this.resize())).observe(canvas);
   }
 
   resize() {

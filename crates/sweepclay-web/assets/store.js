@@ -37,8 +37,6 @@ export const state = {
   // Each design sent to slice is numbered: an answer for an older one
   // never sets the verdict (docs/MODELER.md).
   seq: 0,
-  verifyTimer: 0,
-  verifySeq: 0,
   sliced: null,
   // The point the point bar shows (its editor is `activeEditor`).
   barPoint: -1,

@@ -117,7 +117,9 @@ export class View3D {
       this.dist *= Math.exp(e.deltaY * 0.0015);
       this.redraw();
     }, { passive: false });
-    new ResizeObserver(() => this.redraw()).observe(canvas);
+    // Drawn in the next frame (see editor.js: no resizing inside the
+    // observer's callback).
+    new ResizeObserver(() => requestAnimationFrame(() => this.redraw())).observe(canvas);
   }
 
   /** New slicing result; `params` gives the width range for colours. */

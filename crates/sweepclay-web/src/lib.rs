@@ -141,6 +141,26 @@ pub const ASSETS: &[(&str, &str, &str)] = &[
         include_str!("../assets/curves3d.js"),
     ),
     (
+        "shapes.js",
+        "text/javascript; charset=utf-8",
+        include_str!("../assets/shapes.js"),
+    ),
+    (
+        "editors-panel.js",
+        "text/javascript; charset=utf-8",
+        include_str!("../assets/editors-panel.js"),
+    ),
+    (
+        "pots-panel.js",
+        "text/javascript; charset=utf-8",
+        include_str!("../assets/pots-panel.js"),
+    ),
+    (
+        "files.js",
+        "text/javascript; charset=utf-8",
+        include_str!("../assets/files.js"),
+    ),
+    (
         "slice-worker.js",
         "text/javascript; charset=utf-8",
         include_str!("../assets/slice-worker.js"),
@@ -164,6 +184,9 @@ impl IntoResponse for ApiError {
 pub(crate) struct AppState {
     limits: Limits,
     pool: guard::Pool,
+    /// Stage 1's recent outputs: an edit that changes only the printer,
+    /// speeds or flow is not resampled (docs/ARCHITECTURE.md, "Stages").
+    samples: sweepclay_plan::Samples,
 }
 
 pub(crate) type Shared = Arc<AppState>;
@@ -200,6 +223,7 @@ pub fn router(limits: Limits) -> Router {
     let state = Arc::new(AppState {
         pool: guard::Pool::new(&limits),
         limits,
+        samples: sweepclay_plan::Samples::new(),
     });
     Router::new()
         .route("/", get(|| asset(Path("index.html".into()))))
@@ -276,7 +300,10 @@ pub(crate) async fn with_design<T: Send + 'static>(
     let state = limits.clone();
     state
         .pool
-        .run(move |cancel| f(api::parse_design(&text, &limits.limits)?, cancel))
+        .run(move |cancel| {
+            let job = api::parse_design(&text, &limits.limits)?.with_samples(&limits.samples);
+            f(job, cancel)
+        })
         .await
 }
 

@@ -1,0 +1,489 @@
+//! A vessel mesh back to an editable design (docs/MESHES.md): the mesh is
+//! cut into horizontal sections ([`crate::sections`]); the bottom
+//! section's wall is the trajectory Ψ; along rays from Ψ (radial from the
+//! centre, or along Ψ's normal) each section's wall lies at an offset
+//! D(k, j); and D is fitted by the design's own form — one profile, or two
+//! blended round the loop by an interpolation curve, D ≈ S(z) + λ(u)·(T(z)
+//! − S(z)) (the paper's §3 sweep, eq. 1–2). The fit's profiles and
+//! interpolation are B-splines made to pass through the fitted values,
+//! and the largest difference between the fitted design and the mesh's
+//! sections is measured and reported with where it lies. A section that
+//! splits (a handle, two bodies), a wall a ray meets twice, a mesh with a
+//! hole, or a fit beyond the tolerance is refused by name.
+//!
+//! A solid (one loop a section) is fitted at its outside; a shell (two
+//! nested loops: a wall with its thickness, as sweepclay's own STL export
+//! writes) at the middle of its wall. Cost: linear in the triangles
+//! (cutting) plus sections × rays × loop points (about 0.1 s for a pot).
+
+use crate::bspline::BSpline;
+use crate::design::{CurveSpec, Design, Offset, TrajectorySpec};
+use crate::error::{Error, Result};
+use crate::meshread::TriMesh;
+use crate::sections::{self, signed_area2};
+
+mod rays;
+mod through;
+mod uneven;
+
+use rays::*;
+use through::*;
+use uneven::*;
+
+/// How a mesh is fitted.
+#[derive(Clone, Debug, PartialEq)]
+pub struct FitOptions {
+    /// The largest difference the fitted design may have from the mesh
+    /// (mm).
+    pub tolerance_mm: f64,
+    /// The design's name.
+    pub name: String,
+}
+
+impl Default for FitOptions {
+    fn default() -> FitOptions {
+        FitOptions {
+            tolerance_mm: 0.3,
+            name: String::new(),
+        }
+    }
+}
+
+/// A fitted mesh.
+#[derive(Clone, Debug)]
+pub struct Fitted {
+    /// The editable design (printer and parameters left to the caller).
+    pub design: Design,
+    /// The largest difference from the mesh's sections (mm).
+    pub deviation_mm: f64,
+    /// Where it lies, in the design's frame (mm).
+    pub at: [f64; 3],
+    /// Solid (fitted at its outside) or shell (at its wall's middle).
+    pub kind: &'static str,
+    /// How many sections were compared.
+    pub sections: usize,
+    /// What the fit moved the mesh by to put its foot's centre at o and
+    /// its foot on the bed (mm).
+    pub moved: [f64; 3],
+}
+
+/// A mesh file read and fitted: what `slice pot.stl`, `import` and the
+/// modeler's "Open…" share.
+#[derive(Clone, Debug)]
+pub struct Imported {
+    /// The fit.
+    pub fitted: Fitted,
+    /// Triangles read (after the repairs).
+    pub triangles: usize,
+    /// What was assumed about the mesh's units, to be said.
+    pub units_note: Option<String>,
+}
+
+/// Reads a mesh file's bytes (`name` gives the format by its extension
+/// and the design's name by its stem), stands it on axis `up` (0 x, 1 y,
+/// 2 z), brings it to millimetres ([`units`]) and fits it with `opts`
+/// (its name replaced by the file's stem).
+pub fn import(
+    name: &str,
+    bytes: &[u8],
+    up: usize,
+    scale: Option<f64>,
+    opts: &FitOptions,
+) -> Result<Imported> {
+    let mut mesh = TriMesh::read(name, bytes)?;
+    mesh.stand_up(up);
+    let (k, units_note) = units(&mesh, scale)?;
+    mesh.scale(k);
+    let stem = std::path::Path::new(name)
+        .file_stem()
+        .map(|s| s.to_string_lossy().into_owned())
+        .unwrap_or_default();
+    let opts = FitOptions {
+        name: stem,
+        ..opts.clone()
+    };
+    Ok(Imported {
+        fitted: fit(&mesh, &opts)?,
+        triangles: mesh.triangles.len(),
+        units_note,
+    })
+}
+
+/// The factor that brings `mesh` to millimetres, and what to tell the
+/// user about it: `scale` if given; else 25.4 for a mesh 0.8 to 16 units
+/// tall (a pot drawn in inches: 20 to 400 mm), said so; else 1.
+pub fn units(mesh: &TriMesh, scale: Option<f64>) -> Result<(f64, Option<String>)> {
+    let (lo, hi) = mesh.bounds();
+    let h = hi[2] - lo[2];
+    match scale {
+        Some(k) if !(k.is_finite() && k > 0.0 && k <= 1e4) => Err(Error::invalid(
+            "scale",
+            format!("must be a factor above 0 and at most 10000 (got {k})"),
+        )),
+        Some(k) => Ok((k, None)),
+        None if (0.8..16.0).contains(&h) => Ok((
+            25.4,
+            Some(format!(
+                "the mesh is {h:.2} units tall: taken as inches and scaled by 25.4 to {:.1} mm (--scale 1 keeps millimetres)",
+                h * 25.4
+            )),
+        )),
+        None => Ok((1.0, None)),
+    }
+}
+
+/// The top of a wall not fitted: its lip (mm).
+const RIM_LIP_MM: f64 = 3.0;
+
+/// Sections compared at most: one every [`SECTION_MM`] up to this many.
+const MAX_SECTIONS: usize = 800;
+/// The distance between sections (mm): a rim's height is known to half
+/// of it.
+const SECTION_MM: f64 = 0.25;
+/// Rays round the loop.
+const RAYS: usize = 360;
+/// A profile or interpolation curve keeps at most this many control
+/// points (the rest of the detail is below the tolerance).
+const MAX_CURVE_POINTS: usize = 160;
+
+/// Fits `mesh` (millimetres, any position) by a design within
+/// `opts.tolerance_mm`.
+pub fn fit(mesh: &TriMesh, opts: &FitOptions) -> Result<Fitted> {
+    let (lo, hi) = mesh.bounds();
+    let height = hi[2] - lo[2];
+    if !(5.0..=2000.0).contains(&height) {
+        return Err(Error::invalid(
+            "mesh",
+            format!("is {height:.2} mm tall: a vessel is 5 to 2000 mm; give --scale (millimetres are assumed: --scale 1000 for metres, 10 for centimetres, 25.4 for inches)"),
+        ));
+    }
+    let n = ((height / SECTION_MM) as usize).clamp(20, MAX_SECTIONS);
+    let dz = height / n as f64;
+    let mut cut = sections::cut(mesh, lo[2] + 0.5 * dz, dz, n, lo[2])?;
+    // A rim that is not quite level (a helix's last turn, a rim's
+    // rounding) leaves sections near the top that do not go round: the
+    // rim is where the last whole section is, if that is within 3 mm of
+    // the top; else the rim is uneven, which a design's rim key shapes
+    // but the fit does not yet find.
+    let whole = cut
+        .iter()
+        .position(|s| {
+            !s.loops
+                .iter()
+                .any(|l| nested(&[centroid(l)], l) && around(l, &s.loops))
+        })
+        .unwrap_or(cut.len());
+    if whole == 0 {
+        return Err(Error::invalid(
+            "mesh",
+            "has no section that goes round its centre at its foot: not a vessel standing on its base (turn it so its opening is up)",
+        ));
+    }
+    if whole < cut.len() {
+        let z = cut[whole].z;
+        if height - z > RIM_LIP_MM && cut[whole - 1].loops.len() == 2 {
+            // A wall with its thickness whose rim rises round the loop.
+            return fit_uneven(&cut, whole, dz, opts, lo[2]);
+        }
+        if height - z > RIM_LIP_MM {
+            return Err(Error::invalid(
+                "mesh",
+                format!(
+                    "has an uneven rim: from z = {z:.1} mm up ({:.1} mm below its top) the wall does not go all the way round; a solid's slanted or raised rim is not fitted (a wall with its thickness is; or cut the mesh level there, or draw the rim with the design's `rim` key){}",
+                    height - z,
+                    if hi[0] - lo[0] > height || hi[1] - lo[1] > height {
+                        "; or it lies on its side: --up y (or x) stands it up"
+                    } else {
+                        ""
+                    }
+                ),
+            ));
+        }
+        cut.truncate(whole);
+    }
+    // Each section's wall: its one loop, or two nested (a shell).
+    let mut shell = false;
+    for s in &cut {
+        match s.loops.len() {
+            0 => {
+                return Err(Error::invalid(
+                    "mesh",
+                    format!("has nothing at z = {:.1} mm: a vessel's wall runs from its foot to its rim", s.z),
+                ))
+            }
+            1 => {}
+            2 if nested(&s.loops[0], &s.loops[1]) || nested(&s.loops[1], &s.loops[0]) => {
+                shell = true;
+            }
+            k => {
+                return Err(Error::invalid(
+                    "mesh",
+                    format!(
+                        "splits into {k} parts at z = {:.1} mm (a handle, a knob or two bodies): one loop a height makes a vessel, or two nested for a wall with its thickness",
+                        s.z
+                    ),
+                ))
+            }
+        }
+    }
+    let (c, psi) = foot_frame(&cut);
+    let loops: Vec<Vec<Vec<[f64; 2]>>> = cut.iter().map(|s| about(s, c)).collect();
+    let zs: Vec<f64> = cut.iter().map(|s| s.z).collect();
+    let mut best: Option<Candidate> = None;
+    let mut why = Vec::new();
+    for offset in [Offset::Radial, Offset::Normal] {
+        match offsets(&psi, &zs, &loops, offset, shell) {
+            Ok((mut d, dirs)) => {
+                // Only a profile's change from its foot counts (docs/
+                // FORMATS.md): Ψ is the wall at the lowest section (a
+                // shell's middle, not the foot's outside), and D is
+                // measured from it.
+                let base = d[0].clone();
+                let psi: Vec<[f64; 2]> = (0..psi.len())
+                    .map(|j| {
+                        [
+                            psi[j][0] + base[j] * dirs[j][0],
+                            psi[j][1] + base[j] * dirs[j][1],
+                        ]
+                    })
+                    .collect();
+                for row in &mut d {
+                    for (x, b) in row.iter_mut().zip(&base) {
+                        *x -= b;
+                    }
+                }
+                let cand = fit_offsets(&psi, &zs, &d, offset, height, opts.tolerance_mm);
+                if best.as_ref().is_none_or(|b| cand.deviation < b.deviation) {
+                    best = Some(cand);
+                }
+            }
+            Err(e) => why.push(e),
+        }
+    }
+    let Some(b) = best else {
+        // Neither frame finds one wall a ray: the radial reason says where.
+        return Err(Error::invalid(
+            "mesh",
+            format!("is not a sweep of its foot's loop: {}", why[0]),
+        ));
+    };
+    if b.deviation > opts.tolerance_mm {
+        return Err(Error::invalid(
+            "mesh",
+            format!(
+                "is not a sweep of one loop within {} mm: the closest design (a loop, {}, {} offsets) differs from it by {:.2} mm at ({:.1}, {:.1}, {:.1}) mm",
+                opts.tolerance_mm,
+                if b.two { "two profiles blended round it" } else { "one profile" },
+                if b.offset == Offset::Radial { "radial" } else { "normal" },
+                b.deviation,
+                b.at[0],
+                b.at[1],
+                b.at[2]
+            ),
+        ));
+    }
+    let mut design = Design::from_json(&b.json(&opts.name))?;
+    design.name = opts.name.clone();
+    Ok(Fitted {
+        design,
+        deviation_mm: b.deviation,
+        at: b.at,
+        kind: if shell { "shell" } else { "solid" },
+        sections: cut.len(),
+        moved: [-c[0], -c[1], -lo[2]],
+    })
+}
+
+/// A fitted form and its largest difference from the mesh.
+struct Candidate {
+    offset: Offset,
+    two: bool,
+    psi: Vec<[f64; 2]>,
+    start: Vec<[f64; 2]>,
+    end: Vec<[f64; 2]>,
+    interp: Vec<[f64; 2]>,
+    deviation: f64,
+    at: [f64; 3],
+}
+
+impl Candidate {
+    fn json(&self, name: &str) -> String {
+        let traj = TrajectorySpec {
+            control_points: None,
+            points: Some(self.psi.clone()),
+            closed: true,
+            offset: self.offset,
+        };
+        let mut v = serde_json::json!({
+            "sweepclay": 1,
+            "name": name,
+            "profile_start": CurveSpec { control_points: self.start.clone(), points: None },
+            "trajectory": traj,
+        });
+        if self.two {
+            v["profile_end"] = serde_json::json!(CurveSpec {
+                control_points: self.end.clone(),
+                points: None,
+            });
+            v["interpolation"] = serde_json::json!(CurveSpec {
+                control_points: self.interp.clone(),
+                points: None,
+            });
+        }
+        v.to_string()
+    }
+}
+
+/// Fits D by one profile, and by two blended round the loop where one
+/// does not reach the tolerance of a few hundredths; the better of both.
+fn fit_offsets(
+    psi: &[[f64; 2]],
+    zs: &[f64],
+    d: &[Vec<f64>],
+    offset: Offset,
+    height: f64,
+    tol: f64,
+) -> Candidate {
+    let (kk, jj) = (d.len(), psi.len());
+    let mean: Vec<f64> = d
+        .iter()
+        .map(|r| r.iter().sum::<f64>() / jj as f64)
+        .collect();
+    // The first singular pair of D less its row means: D ≈ m + a bᵀ.
+    let mut b = vec![0.0; jj];
+    for (j, v) in b.iter_mut().enumerate() {
+        *v = (std::f64::consts::TAU * j as f64 / jj as f64).cos();
+    }
+    let mut a = vec![0.0; kk];
+    for _ in 0..60 {
+        for k in 0..kk {
+            a[k] = (0..jj).map(|j| (d[k][j] - mean[k]) * b[j]).sum::<f64>();
+        }
+        let na = a.iter().map(|x| x * x).sum::<f64>().sqrt().max(1e-300);
+        a.iter_mut().for_each(|x| *x /= na);
+        for j in 0..jj {
+            b[j] = (0..kk).map(|k| (d[k][j] - mean[k]) * a[k]).sum::<f64>();
+        }
+    }
+    let (bmin, bmax) = b
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(lo, hi), &x| {
+            (lo.min(x), hi.max(x))
+        });
+    // Ψ starts where λ is 0 (a loop's interpolation starts and ends at 0).
+    let j0 = b
+        .iter()
+        .enumerate()
+        .min_by(|x, y| x.1.total_cmp(y.1))
+        .map_or(0, |(j, _)| j);
+    let spread = (bmax - bmin).max(1e-12);
+    let lambda: Vec<f64> = (0..jj)
+        .map(|j| (b[(j0 + j) % jj] - bmin) / spread)
+        .collect();
+    let psi: Vec<[f64; 2]> = (0..jj).map(|j| psi[(j0 + j) % jj]).collect();
+    let d: Vec<Vec<f64>> = d
+        .iter()
+        .map(|r| (0..jj).map(|j| r[(j0 + j) % jj]).collect())
+        .collect();
+    let s: Vec<f64> = (0..kk).map(|k| mean[k] + a[k] * bmin).collect();
+    let t: Vec<f64> = (0..kk).map(|k| s[k] + a[k] * spread).collect();
+    // One profile is the simpler design to edit: kept when it is within
+    // the tolerance.
+    let g = Frame {
+        psi: &psi,
+        zs,
+        offset,
+        height,
+        tol,
+    };
+    let one = candidate(&g, &d, &mean, None);
+    if one.deviation <= tol {
+        return one;
+    }
+    let two = candidate(&g, &d, &s, Some((&t, &lambda)));
+    if two.deviation < one.deviation {
+        two
+    } else {
+        one
+    }
+}
+
+/// What every candidate of one fit shares: Ψ, the sections' heights,
+/// the frame of the offsets, the height and the tolerance.
+#[derive(Clone, Copy)]
+struct Frame<'a> {
+    psi: &'a [[f64; 2]],
+    zs: &'a [f64],
+    offset: Offset,
+    height: f64,
+    tol: f64,
+}
+
+/// The design of profile values `s` (and `t` blended by `lambda`) at the
+/// sections' heights, as B-splines through them, and its largest
+/// difference from `d`.
+fn candidate(g: &Frame, d: &[Vec<f64>], s: &[f64], two: Option<(&[f64], &[f64])>) -> Candidate {
+    let Frame {
+        psi,
+        zs,
+        offset,
+        height,
+        tol,
+    } = *g;
+    let profile = |v: &[f64]| -> Vec<[f64; 2]> {
+        // From the bed to the rim: the lowest and highest sections'
+        // values held to z 0 and the top.
+        let mut pts: Vec<[f64; 2]> = vec![[v[0], 0.0]];
+        pts.extend(v.iter().zip(zs).map(|(&x, &z)| [x, z]));
+        pts.push([v[v.len() - 1], height]);
+        profile_through(&pts, tol)
+    };
+    let start = profile(s);
+    let (end, interp) = match two {
+        Some((t, lambda)) => (profile(t), interpolation_through(lambda)),
+        None => (Vec::new(), Vec::new()),
+    };
+    // The fitted offsets, as the design will sample them.
+    let sp = dense(&start);
+    let ep = if two.is_some() {
+        dense(&end)
+    } else {
+        Vec::new()
+    };
+    let lam: Vec<f64> = if two.is_some() {
+        let c = BSpline::clamped(interp.clone())
+            .expect("points")
+            .flatten(16);
+        (0..psi.len())
+            .map(|j| at_x(&c, j as f64 / psi.len() as f64))
+            .collect()
+    } else {
+        vec![0.0; psi.len()]
+    };
+    let mut worst = (0.0f64, [0.0; 3]);
+    for (k, &z) in zs.iter().enumerate() {
+        let (a, b) = (at_z(&sp, z), if ep.is_empty() { 0.0 } else { at_z(&ep, z) });
+        for (j, &l) in lam.iter().enumerate() {
+            let fitted = if ep.is_empty() {
+                a
+            } else {
+                (1.0 - l) * a + l * b
+            };
+            let e = (fitted - d[k][j]).abs();
+            if e > worst.0 {
+                let p = psi[j];
+                worst = (e, [p[0], p[1], z]);
+            }
+        }
+    }
+    Candidate {
+        offset,
+        two: two.is_some(),
+        psi: psi.to_vec(),
+        start,
+        end,
+        interp,
+        deviation: worst.0,
+        at: worst.1,
+    }
+}

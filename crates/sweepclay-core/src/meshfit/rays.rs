@@ -1,0 +1,246 @@
+//! The mesh's sections read along rays (docs/MESHES.md, "Fitting"): the
+//! foot's wall as Ψ and its centre, the loops of a section about it, and
+//! where each ray from Ψ meets a section's wall, D(k, j).
+
+use super::*;
+/// The foot's wall (the lowest section's) as Ψ: its area centroid, o,
+/// and [`RAYS`] points evenly along it, about o.
+pub(super) fn foot_frame(cut: &[sections::Section]) -> ([f64; 2], Vec<[f64; 2]>) {
+    let foot = wall_loop(&cut[0].loops);
+    let c = centroid(foot);
+    let psi = resample(foot, RAYS)
+        .into_iter()
+        .map(|p| [p[0] - c[0], p[1] - c[1]])
+        .collect();
+    (c, psi)
+}
+
+/// A section's loops about the centre `c`, resampled a point every
+/// 0.4 mm (16 to 4,000 a loop): the rays' cost does not grow with the
+/// mesh's triangles.
+pub(super) fn about(sec: &sections::Section, c: [f64; 2]) -> Vec<Vec<[f64; 2]>> {
+    sec.loops
+        .iter()
+        .map(|l| {
+            let k = (perimeter(l) / 0.4).ceil().clamp(16.0, 4000.0) as usize;
+            resample(l, k)
+                .into_iter()
+                .map(|p| [p[0] - c[0], p[1] - c[1]])
+                .collect()
+        })
+        .collect()
+}
+
+/// Whether loop `a` lies inside loop `b` (its first point does).
+pub(super) fn nested(a: &[[f64; 2]], b: &[[f64; 2]]) -> bool {
+    let p = a[0];
+    let mut inside = false;
+    for i in 0..b.len() {
+        let (q, r) = (b[i], b[(i + 1) % b.len()]);
+        if (q[1] > p[1]) != (r[1] > p[1])
+            && p[0] < q[0] + (p[1] - q[1]) / (r[1] - q[1]) * (r[0] - q[0])
+        {
+            inside = !inside;
+        }
+    }
+    inside
+}
+
+/// Whether loop `l` is a wall round the section's middle: no other loop
+/// of the section holds it (a shell's inner loop is inside the outer).
+pub(super) fn around(l: &[[f64; 2]], all: &[Vec<[f64; 2]>]) -> bool {
+    all.iter()
+        .all(|o| std::ptr::eq(o.as_slice(), l) || !nested(l, o))
+}
+
+/// The loop that stands for a section's wall in plan: the outer of two.
+pub(super) fn wall_loop(loops: &[Vec<[f64; 2]>]) -> &[[f64; 2]] {
+    loops
+        .iter()
+        .max_by(|a, b| signed_area2(a).abs().total_cmp(&signed_area2(b).abs()))
+        .expect("a section has a loop")
+}
+
+/// The area centroid of a loop.
+pub(super) fn centroid(l: &[[f64; 2]]) -> [f64; 2] {
+    let (mut a, mut cx, mut cy) = (0.0, 0.0, 0.0);
+    for i in 0..l.len() {
+        let (p, q) = (l[i], l[(i + 1) % l.len()]);
+        let w = p[0] * q[1] - q[0] * p[1];
+        a += w;
+        cx += (p[0] + q[0]) * w;
+        cy += (p[1] + q[1]) * w;
+    }
+    [cx / (3.0 * a), cy / (3.0 * a)]
+}
+
+pub(super) fn perimeter(l: &[[f64; 2]]) -> f64 {
+    (0..l.len())
+        .map(|i| {
+            let (p, q) = (l[i], l[(i + 1) % l.len()]);
+            (q[0] - p[0]).hypot(q[1] - p[1])
+        })
+        .sum()
+}
+
+/// `k` points evenly spaced along a closed loop, counter-clockwise.
+pub(super) fn resample(l: &[[f64; 2]], k: usize) -> Vec<[f64; 2]> {
+    let mut l = l.to_vec();
+    if signed_area2(&l) < 0.0 {
+        l.reverse();
+    }
+    let total = perimeter(&l);
+    let mut out = Vec::with_capacity(k);
+    let (mut i, mut walked) = (0usize, 0.0);
+    for m in 0..k {
+        let want = total * m as f64 / k as f64;
+        loop {
+            let (p, q) = (l[i % l.len()], l[(i + 1) % l.len()]);
+            let seg = (q[0] - p[0]).hypot(q[1] - p[1]);
+            if walked + seg >= want || i >= 2 * l.len() {
+                let t = if seg > 0.0 {
+                    (want - walked) / seg
+                } else {
+                    0.0
+                };
+                out.push([p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])]);
+                break;
+            }
+            walked += seg;
+            i += 1;
+        }
+    }
+    out
+}
+
+/// Where the ray `o + t·d` crosses the loop: every t.
+pub(super) fn hits(l: &[[f64; 2]], o: [f64; 2], d: [f64; 2]) -> Vec<f64> {
+    let mut ts = Vec::new();
+    for i in 0..l.len() {
+        let (p, q) = (l[i], l[(i + 1) % l.len()]);
+        let e = [q[0] - p[0], q[1] - p[1]];
+        let den = d[0] * e[1] - d[1] * e[0];
+        if den.abs() < 1e-12 {
+            continue;
+        }
+        let w = [p[0] - o[0], p[1] - o[1]];
+        let t = (w[0] * e[1] - w[1] * e[0]) / den;
+        let s = (w[0] * d[1] - w[1] * d[0]) / den;
+        if (-1e-9..1.0 + 1e-9).contains(&s) {
+            ts.push(t);
+        }
+    }
+    // A ray through a vertex crosses both its edges at one place.
+    ts.sort_by(f64::total_cmp);
+    ts.dedup_by(|a, b| (*a - *b).abs() < 1e-6);
+    ts
+}
+
+/// D(k, j) by section and ray, and each ray's direction.
+type Offsets = (Vec<Vec<f64>>, Vec<[f64; 2]>);
+
+/// D(k, j): for each section k and each point j of Ψ, the offset of the
+/// section's wall along the ray of the frame (`offset`), and each ray's
+/// direction. A ray that meets
+/// a solid's loop more than once from its start (radial) is refused: the
+/// wall there folds back across the ray.
+pub(super) fn offsets(
+    psi: &[[f64; 2]],
+    zs: &[f64],
+    loops: &[Vec<Vec<[f64; 2]>>],
+    offset: Offset,
+    shell: bool,
+) -> std::result::Result<Offsets, String> {
+    let n = psi.len();
+    let rays: Vec<([f64; 2], [f64; 2], f64)> = (0..n)
+        .map(|j| {
+            let p = psi[j];
+            match offset {
+                Offset::Radial => {
+                    let r = p[0].hypot(p[1]).max(1e-9);
+                    ([0.0, 0.0], [p[0] / r, p[1] / r], r)
+                }
+                Offset::Normal => {
+                    let (a, b) = (psi[(j + n - 1) % n], psi[(j + 1) % n]);
+                    let t = [b[0] - a[0], b[1] - a[1]];
+                    let l = t[0].hypot(t[1]).max(1e-12);
+                    // Outward, as a loop's normal offsets move (right
+                    // of travel on this counter-clockwise Ψ).
+                    (p, [t[1] / l, -t[0] / l], 0.0)
+                }
+            }
+        })
+        .collect();
+    let mut d = Vec::with_capacity(loops.len());
+    // Half the wall's thickness along each ray, where a shell's section
+    // has both its loops.
+    let mut half: Vec<Option<Vec<f64>>> = Vec::with_capacity(loops.len());
+    for (k, sec) in loops.iter().enumerate() {
+        let mut row = Vec::with_capacity(n);
+        let mut halves = Vec::with_capacity(n);
+        for &(o, dir, base) in &rays {
+            let mut wall = Vec::with_capacity(2);
+            for l in sec {
+                let ts = hits(l, o, dir);
+                let t = match offset {
+                    Offset::Radial => {
+                        let ahead: Vec<f64> = ts.into_iter().filter(|&t| t > 0.0).collect();
+                        if ahead.len() != 1 {
+                            return Err(format!(
+                                "its wall at z = {:.1} mm does not go once round its foot's centre (a ray from the centre meets it {} times, near ({:.1}, {:.1}) mm)",
+                                zs[k],
+                                ahead.len(),
+                                dir[0] * base,
+                                dir[1] * base
+                            ));
+                        }
+                        ahead[0]
+                    }
+                    Offset::Normal => match ts
+                        .into_iter()
+                        .min_by(|a, b| a.abs().total_cmp(&b.abs()))
+                    {
+                        Some(t) => t,
+                        None => {
+                            return Err(format!(
+                                "its wall at z = {:.1} mm is not across the foot's wall near ({:.1}, {:.1}) mm (it leans out beyond where the foot reaches)",
+                                zs[k], o[0], o[1]
+                            ))
+                        }
+                    },
+                };
+                wall.push(t);
+            }
+            let t = if shell && wall.len() == 2 {
+                halves.push(0.5 * (wall[0] - wall[1]).abs());
+                0.5 * (wall[0] + wall[1])
+            } else {
+                wall[0]
+            };
+            row.push(t - base);
+        }
+        d.push(row);
+        half.push((halves.len() == n).then_some(halves));
+    }
+    if shell {
+        // A shell's floor slab is cut as one loop, its outside: its wall's
+        // middle lies half the thickness of the nearest whole section in
+        // (toward Ψ's side the inner loop lay on).
+        let whole: Vec<usize> = (0..d.len()).filter(|&k| half[k].is_some()).collect();
+        for k in 0..d.len() {
+            if half[k].is_some() {
+                continue;
+            }
+            let near = whole.iter().min_by_key(|&&w| w.abs_diff(k)).copied();
+            if let Some(w) = near {
+                let h = half[w].clone().expect("whole");
+                for j in 0..n {
+                    // Both frames point out: the middle is half the
+                    // thickness in from the outside.
+                    d[k][j] -= h[j];
+                }
+            }
+        }
+    }
+    Ok((d, rays.iter().map(|r| r.1).collect()))
+}

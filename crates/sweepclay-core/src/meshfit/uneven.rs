@@ -1,0 +1,234 @@
+//! Uneven rims (docs/MESHES.md, "Uneven rims"): a wall with its
+//! thickness whose rim rises round the loop, fitted along radial rays by
+//! two profiles of different heights blended by the rim's own height.
+
+use super::*;
+/// A shell whose rim rises round the loop (docs/MESHES.md, "Uneven
+/// rims"): sections up to `whole` go round, those above are the wall's
+/// higher parts. Along each radial ray the wall's middle is found in
+/// every section it reaches and the ray's rim height H_j where it stops;
+/// the design's two profiles of heights Z_s = min H and Z_t = max H are
+/// blended by λ_j = (H_j − Z_s) / (Z_t − Z_s), at the same fraction of
+/// each column's height (as the design's surface is: its offsets blend
+/// at t = z / h_i), so the profiles are the regression of each height
+/// fraction's offsets on λ.
+pub(super) fn fit_uneven(
+    cut: &[sections::Section],
+    whole: usize,
+    dz: f64,
+    opts: &FitOptions,
+    bed: f64,
+) -> Result<Fitted> {
+    let tol = opts.tolerance_mm;
+    let (c, psi0) = foot_frame(cut);
+    let jj = psi0.len();
+    let zs: Vec<f64> = cut.iter().map(|s| s.z).collect();
+    // The wall's middle along each ray in each section it reaches.
+    let mut d: Vec<Vec<Option<f64>>> = Vec::with_capacity(cut.len());
+    let mut half = vec![None::<f64>; jj];
+    for (k, sec) in cut.iter().enumerate() {
+        let loops = about(sec, c);
+        let mut row = Vec::with_capacity(jj);
+        for (j, p) in psi0.iter().enumerate() {
+            let r = p[0].hypot(p[1]).max(1e-9);
+            let dir = [p[0] / r, p[1] / r];
+            let mut ts: Vec<f64> = loops
+                .iter()
+                .flat_map(|l| hits(l, [0.0, 0.0], dir))
+                .filter(|&t| t > 0.0)
+                .collect();
+            ts.sort_by(f64::total_cmp);
+            row.push(match ts.len() {
+                2 => {
+                    if k < whole {
+                        half[j] = Some(0.5 * (ts[1] - ts[0]));
+                    }
+                    Some(0.5 * (ts[0] + ts[1]) - r)
+                }
+                // A shell's floor slab: its outside only.
+                1 if k < whole => Some(ts[0] - r),
+                0 if k >= whole => None,
+                n if k < whole => {
+                    return Err(Error::invalid(
+                        "mesh",
+                        format!("is not a sweep of its foot's loop: its wall at z = {:.1} mm does not go once round its foot's centre (a ray from the centre meets it {n} times)", zs[k]),
+                    ))
+                }
+                // A ray grazing the end of a higher part of the wall.
+                _ => None,
+            });
+        }
+        d.push(row);
+    }
+    // The slab's middle: half the wall's thickness in from its outside.
+    for (k, row) in d.iter_mut().enumerate().take(whole) {
+        if cut[k].loops.len() == 1 {
+            for (v, h) in row.iter_mut().zip(&half) {
+                if let (Some(v), Some(h)) = (v.as_mut(), h) {
+                    *v -= h;
+                }
+            }
+        }
+    }
+    // Ψ is the wall's middle at the lowest section; D is from it.
+    let base: Vec<f64> = d[0].iter().map(|v| v.unwrap_or(0.0)).collect();
+    let psi: Vec<[f64; 2]> = (0..jj)
+        .map(|j| {
+            let p = psi0[j];
+            let r = p[0].hypot(p[1]).max(1e-9);
+            [p[0] * (1.0 + base[j] / r), p[1] * (1.0 + base[j] / r)]
+        })
+        .collect();
+    for row in &mut d {
+        for (v, b) in row.iter_mut().zip(&base) {
+            if let Some(v) = v.as_mut() {
+                *v -= b;
+            }
+        }
+    }
+    // Each ray's rim: the top of the highest section it reaches, with no
+    // gap below it.
+    let mut rim = vec![0.0; jj];
+    for j in 0..jj {
+        let top = (0..d.len())
+            .take_while(|&k| d[k][j].is_some())
+            .last()
+            .unwrap_or(0);
+        if let Some(k) = (top + 1..d.len()).find(|&k| d[k][j].is_some()) {
+            let p = psi[j];
+            return Err(Error::invalid(
+                "mesh",
+                format!(
+                    "has a gap in its wall near ({:.1}, {:.1}) mm between z = {:.1} and {:.1} mm (a window or a cut-out): one wall from the foot to the rim is a vessel",
+                    p[0], p[1], zs[top], zs[k]
+                ),
+            ));
+        }
+        rim[j] = zs[top] + 0.5 * dz;
+        // The top 3 mm under the rim are its lip: a rim's rounding, the
+        // end caps where a rim rises (a ray there can cross a cap, not
+        // the wall), a printed wall's last bead standing above its
+        // design. Not measured, as a level rim's top 3 mm are not.
+        for (k, row) in d.iter_mut().enumerate().skip(1) {
+            if zs[k] > rim[j] - RIM_LIP_MM {
+                row[j] = None;
+            }
+        }
+    }
+    let (zs_lo, zt_hi) = rim
+        .iter()
+        .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &h| {
+            (a.min(h), b.max(h))
+        });
+    // Ψ starts at the lowest rim: λ = 0 there.
+    let j0 = (0..jj)
+        .min_by(|&a, &b| rim[a].total_cmp(&rim[b]))
+        .unwrap_or(0);
+    let turn = |v: &[f64]| -> Vec<f64> { (0..jj).map(|j| v[(j0 + j) % jj]).collect() };
+    let rim = turn(&rim);
+    let psi: Vec<[f64; 2]> = (0..jj).map(|j| psi[(j0 + j) % jj]).collect();
+    let d: Vec<Vec<Option<f64>>> = d
+        .iter()
+        .map(|row| (0..jj).map(|j| row[(j0 + j) % jj]).collect())
+        .collect();
+    let lambda: Vec<f64> = rim.iter().map(|h| (h - zs_lo) / (zt_hi - zs_lo)).collect();
+    // The offsets at each fraction t of each column's height.
+    let m = ((zt_hi / 0.5) as usize).clamp(20, MAX_SECTIONS);
+    let column_at = |j: usize, z: f64| -> f64 {
+        let ks: Vec<usize> = (0..d.len()).filter(|&k| d[k][j].is_some()).collect();
+        let v = |k: usize| d[k][j].expect("some");
+        let first = ks[0];
+        let last = *ks.last().expect("a section");
+        if z <= zs[first] {
+            return v(first);
+        }
+        if z >= zs[last] {
+            // The lip (not measured) goes on as the wall below it leans.
+            let prev = ks[ks.len().saturating_sub(9)];
+            if prev == last {
+                return v(last);
+            }
+            let slope = (v(last) - v(prev)) / (zs[last] - zs[prev]);
+            return v(last) + slope * (z - zs[last]);
+        }
+        let i = ks.partition_point(|&k| zs[k] <= z);
+        let (a, b) = (ks[i - 1], ks[i]);
+        let f = (z - zs[a]) / (zs[b] - zs[a]);
+        v(a) + f * (v(b) - v(a))
+    };
+    let mean_l = lambda.iter().sum::<f64>() / jj as f64;
+    let var_l = lambda
+        .iter()
+        .map(|l| (l - mean_l).powi(2))
+        .sum::<f64>()
+        .max(1e-12);
+    let (mut sv, mut tv) = (Vec::with_capacity(m), Vec::with_capacity(m));
+    for i in 0..m {
+        let t = i as f64 / (m - 1) as f64;
+        let y: Vec<f64> = (0..jj).map(|j| column_at(j, t * rim[j])).collect();
+        let mean_y = y.iter().sum::<f64>() / jj as f64;
+        let slope = (0..jj)
+            .map(|j| (lambda[j] - mean_l) * (y[j] - mean_y))
+            .sum::<f64>()
+            / var_l;
+        let a = mean_y - slope * mean_l;
+        sv.push([a, t * zs_lo]);
+        tv.push([a + slope, t * zt_hi]);
+    }
+    let start = profile_through(&sv, tol);
+    let end = profile_through(&tv, tol);
+    let interp = interpolation_through(&lambda);
+    // The design as it will be sampled, against every offset found.
+    let (sp, ep) = (dense(&start), dense(&end));
+    let lc = BSpline::clamped(interp.clone())
+        .expect("points")
+        .flatten(16);
+    let mut worst = (0.0f64, [0.0; 3]);
+    for j in 0..jj {
+        let l = at_x(&lc, j as f64 / jj as f64);
+        let h = (1.0 - l) * zs_lo + l * zt_hi;
+        // The rim's height is known to half a section.
+        let high = ((h - rim[j]).abs() - 0.5 * dz).max(0.0);
+        if high > worst.0 {
+            worst = (high, [psi[j][0], psi[j][1], rim[j]]);
+        }
+        for (k, v) in d.iter().enumerate() {
+            let Some(v) = v[j] else { continue };
+            let t = (zs[k] / h).min(1.0);
+            let fitted = (1.0 - l) * at_z(&sp, t * zs_lo) + l * at_z(&ep, t * zt_hi);
+            let e = (fitted - v).abs();
+            if e > worst.0 {
+                worst = (e, [psi[j][0], psi[j][1], zs[k]]);
+            }
+        }
+    }
+    let cand = Candidate {
+        offset: Offset::Radial,
+        two: true,
+        psi,
+        start,
+        end,
+        interp,
+        deviation: worst.0,
+        at: worst.1,
+    };
+    if cand.deviation > tol {
+        return Err(Error::invalid(
+            "mesh",
+            format!(
+                "is not a sweep of one loop within {tol} mm: the closest design (a loop, two profiles of {:.1} and {:.1} mm blended round it for its uneven rim, radial offsets) differs from it by {:.2} mm at ({:.1}, {:.1}, {:.1}) mm",
+                zs_lo, zt_hi, cand.deviation, cand.at[0], cand.at[1], cand.at[2]
+            ),
+        ));
+    }
+    let mut design = Design::from_json(&cand.json(&opts.name))?;
+    design.name = opts.name.clone();
+    Ok(Fitted {
+        design,
+        deviation_mm: cand.deviation,
+        at: cand.at,
+        kind: "shell",
+        sections: cut.len(),
+        moved: [-c[0], -c[1], -bed],
+    })
+}
