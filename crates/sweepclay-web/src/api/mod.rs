@@ -567,7 +567,7 @@ mod tests {
         // "New pot" on the cerambot-plus, its base typed 150 mm wide under
         // rows 60 mm wide.
         let d =
-            Design::from_json(include_str!("../../sweepclay-plan/tests/foot-pot.json")).unwrap();
+            Design::from_json(include_str!("../../../sweepclay-plan/tests/foot-pot.json")).unwrap();
         let v = slice_view(&job(d.clone()), &Cancel::new()).unwrap();
         let verdict = v.verdict.as_ref().expect("a verdict");
         assert!(verdict.printable, "{:?}", verdict.failures);
