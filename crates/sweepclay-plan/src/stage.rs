@@ -178,8 +178,10 @@ mod tests {
         Design::from_json(examples::example(name).unwrap()).unwrap()
     }
 
-    /// Each edit, and the stage it must first recompute.
-    fn edits() -> Vec<(&'static str, Stage, fn(&mut Design))> {
+    /// An edit's name, the stage it must first recompute, the edit.
+    type Edit = (&'static str, Stage, fn(&mut Design));
+
+    fn edits() -> Vec<Edit> {
         vec![
             ("name", Stage::Emit, |d| d.name = "renamed".into()),
             ("feedrate", Stage::Emit, |d| d.params.feedrate *= 1.5),
