@@ -40,6 +40,25 @@ export const state = {
   sliced: null,
   // The point the point bar shows (its editor is `activeEditor`).
   barPoint: -1,
+  activeEditor: null,
+  // The curve editors (editors-panel.js) and the 3D view (app.js).
+  editors: [],
+  view: null,
+  // Frame timing (frame.js), for the speed budget's tests.
+  frames: null,
+  // When the last edit was made (ms), and its verdict's times after it.
+  lastEditAt: null,
+  // The parameter typed last: an error about it is shown beside it.
+  lastParam: null,
+  // The design was restored from the browser, not opened or asked for.
+  restored: false,
+  // The printer the dialog started from (printer-dialog.js).
+  printerBase: null,
+  // What the pots table and the statistics last drew (none redrawn alike).
+  potLook: null,
+  statsHtml: null,
+  // The 3D view was framed on a design once.
+  fittedOnce: false,
 };
 
 const listeners = [];

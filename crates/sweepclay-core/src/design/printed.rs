@@ -1,0 +1,155 @@
+//! The design as printed (docs/FORMATS.md, "shrinkage" and "texture"):
+//! enlarged for the kiln, its sampling refined for its textures, its
+//! textures and its size checked against the printer.
+
+use super::*;
+
+impl Design {
+    /// The piece as printed: the geometry enlarged by 1 / (1 − s) across
+    /// (profiles' offsets, Ψ) and in height (profiles' z) for the firing
+    /// shrinkages `params.shrinkage_xy` and `shrinkage_z`, so that it has
+    /// the designed size after the kiln (docs/ALGORITHMS.md §6). Layer
+    /// heights, bead widths and the printer are not scaled: they are the
+    /// process, not the piece. Without shrinkage, the design itself.
+    pub fn printed(&self) -> Design {
+        let mut d = self.scaled_for_firing();
+        d.params = d.texture_params();
+        d
+    }
+
+    /// The sampling the textures ask for: the spacing and the thickest
+    /// layer that give each texture 8 samples a period (never under the
+    /// thinnest layer [`Params::validate`] allows; [`Design::check_texture`]
+    /// refuses a texture that would need less).
+    pub(crate) fn texture_params(&self) -> Params {
+        let mut p = self.params.clone();
+        if self.texture.is_empty() {
+            return p;
+        }
+        let length = crate::trajectory_length(self);
+        let [along, up] = crate::texture::needs(&self.texture, length, self.trajectory.closed);
+        if let Some((s, _)) = along.filter(|(s, _)| s.is_finite() && *s > 0.0) {
+            p.spacing = p.spacing.min(s.max(MIN_SPACING));
+        }
+        if let Some((z, _)) = up.filter(|(z, _)| z.is_finite()) {
+            p.max_layer_height = p.max_layer_height.min(z.max(MIN_LAYER));
+            // Room below it, so a column's height splits into whole layers.
+            p.layer_height = p
+                .layer_height
+                .min((0.6 * p.max_layer_height).max(MIN_LAYER))
+                .min(p.max_layer_height);
+        }
+        p
+    }
+
+    /// Checks the textures and the twist, and refuses a texture whose
+    /// period is too short to sample (it would need layers thinner than
+    /// [`MIN_LAYER`] or a spacing under [`MIN_SPACING`]), naming it.
+    pub fn check_texture(&self) -> Result<()> {
+        crate::texture::validate(&self.texture, self.twist_deg, self.trajectory.closed)?;
+        if self.texture.is_empty() {
+            return Ok(());
+        }
+        let d = self.scaled_for_firing();
+        let length = crate::trajectory_length(&d);
+        let [along, up] = crate::texture::needs(&d.texture, length, d.trajectory.closed);
+        if let Some((z, k)) = up.filter(|(z, _)| *z < MIN_LAYER) {
+            return Err(Error::invalid(
+                format!("texture[{k}]"),
+                format!(
+                    "needs layers of {z:.2} mm to show ({} samples a period in height), thinner than the thinnest layer ({MIN_LAYER} mm); make its period (or pitch) at least {} mm",
+                    crate::texture::SAMPLES_PER_PERIOD,
+                    MIN_LAYER * crate::texture::SAMPLES_PER_PERIOD
+                ),
+            ));
+        }
+        if let Some((s, k)) = along.filter(|(s, _)| *s < MIN_SPACING) {
+            return Err(Error::invalid(
+                format!("texture[{k}]"),
+                format!(
+                    "needs samples {s:.3} mm apart along the trajectory to show, closer than {MIN_SPACING} mm; use fewer ribs"
+                ),
+            ));
+        }
+        Ok(())
+    }
+
+    /// The design enlarged for the firing shrinkage, textures included.
+    pub(super) fn scaled_for_firing(&self) -> Design {
+        let mut d = self.clone();
+        let [kxy, kz] = self.params.print_scale();
+        if kxy == 1.0 && kz == 1.0 {
+            return d;
+        }
+        for c in std::iter::once(&mut d.profile_start).chain(d.profile_end.as_mut()) {
+            // A scaled curve passes through its scaled rows (affine
+            // invariance).
+            for p in c
+                .control_points
+                .iter_mut()
+                .chain(c.points.iter_mut().flatten())
+            {
+                *p = [p[0] * kxy, p[1] * kz];
+            }
+        }
+        d.texture = self.texture.iter().map(|t| t.scaled(kxy, kz)).collect();
+        if let Some(r) = d.rim.as_mut() {
+            r.rise *= kz;
+        }
+        let t = &mut d.trajectory;
+        for pts in [t.control_points.as_mut(), t.points.as_mut()]
+            .into_iter()
+            .flatten()
+        {
+            for p in pts.iter_mut() {
+                *p = [p[0] * kxy, p[1] * kxy];
+            }
+        }
+        d
+    }
+
+    /// Refuses, before anything is sampled, a design that cannot fit its
+    /// printer: the surface starts and ends at Ψ's first and last points
+    /// on the bed and is as tall there as the profiles, so if those leave
+    /// the build volume the whole does ([`Error::DoesNotFit`], as slicing
+    /// would say). A closed B-spline Ψ does not pass through its control
+    /// points, so for a closed Ψ only the height is checked here (slicing
+    /// checks the rest). [`crate::check_size`] adds the cap on work.
+    pub fn check_fit(&self) -> crate::Result<()> {
+        let printed = self.printed();
+        let this = &printed;
+        let pr = self.printer.resolve()?;
+        let t = &this.trajectory;
+        let pts = t.given_points();
+        let top = |c: &CurveSpec| c.control_points.last().map_or(0.0, |p| p[1]);
+        let mut lo = [f64::INFINITY; 3];
+        let mut hi = [f64::NEG_INFINITY; 3];
+        let ends = pts
+            .first()
+            .into_iter()
+            .chain(pts.last())
+            .filter(|_| !t.closed);
+        for p in ends {
+            for a in 0..2 {
+                lo[a] = lo[a].min(pr.origin[a] + p[a]);
+                hi[a] = hi[a].max(pr.origin[a] + p[a]);
+            }
+        }
+        lo[2] = 0.0;
+        hi[2] = top(&this.profile_start).max(top(&this.end_profile()));
+        for a in 0..3 {
+            let (min, max) = (pr.bed_min[a], pr.bed_min[a] + pr.build_volume[a]);
+            if lo[a] < min - 1e-9 || hi[a] > max + 1e-9 {
+                return Err(Error::DoesNotFit {
+                    printer: pr.name.clone(),
+                    axis: ['x', 'y', 'z'][a],
+                    min: lo[a],
+                    max: hi[a],
+                    low: min,
+                    limit: max,
+                });
+            }
+        }
+        Ok(())
+    }
+}
