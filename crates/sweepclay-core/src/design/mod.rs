@@ -253,10 +253,6 @@ impl Design {
         Ok(())
     }
 
-
-
-
-
     /// C_t: `profile_end`, or `profile_start` where the design gives one
     /// profile (the same section all round the loop or along the wall),
     /// stretched to the taller rim where the design shapes its `rim`.
@@ -276,7 +272,6 @@ impl Design {
     pub fn to_json(&self) -> String {
         serde_json::to_string_pretty(self).expect("a design always serialises")
     }
-
 }
 
 #[cfg(test)]

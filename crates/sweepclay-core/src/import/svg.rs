@@ -346,7 +346,11 @@ pub(super) fn spend(budget: &mut usize, n: usize) -> Result<()> {
     Ok(())
 }
 
-pub(super) fn flatten_path(d: &str, step: f64, budget: &mut usize) -> Result<Vec<(Vec<[f64; 2]>, bool)>> {
+pub(super) fn flatten_path(
+    d: &str,
+    step: f64,
+    budget: &mut usize,
+) -> Result<Vec<(Vec<[f64; 2]>, bool)>> {
     let mut out = Vec::new();
     let mut closed = false;
     let mut pts: Vec<[f64; 2]> = Vec::new();
@@ -426,7 +430,11 @@ pub(super) fn flatten_path(d: &str, step: f64, budget: &mut usize) -> Result<Vec
 /// Adds a flattened sub-path to `out` unless it is a lone point; one drawn
 /// back onto its start without a `Z` is closed too, and a closed one drops
 /// its repeated start.
-pub(super) fn end_subpath(out: &mut Vec<(Vec<[f64; 2]>, bool)>, mut pts: Vec<[f64; 2]>, closed: bool) {
+pub(super) fn end_subpath(
+    out: &mut Vec<(Vec<[f64; 2]>, bool)>,
+    mut pts: Vec<[f64; 2]>,
+    closed: bool,
+) {
     if pts.len() < 2 {
         return;
     }

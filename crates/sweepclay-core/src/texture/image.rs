@@ -88,7 +88,7 @@ impl Grey {
 
     /// The image averaged down to at most `w` × `h` cells (box filter),
     /// so the sampling resolves what is left of it.
-    fn fit(&self, w: usize, h: usize) -> Grey {
+    pub(super) fn fit(&self, w: usize, h: usize) -> Grey {
         let (w, h) = (w.clamp(1, self.width), h.clamp(1, self.height));
         if w == self.width && h == self.height {
             return self.clone();
@@ -116,7 +116,7 @@ impl Grey {
 
     /// Bilinear grey at (x, y) ∈ [0, 1]² (y from the top), clamped at the
     /// edges; across x, wrapped when `wrap` (round a loop).
-    fn at(&self, x: f64, y: f64, wrap: bool) -> f64 {
+    pub(super) fn at(&self, x: f64, y: f64, wrap: bool) -> f64 {
         let fx = if wrap {
             x.rem_euclid(1.0) * self.width as f64 - 0.5
         } else {
