@@ -67,6 +67,10 @@ pub(crate) struct ImportArgs {
     /// The mesh's axis that points up (x, y or z).
     #[arg(long, default_value = "z", value_parser = ["x", "y", "z"])]
     pub(crate) up: String,
+    /// Refuse a mesh that is no sweep within the tolerance, instead of
+    /// keeping what it has beyond the closest sweep as a relief.
+    #[arg(long)]
+    pub(crate) sweep_only: bool,
     /// Printer preset or printer JSON file for the design.
     #[arg(long)]
     pub(crate) printer: Option<String>,
@@ -82,6 +86,7 @@ pub(crate) fn mesh_design(
     scale: Option<f64>,
     tolerance: f64,
     up: &str,
+    relief: bool,
 ) -> Result<Design> {
     use sweepclay_core::meshfit;
     let shown = path.display().to_string();
@@ -93,6 +98,7 @@ pub(crate) fn mesh_design(
     };
     let opts = meshfit::FitOptions {
         tolerance_mm: tolerance,
+        relief,
         ..meshfit::FitOptions::default()
     };
     let m = meshfit::import(&shown, &bytes, up, scale, &opts).with_context(|| shown.clone())?;
@@ -100,6 +106,22 @@ pub(crate) fn mesh_design(
         eprintln!("note: {shown}: {n}");
     }
     let f = m.fitted;
+    if let (Some((dev, at)), Some(r)) = (f.sweep, &f.design.relief) {
+        say!(
+            "{shown}: {} triangles, a {}; no sweep of one loop within {tolerance} mm (the closest, {}, differs by {dev:.2} mm at ({:.1}, {:.1}, {:.1}) mm): printed as the mesh is, that sweep and a relief of {} heights × {} places over it, within {:.2} mm of its {} sections; its foot's centre moved to o (editing its curves reshapes the sweep under the relief; --sweep-only refuses such a mesh)",
+            m.triangles,
+            if f.kind == "shell" { "wall with its thickness (fitted at its middle)" } else { "solid (fitted at its outside)" },
+            if f.design.profile_end.is_some() { "two profiles blended round one loop" } else { "one profile round one loop" },
+            at[0],
+            at[1],
+            at[2],
+            r.z.len(),
+            r.u.len(),
+            f.deviation_mm,
+            f.sections
+        );
+        return Ok(f.design);
+    }
     say!(
         "{shown}: {} triangles, a {}; fitted by a design (one loop, {}) within {:.2} mm of its {} sections (largest at ({:.1}, {:.1}, {:.1}) mm); its foot's centre moved to o",
         m.triangles,
@@ -126,7 +148,7 @@ pub(crate) fn import_cmd(a: ImportArgs) -> Result<i32> {
             a.tolerance
         );
     }
-    let mut design = mesh_design(&a.mesh, a.scale, a.tolerance, &a.up)?;
+    let mut design = mesh_design(&a.mesh, a.scale, a.tolerance, &a.up, !a.sweep_only)?;
     if let Some(p) = &a.printer {
         design.printer = PrinterRef::Inline(Box::new(load_printer(p)?));
     }
@@ -148,7 +170,7 @@ pub(crate) fn import_cmd(a: ImportArgs) -> Result<i32> {
 
 pub(crate) fn slice(a: SliceArgs) -> Result<i32> {
     if is_mesh(&a.design) {
-        let design = mesh_design(Path::new(&a.design), a.scale, 0.3, &a.up)?;
+        let design = mesh_design(Path::new(&a.design), a.scale, 0.3, &a.up, true)?;
         return slice_design(a, design.to_json(), String::new());
     }
     if a.scale.is_some() || a.up != "z" {

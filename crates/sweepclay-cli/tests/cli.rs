@@ -1095,3 +1095,39 @@ fn a_vessel_mesh_slices_and_imports_as_a_design() {
         .failure()
         .stderr(predicate::str::contains("broken.stl: mesh: has a hole"));
 }
+
+#[test]
+fn a_mesh_that_is_no_sweep_prints_as_it_is_or_is_refused_sweep_only() {
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    // Twisted lobes: no sweep of one loop comes within 0.3 mm of a twist.
+    sweepclay(dir)
+        .args(["slice", "twisted-lobes", "-o", "t.gcode", "--stl", "t.stl"])
+        .assert()
+        .success();
+    sweepclay(dir)
+        .args(["slice", "t.stl", "-o", "again.gcode"])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("printed as the mesh is"))
+        .stdout(predicate::str::contains("a relief of"))
+        .stdout(predicate::str::contains("check              printable"));
+    sweepclay(dir)
+        .args(["check", "again.gcode"])
+        .assert()
+        .success();
+    sweepclay(dir)
+        .args(["import", "t.stl", "-o", "t.json"])
+        .assert()
+        .success();
+    let d = std::fs::read_to_string(dir.join("t.json")).unwrap();
+    assert!(d.contains("\"relief\""), "no relief in the design");
+    sweepclay(dir)
+        .args(["import", "t.stl", "--sweep-only", "-o", "u.json"])
+        .assert()
+        .failure()
+        .stderr(predicate::str::contains(
+            "is not a sweep of one loop within 0.3 mm",
+        ));
+    assert!(!dir.join("u.json").exists());
+}

@@ -61,6 +61,7 @@ pub mod motion;
 pub mod plane;
 pub mod preview;
 pub mod printer;
+pub mod relief;
 pub mod rim;
 pub mod sections;
 pub mod size;

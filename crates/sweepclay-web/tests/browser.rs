@@ -2819,6 +2819,37 @@ async fn a_mesh_opens_as_an_editable_design_and_downloads_its_gcode() {
     let (text, _) =
         download_printable(&c, &downloads, "no G-code of the mesh was downloaded").await;
     assert!(text.contains("; design: old-cup"), "{}", &text[..300]);
+    // A mesh that is no sweep (twisted lobes) opens as the closest sweep
+    // and a relief, prints as it is, and the note says why it could not
+    // be made editable.
+    let lobes = sweepclay_core::Design::from_json(
+        sweepclay_core::examples::example("twisted-lobes").unwrap(),
+    )
+    .unwrap();
+    let mut stl = Vec::new();
+    sweepclay_core::mesh::write_stl(&sweepclay_core::slice(&lobes).unwrap(), &mut stl).unwrap();
+    let file = tmp.path().join("lobes.stl");
+    std::fs::write(&file, &stl).unwrap();
+    choose_file(&c, "open-file", &file).await;
+    let note = wait_js(
+        &c,
+        &format!(
+            "return {IDLE} && window.sweepclay.design.name === 'lobes' && {} && document.querySelector('#status .note')?.textContent || null",
+            &PRINTABLE[7..]
+        ),
+        "the twisted mesh opened as a printable design",
+    )
+    .await;
+    let note = note.as_str().unwrap().to_string();
+    assert!(
+        note.contains("printed as the mesh is")
+            && note.contains("could not be made an editable sweep"),
+        "{note}"
+    );
+    assert_eq!(
+        js(&c, "return window.sweepclay.design.relief.u.length").await,
+        json!(360)
+    );
     // A mesh with a hole is refused by name.
     let broken = tmp.path().join("broken.stl");
     std::fs::write(&broken, b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 10 0 0\nvertex 0 10 20\nendloop\nendfacet\nendsolid x\n").unwrap();

@@ -55,6 +55,11 @@ pub struct Design {
     /// `interpolation` (docs/FORMATS.md, "rim").
     #[serde(default, skip_serializing_if = "Option::is_none")]
     pub rim: Option<crate::rim::RimSpec>,
+    /// What a mesh has beyond the closest sweep, added to the profiles'
+    /// blend round a vessel's loop (docs/FORMATS.md, "relief";
+    /// docs/MESHES.md).
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub relief: Option<crate::relief::Relief>,
 }
 
 fn is_zero(v: &f64) -> bool {
@@ -196,6 +201,9 @@ impl Design {
                 d.profile_end.is_some(),
                 d.interpolation.is_some(),
             )?;
+        }
+        if let Some(r) = &d.relief {
+            r.validate(d.trajectory.closed)?;
         }
         let mut d = d;
         // The cap and each entry's keys before any picture is decoded: a

@@ -96,6 +96,7 @@ impl Design {
         if let Some(r) = d.rim.as_mut() {
             r.rise *= kz;
         }
+        d.relief = self.relief.as_ref().map(|r| r.scaled(kxy, kz));
         let t = &mut d.trajectory;
         for pts in [t.control_points.as_mut(), t.points.as_mut()]
             .into_iter()

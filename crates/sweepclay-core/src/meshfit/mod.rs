@@ -20,6 +20,7 @@ use crate::bspline::BSpline;
 use crate::design::{CurveSpec, Design, Offset, TrajectorySpec};
 use crate::error::{Error, Result};
 use crate::meshread::TriMesh;
+use crate::relief::Relief;
 use crate::sections::{self, signed_area2};
 
 mod rays;
@@ -38,6 +39,10 @@ pub struct FitOptions {
     pub tolerance_mm: f64,
     /// The design's name.
     pub name: String,
+    /// Beyond the tolerance, keep what the mesh has beyond the closest
+    /// sweep as the design's relief (printed as the mesh is) rather than
+    /// refuse it.
+    pub relief: bool,
 }
 
 impl Default for FitOptions {
@@ -45,6 +50,7 @@ impl Default for FitOptions {
         FitOptions {
             tolerance_mm: 0.3,
             name: String::new(),
+            relief: true,
         }
     }
 }
@@ -65,6 +71,11 @@ pub struct Fitted {
     /// What the fit moved the mesh by to put its foot's centre at o and
     /// its foot on the bed (mm).
     pub moved: [f64; 3],
+    /// Where the mesh is no sweep within the tolerance and is kept as
+    /// its closest sweep and a relief: that sweep's largest difference
+    /// from it (mm) and where it lies. `None` for a design that is the
+    /// sweep alone.
+    pub sweep: Option<(f64, [f64; 3])>,
 }
 
 /// A mesh file read and fitted: what `slice pot.stl`, `import` and the
@@ -267,7 +278,8 @@ pub fn fit(mesh: &TriMesh, opts: &FitOptions) -> Result<Fitted> {
             format!("is not a sweep of its foot's loop: {}", why[0]),
         ));
     };
-    if b.deviation > opts.tolerance_mm {
+    let sweep = (b.deviation > opts.tolerance_mm && opts.relief).then_some((b.deviation, b.at));
+    if b.deviation > opts.tolerance_mm && !opts.relief {
         return Err(Error::invalid(
             "mesh",
             format!(
@@ -284,13 +296,20 @@ pub fn fit(mesh: &TriMesh, opts: &FitOptions) -> Result<Fitted> {
     }
     let mut design = Design::from_json(&b.json(&opts.name))?;
     design.name = opts.name.clone();
+    let (mut deviation, mut at) = (b.deviation, b.at);
+    if sweep.is_some() {
+        let (relief, worst) = relief_of(&b, &zs, dz, opts.tolerance_mm);
+        design.relief = Some(relief);
+        (deviation, at) = worst;
+    }
     Ok(Fitted {
         design,
-        deviation_mm: b.deviation,
-        at: b.at,
+        deviation_mm: deviation,
+        at,
         kind: if shell { "shell" } else { "solid" },
         sections: cut.len(),
         moved: [-c[0], -c[1], -lo[2]],
+        sweep,
     })
 }
 
@@ -304,6 +323,9 @@ struct Candidate {
     interp: Vec<[f64; 2]>,
     deviation: f64,
     at: [f64; 3],
+    /// The mesh's offsets less the design's, section by section and ray
+    /// by ray (mm).
+    residual: Vec<Vec<f64>>,
 }
 
 impl Candidate {
@@ -461,20 +483,24 @@ fn candidate(g: &Frame, d: &[Vec<f64>], s: &[f64], two: Option<(&[f64], &[f64])>
         vec![0.0; psi.len()]
     };
     let mut worst = (0.0f64, [0.0; 3]);
+    let mut residual = Vec::with_capacity(zs.len());
     for (k, &z) in zs.iter().enumerate() {
         let (a, b) = (at_z(&sp, z), if ep.is_empty() { 0.0 } else { at_z(&ep, z) });
+        let mut row = Vec::with_capacity(lam.len());
         for (j, &l) in lam.iter().enumerate() {
             let fitted = if ep.is_empty() {
                 a
             } else {
                 (1.0 - l) * a + l * b
             };
+            row.push(d[k][j] - fitted);
             let e = (fitted - d[k][j]).abs();
             if e > worst.0 {
                 let p = psi[j];
                 worst = (e, [p[0], p[1], z]);
             }
         }
+        residual.push(row);
     }
     Candidate {
         offset,
@@ -485,5 +511,77 @@ fn candidate(g: &Frame, d: &[Vec<f64>], s: &[f64], two: Option<(&[f64], &[f64])>
         interp,
         deviation: worst.0,
         at: worst.1,
+        residual,
     }
+}
+
+/// Most rows a fitted relief keeps (and the top section): one every
+/// [`RELIEF_ROW_MM`] or more, so a design file stays a few hundred
+/// kilobytes.
+const MAX_RELIEF_ROWS: usize = 120;
+/// The least height between a relief's rows (mm): a twisted square's
+/// corner, 1 mm apart, left the surface 0.32 mm off its mesh between
+/// rows; 0.5 mm holds it within 0.3.
+const RELIEF_ROW_MM: f64 = 0.5;
+
+/// A candidate's residual as a relief (docs/MESHES.md, "Printed as the
+/// mesh is"): rows at every few sections (at least [`RELIEF_ROW_MM`]
+/// apart, at most [`MAX_RELIEF_ROWS`], the lowest and highest kept;
+/// closer, down to every section, while the design is farther than
+/// `tol` from a section between them), a column at each ray, placed by
+/// its arc length along Ψ, offsets to 0.01 mm. With it, the design's
+/// largest difference from every section and where it lies.
+fn relief_of(b: &Candidate, zs: &[f64], dz: f64, tol: f64) -> (Relief, (f64, [f64; 3])) {
+    let n = zs.len();
+    // Ψ is the design's closed polyline: each ray's place is its arc
+    // length from the first point, as the design's columns are placed.
+    let m = b.psi.len();
+    let mut s = 0.0;
+    let mut u: Vec<f64> = std::iter::once(0.0)
+        .chain(b.psi.windows(2).map(|w| {
+            s += dist(w[0], w[1]);
+            s
+        }))
+        .collect();
+    let total = s + dist(b.psi[m - 1], b.psi[0]);
+    for x in &mut u {
+        *x /= total;
+    }
+    let round = |v: f64| (v * 100.0).round() / 100.0;
+    let mut step = ((RELIEF_ROW_MM / dz).ceil() as usize)
+        .max(n.div_ceil(MAX_RELIEF_ROWS))
+        .max(1);
+    loop {
+        let mut rows: Vec<usize> = (0..n).step_by(step).collect();
+        if rows.last() != Some(&(n - 1)) {
+            rows.push(n - 1);
+        }
+        let relief = Relief {
+            z: rows.iter().map(|&k| zs[k]).collect(),
+            u: u.clone(),
+            offsets: rows
+                .iter()
+                .map(|&k| b.residual[k].iter().map(|&v| round(v)).collect())
+                .collect(),
+        };
+        let mut worst = (0.0f64, [0.0; 3]);
+        for (k, &z) in zs.iter().enumerate() {
+            for (j, &r) in b.residual[k].iter().enumerate() {
+                let e = (r - relief.at(u[j], z)).abs();
+                if e > worst.0 {
+                    worst = (e, [b.psi[j][0], b.psi[j][1], z]);
+                }
+            }
+        }
+        // A form that changes faster than the rows (a low-poly mesh's
+        // facets) keeps rows closer, down to every section.
+        if worst.0 <= tol || step == 1 {
+            return (relief, worst);
+        }
+        step = step.div_ceil(2);
+    }
+}
+
+fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
+    (a[0] - b[0]).hypot(a[1] - b[1])
 }

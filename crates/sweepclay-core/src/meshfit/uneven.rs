@@ -211,12 +211,14 @@ pub(super) fn fit_uneven(
         interp,
         deviation: worst.0,
         at: worst.1,
+        // An uneven rim is fitted as a sweep or refused: no relief.
+        residual: Vec::new(),
     };
     if cand.deviation > tol {
         return Err(Error::invalid(
             "mesh",
             format!(
-                "is not a sweep of one loop within {tol} mm: the closest design (a loop, two profiles of {:.1} and {:.1} mm blended round it for its uneven rim, radial offsets) differs from it by {:.2} mm at ({:.1}, {:.1}, {:.1}) mm",
+                "is not a sweep of one loop within {tol} mm: the closest design (a loop, two profiles of {:.1} and {:.1} mm blended round it for its uneven rim, radial offsets) differs from it by {:.2} mm at ({:.1}, {:.1}, {:.1}) mm; a wall whose rim rises round the loop is printed only as such a sweep (no relief is fitted to it yet)",
                 zs_lo, zt_hi, cand.deviation, cand.at[0], cand.at[1], cand.at[2]
             ),
         ));
@@ -230,5 +232,6 @@ pub(super) fn fit_uneven(
         kind: "shell",
         sections: cut.len(),
         moved: [-c[0], -c[1], -bed],
+        sweep: None,
     })
 }

@@ -152,13 +152,18 @@ pub struct Surface {
     pub texture: Vec<f64>,
     /// The textures' labels and their summed amplitude (mm), for reports.
     pub texture_label: (String, f64),
+    /// A mesh's relief over the profiles' blend, as printed
+    /// ([`crate::relief`]); part of the drawn form.
+    pub relief: Option<crate::relief::Relief>,
 }
 
 impl Surface {
     /// ξ_i(t) of the design (before corrections), scaled by `compression`.
     pub fn design_offset(&self, col: &Column, z: f64, compression: f64) -> f64 {
         let t = (z / col.height).min(1.0);
-        compression * ((1.0 - col.lambda) * self.start.offset(t) + col.lambda * self.end.offset(t))
+        let relief = self.relief.as_ref().map_or(0.0, |r| r.at(col.u, z));
+        compression
+            * ((1.0 - col.lambda) * self.start.offset(t) + col.lambda * self.end.offset(t) + relief)
     }
 
     /// Column index for position `m` counted from the short end.
@@ -330,14 +335,16 @@ fn twist_leans_within_limit(s: &Surface, twist: f64) -> Result<()> {
     }
 }
 
-/// How much nearer the textures can bring the wall to the extruder body
-/// (mm): their amplitudes summed, each way.
+/// How much nearer the textures and a relief can bring the wall to the
+/// extruder body (mm): the textures' amplitudes summed, each way, and
+/// the relief's largest offset.
 fn texture_reach(design: &Design) -> f64 {
     2.0 * design
         .texture
         .iter()
         .map(|t| t.amplitude.abs())
         .sum::<f64>()
+        + design.relief.as_ref().map_or(0.0, |r| r.max_abs())
 }
 
 /// [`sample_surface`] of the design as printed ([`Design::printed`]),
@@ -461,6 +468,7 @@ fn sample_plain(design: &Design) -> Result<Surface> {
         corners: traj.corners.clone(),
         texture: Vec::new(),
         texture_label: (String::new(), 0.0),
+        relief: design.relief.clone(),
     };
     let mut samples = Vec::new();
     let mut columns = std::mem::take(&mut surface.columns);

@@ -261,6 +261,7 @@ fn vessel_samples(
         corners: Vec::new(),
         texture: Vec::new(),
         texture_label: (String::new(), 0.0),
+        relief: design.relief.clone(),
     };
     // Each arc column's place in the arc.
     let mut in_arc = vec![usize::MAX; n];

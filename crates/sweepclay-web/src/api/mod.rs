@@ -220,6 +220,21 @@ pub struct MeshImport {
     pub triangles: usize,
     /// What was assumed about its units, if anything.
     pub note: Option<String>,
+    /// Where the mesh is no sweep within 0.3 mm: the closest sweep's
+    /// difference from it (mm) and where it lies; the design then
+    /// carries the rest as its relief and prints as the mesh is.
+    #[serde(skip_serializing_if = "Option::is_none")]
+    pub sweep: Option<SweepMiss>,
+}
+
+/// How far a mesh is from the closest sweep (docs/MESHES.md, "Printed as
+/// the mesh is").
+#[derive(Clone, Debug, Serialize)]
+pub struct SweepMiss {
+    /// The largest difference (mm).
+    pub deviation_mm: f64,
+    /// Where it lies (mm, the design's frame).
+    pub at: [f64; 3],
 }
 
 /// Reads a mesh (`name` gives its format by the extension), stands it
@@ -237,6 +252,9 @@ pub fn import_mesh(name: &str, bytes: &[u8], up: usize) -> Result<MeshImport, Ap
         kind: f.kind,
         triangles: m.triangles,
         note: m.units_note,
+        sweep: f
+            .sweep
+            .map(|(deviation_mm, at)| SweepMiss { deviation_mm, at }),
     })
 }
 
