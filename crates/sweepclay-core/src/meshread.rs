@@ -111,6 +111,42 @@ impl TriMesh {
         }
     }
 
+    /// A closed solid standing on z = 0 whose section at height z is the
+    /// loop of radius `r(θ, z)` about the z axis: `m` vertices round,
+    /// `k + 1` rings up to `h`, capped top and bottom by fans. Closed-form
+    /// meshes for tests and benchmarks (a revolved pot, a lofted oval, a
+    /// twisted polygon).
+    pub fn solid_of(r: impl Fn(f64, f64) -> f64, h: f64, m: usize, k: usize) -> TriMesh {
+        let mut vertices = Vec::with_capacity(m * (k + 1) + 2);
+        for i in 0..=k {
+            let z = h * i as f64 / k as f64;
+            for j in 0..m {
+                let a = std::f64::consts::TAU * j as f64 / m as f64;
+                let rr = r(a, z);
+                vertices.push([rr * a.cos(), rr * a.sin(), z]);
+            }
+        }
+        let (bottom, top) = (vertices.len() as u32, vertices.len() as u32 + 1);
+        vertices.push([0.0, 0.0, 0.0]);
+        vertices.push([0.0, 0.0, h]);
+        let id = |i: usize, j: usize| (i * m + j % m) as u32;
+        let mut triangles = Vec::with_capacity(2 * m * (k + 1));
+        for i in 0..k {
+            for j in 0..m {
+                triangles.push([id(i, j), id(i, j + 1), id(i + 1, j + 1)]);
+                triangles.push([id(i, j), id(i + 1, j + 1), id(i + 1, j)]);
+            }
+        }
+        for j in 0..m {
+            triangles.push([bottom, id(0, j + 1), id(0, j)]);
+            triangles.push([top, id(k, j), id(k, j + 1)]);
+        }
+        TriMesh {
+            vertices,
+            triangles,
+        }
+    }
+
     /// Moves every vertex by `d`.
     pub fn translate(&mut self, d: [f64; 3]) {
         for v in &mut self.vertices {

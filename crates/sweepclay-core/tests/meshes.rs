@@ -8,38 +8,9 @@ use sweepclay_core::meshfit::{fit, FitOptions};
 use sweepclay_core::meshread::TriMesh;
 use sweepclay_core::{examples, Design};
 
-/// A closed solid whose section at height z is the loop `r(θ, z)` about
-/// the axis, `m` points round and `k` + 1 rings up `h` mm, capped top
-/// and bottom by fans.
+/// The closed solid of radius `r(θ, z)` (see [`TriMesh::solid_of`]).
 fn solid(r: impl Fn(f64, f64) -> f64, h: f64, m: usize, k: usize) -> TriMesh {
-    let mut vertices = Vec::new();
-    for i in 0..=k {
-        let z = h * i as f64 / k as f64;
-        for j in 0..m {
-            let a = std::f64::consts::TAU * j as f64 / m as f64;
-            let rr = r(a, z);
-            vertices.push([rr * a.cos(), rr * a.sin(), z]);
-        }
-    }
-    let (bottom, top) = (vertices.len() as u32, vertices.len() as u32 + 1);
-    vertices.push([0.0, 0.0, 0.0]);
-    vertices.push([0.0, 0.0, h]);
-    let id = |i: usize, j: usize| (i * m + j % m) as u32;
-    let mut triangles = Vec::new();
-    for i in 0..k {
-        for j in 0..m {
-            triangles.push([id(i, j), id(i, j + 1), id(i + 1, j + 1)]);
-            triangles.push([id(i, j), id(i + 1, j + 1), id(i + 1, j)]);
-        }
-    }
-    for j in 0..m {
-        triangles.push([bottom, id(0, j + 1), id(0, j)]);
-        triangles.push([top, id(k, j), id(k, j + 1)]);
-    }
-    TriMesh {
-        vertices,
-        triangles,
-    }
+    TriMesh::solid_of(r, h, m, k)
 }
 
 #[test]

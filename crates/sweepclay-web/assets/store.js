@@ -59,6 +59,9 @@ export const state = {
   statsHtml: null,
   // The 3D view was framed on a design once.
   fittedOnce: false,
+  // The design waits to be kept in the browser's storage (saveSoon).
+  unsaved: false,
+  saveTimer: 0,
 };
 
 const listeners = [];
@@ -106,13 +109,22 @@ function saveNow() {
   state.unsaved = false;
   try {
     localStorage.setItem(STORE, JSON.stringify(state.design));
-    const kept = state.history.slice(-KEPT_STEPS);
-    const at = state.at - (state.history.length - kept.length);
-    const h = JSON.stringify({ history: kept, at });
-    localStorage.setItem(HISTORY, h);
-    sessionStorage.setItem(TAB_HISTORY, h);
   } catch (e) {
-    /* private mode or full: no autosave */
+    return; // private mode or full: no autosave
+  }
+  // A large design (a mesh's relief: a few hundred kilobytes a step)
+  // keeps fewer undo steps rather than none.
+  for (const steps of [KEPT_STEPS, 8, 1]) {
+    const kept = state.history.slice(-steps);
+    const at = Math.max(0, state.at - (state.history.length - kept.length));
+    const h = JSON.stringify({ history: kept, at });
+    try {
+      localStorage.setItem(HISTORY, h);
+      sessionStorage.setItem(TAB_HISTORY, h);
+      return;
+    } catch (e) {
+      /* too large for the browser's storage: fewer steps */
+    }
   }
 }
 

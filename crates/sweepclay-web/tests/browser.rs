@@ -2850,6 +2850,9 @@ async fn a_mesh_opens_as_an_editable_design_and_downloads_its_gcode() {
         js(&c, "return window.sweepclay.design.relief.u.length").await,
         json!(360)
     );
+    if let Ok(path) = std::env::var("SWEEPCLAY_RELIEF_SCREENSHOT") {
+        std::fs::write(&path, c.screenshot().await.unwrap()).unwrap();
+    }
     // A mesh with a hole is refused by name.
     let broken = tmp.path().join("broken.stl");
     std::fs::write(&broken, b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 10 0 0\nvertex 0 10 20\nendloop\nendfacet\nendsolid x\n").unwrap();
