@@ -38,8 +38,12 @@ pub fn cut(mesh: &TriMesh, z0: f64, dz: f64, n: usize, bed: f64) -> Result<Vec<S
         let lo = zs.iter().copied().fold(f64::INFINITY, f64::min);
         let hi = zs.iter().copied().fold(f64::NEG_INFINITY, f64::max);
         // Heights k with lo < z_k ≤ hi... strictly: some vertex below
-        // (z < z_k) and some at or above.
-        let first = (((lo - z0) / dz).floor() as i64 + 1).max(0);
+        // (z < z_k) and some at or above, which the test below decides
+        // exactly. The range starts a height early: a vertex a rounding
+        // below z_k gave (lo − z0) / dz = k exactly, and the floor + 1
+        // skipped the height its triangles cross (a ring of a mesh at
+        // half a pot's height left that section empty).
+        let first = (((lo - z0) / dz).floor() as i64).max(0);
         let last = (((hi - z0) / dz).ceil() as i64).min(n as i64 - 1);
         for k in first..=last {
             let z = z0 + k as f64 * dz;

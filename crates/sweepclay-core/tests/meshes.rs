@@ -197,3 +197,27 @@ fn a_mesh_a_few_units_tall_is_taken_as_inches_and_said_so() {
     let f = fit(&m, &FitOptions::default()).unwrap();
     assert!(f.deviation_mm < 0.05, "{}", f.deviation_mm);
 }
+
+#[test]
+fn a_ring_of_vertices_a_rounding_below_a_section_is_cut() {
+    // 92 rings over 46.458 mm put ring 46 at 23.228904216304212 mm, and
+    // the section at 23.228904216304215: its triangles above were left
+    // out and the section came out empty ("an uneven rim").
+    let h = 46.45780843260843;
+    let m = solid(
+        |_, z| 38.0 - 3.6 * (std::f64::consts::PI * z / h).sin(),
+        h,
+        240,
+        92,
+    );
+    let n = (h / 0.25) as usize;
+    let dz = h / n as f64;
+    let cut = sweepclay_core::sections::cut(&m, 0.5 * dz, dz, n, 0.0).unwrap();
+    assert!(cut.iter().all(|s| s.loops.len() == 1));
+    let f = fit(&m, &FitOptions::default()).unwrap();
+    assert!(
+        f.deviation_mm < 0.1 && f.sweep.is_none(),
+        "{}",
+        f.deviation_mm
+    );
+}

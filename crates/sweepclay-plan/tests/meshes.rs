@@ -95,7 +95,7 @@ proptest! {
                 // Refused by name: which height, what to do.
                 let e = e.to_string();
                 prop_assert!(e.starts_with("mesh:"), "{f:?}: {e}");
-                eprintln!("outcome: mesh refused: {e}");
+                eprintln!("outcome: mesh refused: {f:?}: {e}");
                 return Ok(());
             }
         };
