@@ -1,6 +1,7 @@
 //! Uneven rims (docs/MESHES.md, "Uneven rims"): a wall with its
 //! thickness whose rim rises round the loop, fitted along radial rays by
-//! two profiles of different heights blended by the rim's own height.
+//! two profiles of different heights blended by the rim's own height,
+//! and, beyond the tolerance, the wall's difference kept as a relief.
 
 use super::*;
 /// A shell whose rim rises round the loop (docs/MESHES.md, "Uneven
@@ -183,25 +184,42 @@ pub(super) fn fit_uneven(
     let lc = BSpline::clamped(interp.clone())
         .expect("points")
         .flatten(16);
-    let mut worst = (0.0f64, [0.0; 3]);
+    // The rims' heights and the wall's offsets apart: a relief can take
+    // the wall's difference, not a rim's height.
+    let mut rim_worst = (0.0f64, [0.0; 3]);
+    let mut wall_worst = (0.0f64, [0.0; 3]);
+    let mut residual = vec![vec![0.0; jj]; d.len()];
     for j in 0..jj {
         let l = at_x(&lc, j as f64 / jj as f64);
         let h = (1.0 - l) * zs_lo + l * zt_hi;
         // The rim's height is known to half a section.
         let high = ((h - rim[j]).abs() - 0.5 * dz).max(0.0);
-        if high > worst.0 {
-            worst = (high, [psi[j][0], psi[j][1], rim[j]]);
+        if high > rim_worst.0 {
+            rim_worst = (high, [psi[j][0], psi[j][1], rim[j]]);
         }
+        let mut held = 0.0;
         for (k, v) in d.iter().enumerate() {
-            let Some(v) = v[j] else { continue };
+            // Above what was measured (the lip, the rim), the relief
+            // holds the last difference found below.
+            let Some(v) = v[j] else {
+                residual[k][j] = held;
+                continue;
+            };
             let t = (zs[k] / h).min(1.0);
             let fitted = (1.0 - l) * at_z(&sp, t * zs_lo) + l * at_z(&ep, t * zt_hi);
+            held = v - fitted;
+            residual[k][j] = held;
             let e = (fitted - v).abs();
-            if e > worst.0 {
-                worst = (e, [psi[j][0], psi[j][1], zs[k]]);
+            if e > wall_worst.0 {
+                wall_worst = (e, [psi[j][0], psi[j][1], zs[k]]);
             }
         }
     }
+    let worst = if rim_worst.0 >= wall_worst.0 {
+        rim_worst
+    } else {
+        wall_worst
+    };
     let cand = Candidate {
         offset: Offset::Radial,
         two: true,
@@ -211,27 +229,46 @@ pub(super) fn fit_uneven(
         interp,
         deviation: worst.0,
         at: worst.1,
-        // An uneven rim is fitted as a sweep or refused: no relief.
-        residual: Vec::new(),
+        residual,
     };
-    if cand.deviation > tol {
+    let sweep = (cand.deviation > tol && opts.relief && rim_worst.0 <= tol)
+        .then_some((cand.deviation, cand.at));
+    if cand.deviation > tol && sweep.is_none() {
+        let why = if rim_worst.0 > tol {
+            format!(
+                "; its rim's height differs by {:.2} mm at ({:.1}, {:.1}, {:.1}) mm, which no relief takes",
+                rim_worst.0, rim_worst.1[0], rim_worst.1[1], rim_worst.1[2]
+            )
+        } else {
+            String::new()
+        };
         return Err(Error::invalid(
             "mesh",
             format!(
-                "is not a sweep of one loop within {tol} mm: the closest design (a loop, two profiles of {:.1} and {:.1} mm blended round it for its uneven rim, radial offsets) differs from it by {:.2} mm at ({:.1}, {:.1}, {:.1}) mm; a wall whose rim rises round the loop is printed only as such a sweep (no relief is fitted to it yet)",
+                "is not a sweep of one loop within {tol} mm: the closest design (a loop, two profiles of {:.1} and {:.1} mm blended round it for its uneven rim, radial offsets) differs from it by {:.2} mm at ({:.1}, {:.1}, {:.1}) mm{why}",
                 zs_lo, zt_hi, cand.deviation, cand.at[0], cand.at[1], cand.at[2]
             ),
         ));
     }
     let mut design = Design::from_json(&cand.json(&opts.name))?;
     design.name = opts.name.clone();
+    let (mut deviation, mut at) = (cand.deviation, cand.at);
+    if sweep.is_some() {
+        let (relief, wall) = relief_of(&cand, &zs, dz, tol);
+        design.relief = Some(relief);
+        (deviation, at) = if rim_worst.0 >= wall.0 {
+            rim_worst
+        } else {
+            wall
+        };
+    }
     Ok(Fitted {
         design,
-        deviation_mm: cand.deviation,
-        at: cand.at,
+        deviation_mm: deviation,
+        at,
         kind: "shell",
         sections: cut.len(),
         moved: [-c[0], -c[1], -bed],
-        sweep: None,
+        sweep,
     })
 }
