@@ -19,6 +19,7 @@ import { currentPrinter, fillPrinterOptions, keptPrinters, openPrinter, withMyPr
 import { editors } from './editors-panel.js';
 import './pots-panel.js';
 import { downloadFrom } from './files.js';
+import './transform-panel.js';
 
 const $ = (id) => document.getElementById(id);
 const GUIDE_SEEN = 'sweepclay.guide.v1';

@@ -161,6 +161,11 @@ pub const ASSETS: &[(&str, &str, &str)] = &[
         include_str!("../assets/files.js"),
     ),
     (
+        "transform-panel.js",
+        "text/javascript; charset=utf-8",
+        include_str!("../assets/transform-panel.js"),
+    ),
+    (
         "slice-worker.js",
         "text/javascript; charset=utf-8",
         include_str!("../assets/slice-worker.js"),
@@ -199,6 +204,7 @@ pub fn router(limits: Limits) -> Router {
         .route("/api/gcode", post(gcode))
         .route("/api/stl", post(stl))
         .route("/api/import/{format}", post(import))
+        .route("/api/transform", post(transform))
         .route("/api/send", post(printing::send))
         .route("/api/host/status", post(printing::host_status))
         .route("/api/host/key", post(printing::host_key))
@@ -445,6 +451,36 @@ async fn import(
     state
         .pool
         .run(move |_| api::import(&format, &text))
+        .await
+        .map(Json)
+}
+
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+struct TransformQuery {
+    /// How many times as large (default 1).
+    scale: Option<f64>,
+    /// Degrees counter-clockwise about o (default 0).
+    turn: Option<f64>,
+}
+
+/// A design scaled and turned about o (`Design::transformed`): the page
+/// sizes and turns a mesh-backed design without a copy of the library.
+async fn transform(
+    State(state): State<Shared>,
+    query: Result<Query<TransformQuery>, axum::extract::rejection::QueryRejection>,
+    body: Result<Bytes, BytesRejection>,
+) -> Result<Json<serde_json::Value>, ApiError> {
+    let Query(q) = query.map_err(|e| ApiError::new(400, e.body_text()))?;
+    let text = text(body)?;
+    state
+        .pool
+        .run(move |_| {
+            let d = sweepclay_core::Design::from_json(&text)?
+                .transformed(q.scale.unwrap_or(1.0), q.turn.unwrap_or(0.0))?;
+            serde_json::from_str(&d.to_json())
+                .map_err(|e| ApiError::new(500, format!("the transformed design: {e}")))
+        })
         .await
         .map(Json)
 }

@@ -2853,6 +2853,58 @@ async fn a_mesh_opens_as_an_editable_design_and_downloads_its_gcode() {
     if let Ok(path) = std::env::var("SWEEPCLAY_RELIEF_SCREENSHOT") {
         std::fs::write(&path, c.screenshot().await.unwrap()).unwrap();
     }
+    // Sized and turned as a potter wants it: half as large, a quarter
+    // turn, still printable, its relief kept; a size out of range is
+    // refused beside the field; undo brings it back.
+    let size = js(&c, "return window.sweepclay.sliced.stats.size_mm").await;
+    let size: Vec<f64> = serde_json::from_value(size).unwrap();
+    set_value(&c, "tf-scale", "5000000").await;
+    click(&c, "tf-apply").await;
+    let said = wait_js(
+        &c,
+        "return document.getElementById('tf-error').textContent || null",
+        "the size refused",
+    )
+    .await;
+    assert!(said.as_str().unwrap().contains("from 1 to 10000"), "{said}");
+    set_value(&c, "tf-scale", "50").await;
+    set_value(&c, "tf-turn", "90").await;
+    click(&c, "tf-apply").await;
+    let half = wait_js(
+        &c,
+        &format!(
+            "const s = window.sweepclay.sliced?.stats.size_mm; return {IDLE} && {} && s[2] < 0.6 * {} && s",
+            &PRINTABLE[7..],
+            size[2]
+        ),
+        "the design at half its size",
+    )
+    .await;
+    let half: Vec<f64> = serde_json::from_value(half).unwrap();
+    for (h, (a, w)) in half
+        .iter()
+        .zip([(size[1], 3.0), (size[0], 3.0), (size[2], 1.5)])
+    {
+        assert!((h - 0.5 * a).abs() < w, "{half:?} against {size:?}");
+    }
+    assert_eq!(
+        js(&c, "return window.sweepclay.design.relief.u.length").await,
+        json!(360)
+    );
+    assert_eq!(
+        js(&c, "return document.getElementById('tf-error').textContent").await,
+        json!("")
+    );
+    click(&c, "undo").await;
+    wait_js(
+        &c,
+        &format!(
+            "const s = window.sweepclay.sliced?.stats.size_mm; return {IDLE} && s[2] > 0.9 * {}",
+            size[2]
+        ),
+        "the design back at its size",
+    )
+    .await;
     // A mesh with a hole is refused by name.
     let broken = tmp.path().join("broken.stl");
     std::fs::write(&broken, b"solid x\nfacet normal 0 0 1\nouter loop\nvertex 0 0 0\nvertex 10 0 0\nvertex 0 10 20\nendloop\nendfacet\nendsolid x\n").unwrap();

@@ -287,6 +287,33 @@ mod tests {
     use super::*;
 
     #[test]
+    fn a_design_scaled_and_turned_prints_that_size_and_side() {
+        // A cup with its rim cut 10 mm higher toward 150°.
+        let mut v: serde_json::Value =
+            serde_json::from_str(crate::examples::example("cup").unwrap()).unwrap();
+        let o = v.as_object_mut().unwrap();
+        o.remove("profile_end");
+        o.remove("interpolation");
+        v["rim"] = serde_json::json!({ "shape": "slant", "rise": 10, "toward_deg": 150 });
+        let d = Design::from_json(&v.to_string()).unwrap();
+        let a = crate::slice(&d).unwrap().stats.size_mm;
+        let t = d.transformed(0.5, 90.0).unwrap();
+        let b = crate::slice(&t).unwrap().stats.size_mm;
+        // Half as large; a quarter turn swaps its width and depth (the
+        // beads keep their width: the sizes halve within a bead).
+        let w = d.params.width_max;
+        assert!((b[0] - 0.5 * a[1]).abs() < w, "{a:?} {b:?}");
+        assert!((b[1] - 0.5 * a[0]).abs() < w, "{a:?} {b:?}");
+        assert!((b[2] - 0.5 * a[2]).abs() < 1.5, "{a:?} {b:?}");
+        // 150° + 90° is −120°.
+        assert_eq!(t.rim.as_ref().unwrap().toward_deg, -120.0);
+        let e = d.transformed(0.0, 0.0).unwrap_err().to_string();
+        assert!(e.starts_with("scale:"), "{e}");
+        let e = d.transformed(1.0, 720.0).unwrap_err().to_string();
+        assert!(e.starts_with("turn:"), "{e}");
+    }
+
+    #[test]
     fn an_unknown_key_says_where_it_sits() {
         let mut v: serde_json::Value =
             serde_json::from_str(crate::examples::example("cup").unwrap()).unwrap();

@@ -76,8 +76,49 @@ impl Design {
 
     /// The design enlarged for the firing shrinkage, textures included.
     pub(super) fn scaled_for_firing(&self) -> Design {
-        let mut d = self.clone();
         let [kxy, kz] = self.params.print_scale();
+        self.scaled_by(kxy, kz)
+    }
+
+    /// The design as it would be drawn `scale` times as large (every
+    /// length: the path, the profiles, the rim, the textures, a relief)
+    /// and turned `turn_deg` degrees counter-clockwise about o seen from
+    /// above: a mesh-backed design moved to the size and the side a
+    /// potter wants (docs/MESHES.md). Scale 0.01 to 100, turn −360 to
+    /// 360, each refused naming its key.
+    pub fn transformed(&self, scale: f64, turn_deg: f64) -> crate::Result<Design> {
+        if !(scale.is_finite() && (0.01..=100.0).contains(&scale)) {
+            return Err(Error::invalid(
+                "scale",
+                format!("must be a factor from 0.01 to 100 (got {scale})"),
+            ));
+        }
+        if !(turn_deg.is_finite() && (-360.0..=360.0).contains(&turn_deg)) {
+            return Err(Error::invalid(
+                "turn",
+                format!("must be an angle from -360 to 360 degrees (got {turn_deg})"),
+            ));
+        }
+        let mut d = self.scaled_by(scale, scale);
+        let (s, c) = turn_deg.to_radians().sin_cos();
+        let t = &mut d.trajectory;
+        for pts in [t.control_points.as_mut(), t.points.as_mut()]
+            .into_iter()
+            .flatten()
+        {
+            for p in pts.iter_mut() {
+                *p = [c * p[0] - s * p[1], s * p[0] + c * p[1]];
+            }
+        }
+        if let Some(r) = d.rim.as_mut() {
+            r.toward_deg = (r.toward_deg + turn_deg + 180.0).rem_euclid(360.0) - 180.0;
+        }
+        Ok(d)
+    }
+
+    /// The design scaled by `kxy` across and `kz` in height.
+    fn scaled_by(&self, kxy: f64, kz: f64) -> Design {
+        let mut d = self.clone();
         if kxy == 1.0 && kz == 1.0 {
             return d;
         }
