@@ -62,8 +62,16 @@ fn a_twisted_square_prints_as_it_is_with_a_relief_or_is_refused_sweep_only() {
     assert!(f.deviation_mm <= 0.3, "{}", f.deviation_mm);
     let relief = f.design.relief.as_ref().expect("a relief");
     assert!(relief.z.len() <= 121 && relief.u.len() == 360);
-    // Round trip through the design file.
-    let d = Design::from_json(&f.design.to_json()).unwrap();
+    // Round trip through the design file, whose relief is a row a line.
+    let text = f.design.to_json();
+    // (The path's 360 points take four lines each; the relief's 43,560
+    // offsets one a line would take as many lines.)
+    assert!(
+        text.lines().count() < 2500 + relief.z.len(),
+        "{} lines",
+        text.lines().count()
+    );
+    let d = Design::from_json(&text).unwrap();
     let (a, b) = (d.relief.as_ref().unwrap(), relief);
     assert_eq!((a.z.len(), a.u.len()), (b.z.len(), b.u.len()));
     for (x, y) in a.z.iter().chain(&a.u).zip(b.z.iter().chain(&b.u)) {
