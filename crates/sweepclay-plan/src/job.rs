@@ -4,7 +4,7 @@
 //! range, a texture, the sample cap, the build volume — the way a
 //! command line's raw flags become one validated job before work starts.
 
-use crate::stage::Samples;
+use crate::stage::{Samples, Stage};
 use std::sync::Arc;
 use sweepclay_core::{surface, Design, Error, Result, Surface};
 
@@ -82,10 +82,18 @@ impl Job {
 
     /// The job drawing its sampled surface from `store` (and keeping it
     /// there): a job whose sampling inputs equal a kept one's is not
-    /// sampled again ([`crate::Stage::first_changed`]).
+    /// sampled again ([`Job::first_changed`]).
     pub fn with_samples(mut self, store: &Samples) -> Job {
         self.samples = Some(store.clone());
         self
+    }
+
+    /// The first stage whose inputs differ from this job's in `new`
+    /// ([`Stage::between`] their designs, then the check's overlap
+    /// floor), or `None` when they plan alike.
+    pub fn first_changed(&self, new: &Job) -> Option<Stage> {
+        Stage::between(&self.design, &new.design)
+            .or((self.min_overlap != new.min_overlap).then_some(Stage::Check))
     }
 
     /// Stage 1's output for the job: from its store if it has one, else
@@ -112,6 +120,28 @@ impl Job {
 mod tests {
     use super::*;
     use sweepclay_core::examples;
+
+    #[test]
+    fn an_edit_names_the_first_stage_it_changes() {
+        use crate::stage::tests::{edits, example};
+        let job = |d: Design| Job::new(d, &Limits::default()).unwrap();
+        let d = example("vase");
+        assert_eq!(job(d.clone()).first_changed(&job(d.clone())), None);
+        for (what, stage, edit) in edits() {
+            let mut e = d.clone();
+            edit(&mut e);
+            assert_eq!(job(d.clone()).first_changed(&job(e)), Some(stage), "{what}");
+        }
+        let strict = Job::new(
+            d.clone(),
+            &Limits {
+                min_overlap: 0.7,
+                ..Limits::default()
+            },
+        )
+        .unwrap();
+        assert_eq!(job(d).first_changed(&strict), Some(Stage::Check));
+    }
 
     fn vase() -> Design {
         Design::from_json(examples::example("vase").unwrap()).unwrap()

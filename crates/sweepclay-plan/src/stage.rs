@@ -11,7 +11,6 @@
 //! G-code decides the next round's corrections: whatever changes from
 //! stage 2 on runs that loop again.
 
-use crate::job::Job;
 use std::sync::{Arc, Mutex};
 use sweepclay_core::printer::{Printer, PrinterRef};
 use sweepclay_core::{surface, Design, Result, Surface};
@@ -19,8 +18,8 @@ use sweepclay_core::{surface, Design, Result, Surface};
 /// A stage of the plan, in the order they run.
 #[derive(Clone, Copy, Debug, PartialEq, Eq, PartialOrd, Ord, Hash)]
 pub enum Stage {
-    /// Parsing and [`Job::new`]'s checks: every refusal that needs no
-    /// slicing.
+    /// Parsing and the job's checks (`Job::new`): every refusal that
+    /// needs no slicing.
     Validate,
     /// 1: the design's curves sampled into columns (paper §3), the
     /// layering chosen, textures and twist applied
@@ -40,16 +39,16 @@ pub enum Stage {
 }
 
 impl Stage {
-    /// The first stage whose inputs differ between two jobs, or `None`
-    /// when they plan alike. Stage 1 reads the curves, the textures, the
-    /// twist and rim, the parameters but the feedrate, the even-turn flow
-    /// and the correction report's limit, and of the printer only the
-    /// extruder body's radius (its reach decides which columns are
-    /// neighbours); stage 2 reports with `max_correction_mm`; stage 4
-    /// reads `even_turn_flow`; stage 5 the rest of the printer, the
-    /// feedrate and the name; the check the overlap floor.
-    pub fn first_changed(old: &Job, new: &Job) -> Option<Stage> {
-        let (a, b) = (old.design(), new.design());
+    /// The first stage whose inputs differ between two designs, or
+    /// `None` when they are equal (the job adds the check's overlap
+    /// floor: `Job::first_changed`). Stage 1 reads the curves, the
+    /// textures, the twist, rim and relief, the parameters but the
+    /// feedrate, the even-turn flow and the correction report's limit,
+    /// and of the printer only the extruder body's radius (its reach
+    /// decides which columns are neighbours); stage 2 reports with
+    /// `max_correction_mm`; stage 4 reads `even_turn_flow`; stage 5 the
+    /// rest of the printer, the feedrate and the name.
+    pub fn between(a: &Design, b: &Design) -> Option<Stage> {
         if sampling_view(a) != sampling_view(b) {
             Some(Stage::Sample)
         } else if a.params.max_correction_mm != b.params.max_correction_mm {
@@ -58,8 +57,6 @@ impl Stage {
             Some(Stage::Extrude)
         } else if a != b {
             Some(Stage::Emit)
-        } else if old.min_overlap() != new.min_overlap() {
-            Some(Stage::Check)
         } else {
             None
         }
@@ -68,7 +65,7 @@ impl Stage {
 
 /// What stage 1 reads of a design: the design with what it does not
 /// read set to one value (the printer's body radius kept; a printer that
-/// does not resolve is kept whole, and [`Job::new`] refuses it).
+/// does not resolve is kept whole, and `Job::new` refuses it).
 fn sampling_view(d: &Design) -> Design {
     let mut v = d.clone();
     v.name.clear();
@@ -111,8 +108,7 @@ impl Samples {
     }
 
     /// The sampled surface of `design`: a kept one whose sampling inputs
-    /// are the design's ([`Stage::first_changed`] after
-    /// [`Stage::Sample`]), given the design's name, parameters and
+    /// are the design's ([`Stage::between`] after [`Stage::Sample`]), given the design's name, parameters and
     /// printer, or else sampled now and kept.
     pub fn sampled(&self, design: &Design) -> Result<Arc<Surface>> {
         let view = sampling_view(design);
@@ -165,23 +161,18 @@ fn reuse(kept: Arc<Surface>, design: &Design) -> Result<Arc<Surface>> {
 }
 
 #[cfg(test)]
-mod tests {
+pub(crate) mod tests {
     use super::*;
-    use crate::job::Limits;
     use sweepclay_core::examples;
 
-    fn job(d: Design) -> Job {
-        Job::new(d, &Limits::default()).unwrap()
-    }
-
-    fn example(name: &str) -> Design {
+    pub(crate) fn example(name: &str) -> Design {
         Design::from_json(examples::example(name).unwrap()).unwrap()
     }
 
     /// An edit's name, the stage it must first recompute, the edit.
-    type Edit = (&'static str, Stage, fn(&mut Design));
+    pub(crate) type Edit = (&'static str, Stage, fn(&mut Design));
 
-    fn edits() -> Vec<Edit> {
+    pub(crate) fn edits() -> Vec<Edit> {
         vec![
             ("name", Stage::Emit, |d| d.name = "renamed".into()),
             ("feedrate", Stage::Emit, |d| d.params.feedrate *= 1.5),
@@ -208,30 +199,6 @@ mod tests {
             }),
             ("twist", Stage::Sample, |d| d.twist_deg += 10.0),
         ]
-    }
-
-    #[test]
-    fn an_edit_names_the_first_stage_it_changes() {
-        let d = example("vase");
-        assert_eq!(Stage::first_changed(&job(d.clone()), &job(d.clone())), None);
-        for (what, stage, edit) in edits() {
-            let mut e = d.clone();
-            edit(&mut e);
-            assert_eq!(
-                Stage::first_changed(&job(d.clone()), &job(e)),
-                Some(stage),
-                "{what}"
-            );
-        }
-        let strict = Job::new(
-            d.clone(),
-            &Limits {
-                min_overlap: 0.7,
-                ..Limits::default()
-            },
-        )
-        .unwrap();
-        assert_eq!(Stage::first_changed(&job(d), &strict), Some(Stage::Check));
     }
 
     /// The store's answer after any edit is what sampling the edited

@@ -536,14 +536,8 @@ fn relief_of(b: &Candidate, zs: &[f64], dz: f64, tol: f64) -> (Relief, (f64, [f6
     // Ψ is the design's closed polyline: each ray's place is its arc
     // length from the first point, as the design's columns are placed.
     let m = b.psi.len();
-    let mut s = 0.0;
-    let mut u: Vec<f64> = std::iter::once(0.0)
-        .chain(b.psi.windows(2).map(|w| {
-            s += dist(w[0], w[1]);
-            s
-        }))
-        .collect();
-    let total = s + dist(b.psi[m - 1], b.psi[0]);
+    let mut u = crate::curves::arc_lengths(&b.psi);
+    let total = u[m - 1] + crate::bspline::dist(b.psi[m - 1], b.psi[0]);
     for x in &mut u {
         *x /= total;
     }
@@ -580,8 +574,4 @@ fn relief_of(b: &Candidate, zs: &[f64], dz: f64, tol: f64) -> (Relief, (f64, [f6
         }
         step = step.div_ceil(2);
     }
-}
-
-fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
-    (a[0] - b[0]).hypot(a[1] - b[1])
 }

@@ -338,7 +338,7 @@ fn twist_leans_within_limit(s: &Surface, twist: f64) -> Result<()> {
 /// How much nearer the textures and a relief can bring the wall to the
 /// extruder body (mm): the textures' amplitudes summed, each way, and
 /// the relief's largest offset.
-fn texture_reach(design: &Design) -> f64 {
+fn displacement_reach(design: &Design) -> f64 {
     2.0 * design
         .texture
         .iter()
@@ -445,7 +445,7 @@ fn sample_plain(design: &Design) -> Result<Surface> {
     let spacing = traj.length / (n - 1) as f64;
     // The extruder body reaches r + w_max/2 around the nozzle; 20 % more
     // for the profiles' radial offsets, which move columns in plan.
-    let reach = 1.2 * (printer.nozzle_radius + params.width_max / 2.0) + texture_reach(design);
+    let reach = 1.2 * (printer.nozzle_radius + params.width_max / 2.0) + displacement_reach(design);
     // Clay laid within r + w_max of path is the bead just laid (exempt, as
     // in the checker); one column less for safety.
     let exempt =

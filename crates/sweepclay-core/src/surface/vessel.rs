@@ -100,7 +100,7 @@ pub(super) fn sample_vessel(
     // The extruder body's reach, and the clay just laid along the loop
     // that it may touch, as the checker counts them; columns where the
     // rim is, where collisions happen (docs/ALGORITHMS.md §8).
-    let reach = printer.nozzle_radius + params.width_max / 2.0 + texture_reach(design);
+    let reach = printer.nozzle_radius + params.width_max / 2.0 + displacement_reach(design);
     let exempt = printer.nozzle_radius + params.width_max;
     let offset = |c: &Column| {
         let t = 1.0;
