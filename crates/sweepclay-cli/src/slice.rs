@@ -106,9 +106,15 @@ pub(crate) fn mesh_design(
         eprintln!("note: {shown}: {n}");
     }
     let f = m.fitted;
+    // A twist found in the mesh is the design's own (docs/MESHES.md).
+    let twist = if f.design.twist_deg == 0.0 {
+        String::new()
+    } else {
+        format!(", twisted {}°", f.design.twist_deg)
+    };
     if let (Some((dev, at)), Some(r)) = (f.sweep, &f.design.relief) {
         say!(
-            "{shown}: {} triangles, a {}; no sweep of one loop within {tolerance} mm (the closest, {}, differs by {dev:.2} mm at ({:.1}, {:.1}, {:.1}) mm): printed as the mesh is, that sweep and a relief of {} heights × {} places over it, within {:.2} mm of its {} sections; its foot's centre moved to o (editing its curves reshapes the sweep under the relief; --sweep-only refuses such a mesh)",
+            "{shown}: {} triangles, a {}; no sweep of one loop within {tolerance} mm (the closest, {}{twist}, differs by {dev:.2} mm at ({:.1}, {:.1}, {:.1}) mm): printed as the mesh is, that sweep and a relief of {} heights × {} places over it, within {:.2} mm of its {} sections; its foot's centre moved to o (editing its curves reshapes the sweep under the relief; --sweep-only refuses such a mesh)",
             m.triangles,
             if f.kind == "shell" { "wall with its thickness (fitted at its middle)" } else { "solid (fitted at its outside)" },
             if f.design.profile_end.is_some() { "two profiles blended round one loop" } else { "one profile round one loop" },
@@ -123,7 +129,7 @@ pub(crate) fn mesh_design(
         return Ok(f.design);
     }
     say!(
-        "{shown}: {} triangles, a {}; fitted by a design (one loop, {}) within {:.2} mm of its {} sections (largest at ({:.1}, {:.1}, {:.1}) mm); its foot's centre moved to o",
+        "{shown}: {} triangles, a {}; fitted by a design (one loop, {}{twist}) within {:.2} mm of its {} sections (largest at ({:.1}, {:.1}, {:.1}) mm); its foot's centre moved to o",
         m.triangles,
         if f.kind == "shell" { "wall with its thickness (fitted at its middle)" } else { "solid (fitted at its outside)" },
         if f.design.profile_end.is_some() { "two profiles blended round it" } else { "one profile" },

@@ -38,6 +38,44 @@ fn a_lofted_oval_comes_back_as_two_profiles_blended_round_it() {
 }
 
 #[test]
+fn a_square_twisted_from_its_floor_comes_back_as_an_editable_twist() {
+    // A design's twist turns its wall from its floor's top (two layers of
+    // 1.25 mm) to its rim: a mesh that turns so, flaring a little, is
+    // that design's sweep and comes back with its twist. (A rounded
+    // square, |x|⁴ + |y|⁴ = 30⁴: a sharp corner between facets 1.5°
+    // apart is cut by up to 0.55 mm as it turns past them, which no
+    // sweep follows.)
+    let (h, tw) = (60.0, 0.5f64);
+    let r = move |a: f64, z: f64| {
+        let t = a - tw * ((z - 2.5) / (h - 2.5)).clamp(0.0, 1.0);
+        30.0 / (t.cos().powi(4) + t.sin().powi(4)).powf(0.25) + 0.05 * z
+    };
+    let f = fit(&solid(r, h, 240, 120), &FitOptions::default()).unwrap();
+    assert!(
+        f.sweep.is_none() && f.design.relief.is_none(),
+        "{:?}",
+        f.sweep
+    );
+    assert!(f.deviation_mm <= 0.3, "{}", f.deviation_mm);
+    let want = tw.to_degrees();
+    assert!(
+        (f.design.twist_deg - want).abs() < 0.5,
+        "{} against {want}",
+        f.design.twist_deg
+    );
+    let sliced = sweepclay_core::slice(&f.design).unwrap();
+    let report = common::check_full(&sliced);
+    assert!(report.printable, "{}", report.render());
+    // A round pot turned is the same pot: no twist is found in it.
+    let f = fit(
+        &solid(|_, z| 30.0 + 0.1 * z, h, 240, 120),
+        &FitOptions::default(),
+    )
+    .unwrap();
+    assert_eq!(f.design.twist_deg, 0.0);
+}
+
+#[test]
 fn a_twisted_square_prints_as_it_is_with_a_relief_or_is_refused_sweep_only() {
     let r = |a: f64, z: f64| {
         let t = a - 0.5 * z / 60.0;
@@ -53,12 +91,24 @@ fn a_twisted_square_prints_as_it_is_with_a_relief_or_is_refused_sweep_only() {
         e.contains("is not a sweep of one loop within 0.3 mm"),
         "{e}"
     );
-    assert!(e.contains("differs from it by"), "{e}");
-    // By default the closest sweep carries the rest as a relief: the
-    // design's surface, as sampled, lies on the twisted square.
+    assert!(
+        e.contains("twisted") && e.contains("differs from it by"),
+        "{e}"
+    );
+    // It turns from its foot, a design from its floor's top: the closest
+    // twisted sweep is over 0.5 mm off near the floor. By default it
+    // carries the rest as a relief: the design's surface, as sampled,
+    // lies on the twisted square.
     let f = fit(&mesh, &FitOptions::default()).unwrap();
     let (miss, _) = f.sweep.expect("no sweep within 0.3 mm");
-    assert!(miss > 1.0, "{miss}");
+    assert!(miss > 0.5, "{miss}");
+    // Its faceted corners leave the closest twist within a tenth of
+    // what it turns by above the floor's top, 28.6° · 57.5 / 60.
+    assert!(
+        (f.design.twist_deg - 27.45).abs() < 2.8,
+        "{}",
+        f.design.twist_deg
+    );
     assert!(f.deviation_mm <= 0.3, "{}", f.deviation_mm);
     let relief = f.design.relief.as_ref().expect("a relief");
     assert!(relief.z.len() <= 121 && relief.u.len() == 360);
@@ -80,27 +130,44 @@ fn a_twisted_square_prints_as_it_is_with_a_relief_or_is_refused_sweep_only() {
     assert_eq!(a.offsets, b.offsets);
     let s = sweepclay_core::surface::sample_surface(&d).unwrap();
     // The mesh's own radius at angle θ and height z: where the ray meets
-    // each ring's polygon (240 vertices, so a corner is cut by up to
-    // 0.5 mm), linear between the rings (120 rings, 0.5 mm apart).
-    let ring = |a: f64, i: usize| {
-        let step = std::f64::consts::TAU / 240.0;
-        let j = (a.rem_euclid(std::f64::consts::TAU) / step).floor();
-        let zi = 60.0 * i as f64 / 120.0;
-        let (a0, a1) = (j * step, (j + 1.0) * step);
-        let (p, q) = (
-            [r(a0, zi) * a0.cos(), r(a0, zi) * a0.sin()],
-            [r(a1, zi) * a1.cos(), r(a1, zi) * a1.sin()],
-        );
-        // The ray (cos a, sin a)·t meets p + (q − p)·s.
-        let (dx, dy) = (a.cos(), a.sin());
-        let (ex, ey) = (q[0] - p[0], q[1] - p[1]);
-        (p[0] * ey - p[1] * ex) / (dx * ey - dy * ex)
+    // its section there. Between rings i and i + 1 (0.5 mm apart) the
+    // quad of vertices j and j + 1 (1.5° apart) is two triangles split by
+    // its diagonal from (i, j) to (i + 1, j + 1) (`TriMesh::solid_of`), so
+    // the section crosses it as two segments: up edge j to the diagonal,
+    // and on to up edge j + 1.
+    let vertex = |i: usize, j: i64| {
+        let a = std::f64::consts::TAU * j as f64 / 240.0;
+        let z = 60.0 * i as f64 / 120.0;
+        [r(a, z) * a.cos(), r(a, z) * a.sin()]
     };
-    let mesh_r = |a: f64, z: f64| {
+    let lerp =
+        |p: [f64; 2], q: [f64; 2], t: f64| [p[0] + t * (q[0] - p[0]), p[1] + t * (q[1] - p[1])];
+    let mesh_r = |a: f64, z: f64| -> f64 {
         let f = z / 60.0 * 120.0;
         let i = (f.floor() as usize).min(119);
         let t = f - i as f64;
-        (1.0 - t) * ring(a, i) + t * ring(a, i + 1)
+        let jc =
+            (a.rem_euclid(std::f64::consts::TAU) / (std::f64::consts::TAU / 240.0)).floor() as i64;
+        let (dx, dy) = (a.cos(), a.sin());
+        for j in jc - 2..=jc + 2 {
+            let up = lerp(vertex(i, j), vertex(i + 1, j), t);
+            let diag = lerp(vertex(i, j), vertex(i + 1, j + 1), t);
+            let next = lerp(vertex(i, j + 1), vertex(i + 1, j + 1), t);
+            for (p, q) in [(up, diag), (diag, next)] {
+                // The ray (cos a, sin a)·u meets p + (q − p)·s.
+                let (ex, ey) = (q[0] - p[0], q[1] - p[1]);
+                let den = dx * ey - dy * ex;
+                if den.abs() < 1e-12 {
+                    continue;
+                }
+                let u = (p[0] * ey - p[1] * ex) / den;
+                let s = (p[0] * dy - p[1] * dx) / den;
+                if u > 0.0 && (-1e-9..=1.0 + 1e-9).contains(&s) {
+                    return u;
+                }
+            }
+        }
+        panic!("no section at {a} rad, z {z}");
     };
     let mut worst = 0.0f64;
     for (c, col) in s.columns.iter().enumerate() {
@@ -110,7 +177,8 @@ fn a_twisted_square_prints_as_it_is_with_a_relief_or_is_refused_sweep_only() {
             if !(0.5..57.0).contains(&z) {
                 continue;
             }
-            worst = worst.max((x.hypot(y) - mesh_r(y.atan2(x), z)).abs());
+            let e = (x.hypot(y) - mesh_r(y.atan2(x), z)).abs();
+            worst = worst.max(e);
         }
     }
     assert!(

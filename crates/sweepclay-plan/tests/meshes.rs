@@ -23,8 +23,10 @@ fn seed() -> RngSeed {
 }
 
 /// A solid: `lobes` lobes of `depth` (a fraction of the radius) turned
-/// `twist` radians from foot to rim, its radius flaring by `flare` and
-/// bellying by `belly` (mm), an oval of `oval` (ratio of its axes).
+/// `twist` radians from foot to rim (or, `from_floor`, from 2.5 mm up, as
+/// a design's twist turns above its floor), its radius flaring by
+/// `flare` and bellying by `belly` (mm), an oval of `oval` (ratio of its
+/// axes).
 #[derive(Clone, Debug)]
 struct Form {
     radius: f64,
@@ -35,13 +37,19 @@ struct Form {
     flare: f64,
     belly: f64,
     oval: f64,
+    from_floor: bool,
 }
 
 impl Form {
     fn r(&self, a: f64, z: f64) -> f64 {
         let t = z / self.height;
+        let turn = if self.from_floor {
+            ((z - 2.5) / (self.height - 2.5)).clamp(0.0, 1.0)
+        } else {
+            t
+        };
         let oval = 1.0 / (1.0 + (self.oval * self.oval - 1.0) * a.sin().powi(2)).sqrt();
-        let lobes = 1.0 + self.depth * (f64::from(self.lobes) * (a - self.twist * t)).cos();
+        let lobes = 1.0 + self.depth * (f64::from(self.lobes) * (a - self.twist * turn)).cos();
         self.radius * oval * lobes + self.flare * t + self.belly * (std::f64::consts::PI * t).sin()
     }
 
@@ -63,10 +71,10 @@ fn form() -> impl Strategy<Value = Form> {
         0.0..0.12f64,
         -1.2..1.2f64,
         (-6.0..10.0f64, -4.0..8.0f64),
-        1.0..1.4f64,
+        (1.0..1.4f64, any::<bool>()),
     )
         .prop_map(
-            |(radius, height, lobes, depth, twist, (flare, belly), oval)| Form {
+            |(radius, height, lobes, depth, twist, (flare, belly), (oval, from_floor))| Form {
                 radius,
                 height,
                 lobes,
@@ -75,6 +83,7 @@ fn form() -> impl Strategy<Value = Form> {
                 flare,
                 belly,
                 oval,
+                from_floor,
             },
         )
 }
@@ -115,7 +124,8 @@ proptest! {
                 let r = &p.checked.report;
                 prop_assert!(r.printable, "{f:?}: {}", r.failures.join("; "));
                 let kind = if job.design().relief.is_some() { "relief" } else { "sweep" };
-                eprintln!("outcome: printable, {kind}");
+                let twisted = if job.design().twist_deg == 0.0 { "" } else { ", twisted" };
+                eprintln!("outcome: printable, {kind}{twisted}");
             }
             Err(Unchecked::Design(e)) => {
                 prop_assert!(!e.to_string().is_empty(), "{f:?}");

@@ -106,14 +106,16 @@ async function openMesh(file) {
   setDesign(body.design, { fit: true });
   const kind = body.kind === 'shell' ? 'a wall with its thickness, fitted at its middle' : 'a solid, fitted at its outside';
   const units = body.note ? `; ${body.note}` : '';
+  // A twist found in the mesh is the design's own (docs/MESHES.md, "Twist").
+  const twist = body.design.twist_deg ? `, twisted ${body.design.twist_deg}°` : '';
   if (body.sweep) {
     // No sweep within the tolerance: the design is the closest sweep and
     // a relief, and prints as the mesh is (docs/MESHES.md).
     const [x, y, z] = body.sweep.at.map((v) => v.toFixed(1));
-    showNote(`${file.name}: ${body.triangles} triangles (${kind}), printed as the mesh is (within ${body.deviation_mm.toFixed(2)} mm). It could not be made an editable sweep: the closest one differs from it by ${body.sweep.deviation_mm.toFixed(2)} mm at (${x}, ${y}, ${z}) mm, so the rest rides on it as a relief; editing the curves reshapes the sweep under it${units}`);
+    showNote(`${file.name}: ${body.triangles} triangles (${kind}), printed as the mesh is (within ${body.deviation_mm.toFixed(2)} mm). It could not be made an editable sweep: the closest one${twist} differs from it by ${body.sweep.deviation_mm.toFixed(2)} mm at (${x}, ${y}, ${z}) mm, so the rest rides on it as a relief; editing the curves reshapes the sweep under it${units}`);
     return;
   }
-  showNote(`${file.name}: ${body.triangles} triangles (${kind}), now an editable design within ${body.deviation_mm.toFixed(2)} mm of the mesh${units}`);
+  showNote(`${file.name}: ${body.triangles} triangles (${kind}), now an editable design${twist} within ${body.deviation_mm.toFixed(2)} mm of the mesh${units}`);
 }
 
 $('import').addEventListener('click', () => $('import-file').click());

@@ -83,7 +83,14 @@ pub(super) fn perimeter(l: &[[f64; 2]]) -> f64 {
         .sum()
 }
 
-/// `k` points evenly spaced along a closed loop, counter-clockwise.
+/// A loop's vertex that turns by more than this is a corner (radians):
+/// a 20° bend.
+const CORNER: f64 = 0.35;
+
+/// `k` points evenly spaced along a closed loop, counter-clockwise, each
+/// corner of the loop (a bend over 20°) kept in place of the point
+/// nearest it: a point between two even ones would cut a square's corner
+/// by up to a third of their spacing, where no ray measures.
 pub(super) fn resample(l: &[[f64; 2]], k: usize) -> Vec<[f64; 2]> {
     let mut l = l.to_vec();
     if signed_area2(&l) < 0.0 {
@@ -109,6 +116,20 @@ pub(super) fn resample(l: &[[f64; 2]], k: usize) -> Vec<[f64; 2]> {
             walked += seg;
             i += 1;
         }
+    }
+    // Corners: each takes the place of the even point nearest it along
+    // the loop (within half a spacing, so the order stays).
+    let n = l.len();
+    let mut at = 0.0;
+    for v in 0..n {
+        let (a, p, b) = (l[(v + n - 1) % n], l[v], l[(v + 1) % n]);
+        let (e, f) = ([p[0] - a[0], p[1] - a[1]], [b[0] - p[0], b[1] - p[1]]);
+        let bend = (e[0] * f[1] - e[1] * f[0]).atan2(e[0] * f[0] + e[1] * f[1]);
+        if bend.abs() > CORNER && total > 0.0 {
+            let m = (at / total * k as f64).round() as usize % k;
+            out[m] = p;
+        }
+        at += f[0].hypot(f[1]);
     }
     out
 }

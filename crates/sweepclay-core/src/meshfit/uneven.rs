@@ -230,6 +230,7 @@ pub(super) fn fit_uneven(
         deviation: worst.0,
         at: worst.1,
         residual,
+        twist: (0.0, 0.0),
     };
     let sweep = (cand.deviation > tol && opts.relief && rim_worst.0 <= tol)
         .then_some((cand.deviation, cand.at));
