@@ -1,0 +1,105 @@
+#!/usr/bin/env python3
+"""Closed-form vessel meshes written by trimesh (PyPI), for the mesh tests
+(crates/sweepclay-core/tests/meshes.rs, docs/MESHES.md "Closed forms").
+
+    pip install trimesh numpy shapely mapbox_earcut manifold3d
+    python3 scripts/mesh-fixtures.py
+
+writes small binary STLs to crates/sweepclay-core/tests/fixtures/meshes/.
+Each is a form whose sweep is known: the tests read what trimesh wrote,
+not what our own code would write.
+"""
+
+import os
+import sys
+
+import numpy as np
+import trimesh
+from shapely.geometry import Polygon
+
+OUT = os.path.join(
+    os.path.dirname(os.path.abspath(__file__)),
+    "..", "crates", "sweepclay-core", "tests", "fixtures", "meshes",
+)
+
+
+def revolved(profile, sections):
+    """A solid of revolution from (r, z) points, axis to axis."""
+    pts = [(0.0, profile[0][1])] + list(profile) + [(0.0, profile[-1][1])]
+    return trimesh.creation.revolve(np.array(pts), sections=sections)
+
+
+def lofted_oval(a, b, h, rings, around):
+    """An oval whose half-axes a(z) and b(z) change with height, capped."""
+    verts, faces = [], []
+    for i in range(rings + 1):
+        z = h * i / rings
+        for j in range(around):
+            t = 2 * np.pi * j / around
+            verts.append((a(z) * np.cos(t), b(z) * np.sin(t), z))
+    for i in range(rings):
+        for j in range(around):
+            p, q = i * around + j, i * around + (j + 1) % around
+            faces += [(p, q, q + around), (p, q + around, p + around)]
+    bottom, top = len(verts), len(verts) + 1
+    verts += [(0, 0, 0), (0, 0, h)]
+    for j in range(around):
+        faces.append((bottom, (j + 1) % around, j))
+        top_ring = rings * around
+        faces.append((top, top_ring + j, top_ring + (j + 1) % around))
+    return trimesh.Trimesh(np.array(verts), np.array(faces))
+
+
+def main():
+    os.makedirs(OUT, exist_ok=True)
+    forms = {}
+    # A cylinder, 70 mm across and 80 tall, standing on the bed.
+    c = trimesh.creation.cylinder(radius=35.0, height=80.0, sections=64)
+    c.apply_translation((0, 0, 40.0))
+    forms["cylinder"] = c
+    # A cone's frustum flaring from 30 to 45 mm radius over 70 mm.
+    forms["frustum"] = revolved([(30.0, 0.0), (45.0, 70.0)], 64)
+    # A bellied profile revolved: r = 30 + 10 sin(pi z / 90).
+    zs = np.linspace(0.0, 90.0, 21)
+    forms["revolved"] = revolved([(30 + 10 * np.sin(np.pi * z / 90), z) for z in zs], 64)
+    # A lofted oval: its long axis flares, its short one leans in.
+    forms["lofted-oval"] = lofted_oval(
+        lambda z: 40.0 + 6.0 * z / 70.0,
+        lambda z: 28.0 - 4.0 * (z / 70.0) ** 2,
+        70.0, 20, 96,
+    )
+    # A pentagon (rounded by nothing: its corners are vertices) swept
+    # straight up 70 mm, turning 0.6 rad from its foot.
+    pent = Polygon([(34 * np.cos(a), 34 * np.sin(a))
+                    for a in np.linspace(0, 2 * np.pi, 6)[:-1] + np.pi / 2])
+    path = np.column_stack([np.zeros(71), np.zeros(71), np.linspace(0, 70, 71)])
+    forms["twisted-pentagon"] = trimesh.creation.sweep_polygon(
+        pent, path, angles=np.linspace(0.0, 0.6, 71))
+    # A cylinder cut by a plane rising 12 mm across it: a solid whose rim
+    # slants (its top a cap, not a wall).
+    s = trimesh.creation.cylinder(radius=35.0, height=100.0, sections=64)
+    s.apply_translation((0, 0, 50.0))
+    below = trimesh.creation.box(extents=(400.0, 400.0, 200.0))
+    below.apply_translation((0, 0, -100.0))
+    below.apply_transform(trimesh.transformations.rotation_matrix(
+        -np.arctan2(12.0, 70.0), (0, 1, 0)))
+    below.apply_translation((0, 0, 70.0))
+    forms["slanted-solid"] = s.intersection(below)
+    # A cup as potters model it: a cylinder less a cylinder, a wall 4 mm
+    # thick on a floor 5 mm thick (a shell).
+    outer = trimesh.creation.cylinder(radius=36.0, height=70.0, sections=64)
+    outer.apply_translation((0, 0, 35.0))
+    inner = trimesh.creation.cylinder(radius=32.0, height=70.0, sections=64)
+    inner.apply_translation((0, 0, 40.0))
+    forms["cup-shell"] = outer.difference(inner)
+    for name, m in forms.items():
+        if not m.is_watertight:
+            sys.exit(f"{name}: trimesh wrote a mesh that is not watertight")
+        path = os.path.join(OUT, f"{name}.stl")
+        m.export(path)
+        print(f"{name}: {len(m.faces)} triangles, {os.path.getsize(path)} bytes, "
+              f"{m.bounds[1][2] - m.bounds[0][2]:.1f} mm tall")
+
+
+if __name__ == "__main__":
+    main()
