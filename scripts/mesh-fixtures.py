@@ -85,6 +85,13 @@ def main():
         -np.arctan2(12.0, 70.0), (0, 1, 0)))
     below.apply_translation((0, 0, 70.0))
     forms["slanted-solid"] = s.intersection(below)
+    # The same cylinder under a dome (a sphere of 75 mm round a point
+    # 10 mm off its axis): a top that closes over, no opening.
+    d = trimesh.creation.cylinder(radius=35.0, height=100.0, sections=64)
+    d.apply_translation((0, 0, 50.0))
+    ball = trimesh.creation.icosphere(subdivisions=3, radius=75.0)
+    ball.apply_translation((10.0, 0, 0))
+    forms["domed-solid"] = d.intersection(ball)
     # A cup as potters model it: a cylinder less a cylinder, a wall 4 mm
     # thick on a floor 5 mm thick (a shell).
     outer = trimesh.creation.cylinder(radius=36.0, height=70.0, sections=64)

@@ -17,13 +17,24 @@ pub struct Section {
     pub z: f64,
     /// Closed loops in plan (the last point does not repeat the first).
     pub loops: Vec<Vec<[f64; 2]>>,
+    /// For each loop, whether the segment from each point to the next
+    /// lies on a face turned up (its outward normal within 37° of
+    /// vertical, [`UP`]): a cap across a solid's top, not its wall.
+    pub up: Vec<Vec<bool>>,
 }
+
+/// A face whose outward normal's vertical part exceeds this faces up
+/// (37° from level or flatter): steeper than any wall a clay printer
+/// lays (docs/MESHES.md, "Uneven rims").
+pub const UP: f64 = 0.8;
 
 /// One segment of a section: between the crossings of two edges.
 #[derive(Clone, Copy)]
 struct Seg {
     ends: [u64; 2],
     at: [[f64; 2]; 2],
+    /// Its face turns up ([`UP`]).
+    up: bool,
 }
 
 /// Cuts `mesh` at `n` heights `z0`, `z0 + dz`, …. A vertex exactly at a
@@ -45,6 +56,19 @@ pub fn cut(mesh: &TriMesh, z0: f64, dz: f64, n: usize, bed: f64) -> Result<Vec<S
         // half a pot's height left that section empty).
         let first = (((lo - z0) / dz).floor() as i64).max(0);
         let last = (((hi - z0) / dz).ceil() as i64).min(n as i64 - 1);
+        let up = {
+            let [a, b, c] = t.map(|i| v[i as usize]);
+            let (e, f) = (
+                [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
+                [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
+            );
+            let n = [
+                e[1] * f[2] - e[2] * f[1],
+                e[2] * f[0] - e[0] * f[2],
+                e[0] * f[1] - e[1] * f[0],
+            ];
+            n[2] > UP * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt()
+        };
         for k in first..=last {
             let z = z0 + k as f64 * dz;
             let below = zs.map(|q| q < z);
@@ -64,7 +88,7 @@ pub fn cut(mesh: &TriMesh, z0: f64, dz: f64, n: usize, bed: f64) -> Result<Vec<S
                     m += 1;
                 }
             }
-            buckets[k as usize].push(Seg { ends, at });
+            buckets[k as usize].push(Seg { ends, at, up });
         }
     }
     buckets
@@ -72,16 +96,17 @@ pub fn cut(mesh: &TriMesh, z0: f64, dz: f64, n: usize, bed: f64) -> Result<Vec<S
         .enumerate()
         .map(|(k, segs)| {
             let z = z0 + k as f64 * dz - bed;
-            Ok(Section {
-                z,
-                loops: chain(&segs, z)?,
-            })
+            let (loops, up) = chain(&segs, z)?.into_iter().unzip();
+            Ok(Section { z, loops, up })
         })
         .collect()
 }
 
+/// A loop and whether each of its segments faces up.
+type Loop = (Vec<[f64; 2]>, Vec<bool>);
+
 /// Chains the segments of one section into closed loops.
-fn chain(segs: &[Seg], z: f64) -> Result<Vec<Vec<[f64; 2]>>> {
+fn chain(segs: &[Seg], z: f64) -> Result<Vec<Loop>> {
     let mut by_edge: FxHashMap<u64, [u32; 2]> = FxHashMap::default();
     for (s, g) in segs.iter().enumerate() {
         for e in g.ends {
@@ -105,6 +130,8 @@ fn chain(segs: &[Seg], z: f64) -> Result<Vec<Vec<[f64; 2]>>> {
             continue;
         }
         let mut pts = vec![segs[start].at[0]];
+        // The segment from each point on is the one that starts there.
+        let mut up = vec![segs[start].up];
         let (mut s, mut e) = (start, segs[start].ends[1]);
         used[start] = true;
         loop {
@@ -121,6 +148,7 @@ fn chain(segs: &[Seg], z: f64) -> Result<Vec<Vec<[f64; 2]>>> {
             let g = segs[next];
             let (here, far) = if g.ends[0] == e { (0, 1) } else { (1, 0) };
             pts.push(g.at[here]);
+            up.push(g.up);
             if next == start {
                 break;
             }
@@ -129,9 +157,24 @@ fn chain(segs: &[Seg], z: f64) -> Result<Vec<Vec<[f64; 2]>>> {
             e = g.ends[far];
         }
         pts.pop();
-        pts.dedup_by(|a, b| (a[0] - b[0]).hypot(a[1] - b[1]) < 1e-9);
-        if pts.len() >= 3 {
-            loops.push(pts);
+        up.pop();
+        // A point a rounding from the one before ends a segment of no
+        // length: the one before starts the point's own segment.
+        let (mut kept, mut kept_up): (Vec<[f64; 2]>, Vec<bool>) = (Vec::new(), Vec::new());
+        for (p, u) in pts.into_iter().zip(up) {
+            match kept.last() {
+                Some(q) if (p[0] - q[0]).hypot(p[1] - q[1]) < 1e-9 => {
+                    let last = kept_up.len() - 1;
+                    kept_up[last] = u;
+                }
+                _ => {
+                    kept.push(p);
+                    kept_up.push(u);
+                }
+            }
+        }
+        if kept.len() >= 3 {
+            loops.push((kept, kept_up));
         }
     }
     Ok(loops)
@@ -187,6 +230,9 @@ mod tests {
         for sec in &s {
             assert_eq!(sec.loops.len(), 1, "at {}", sec.z);
             assert!((signed_area2(&sec.loops[0]).abs() - 200.0).abs() < 1e-9);
+            // Its sides stand: no segment lies on a face turned up.
+            assert_eq!(sec.up[0].len(), sec.loops[0].len());
+            assert!(sec.up[0].iter().all(|&u| !u));
         }
         // The top face's height counts as above: a cut there meets the
         // side faces' top edges only and still closes.

@@ -348,4 +348,51 @@ fn closed_forms_trimesh_wrote_come_back_as_their_sweeps() {
     let s = sweepclay_core::slice(&f.design).unwrap();
     let r = common::check_full(&s);
     assert!(r.printable, "{}", r.render());
+    // A cylinder cut by a plane rising from 64 to 76 mm across it: a
+    // solid whose top is a slanted cap. Its rim is where the wall meets
+    // the cap, the design's two profiles 64 and 76 mm tall.
+    let f = trimesh_form("slanted-solid").unwrap();
+    assert_eq!(f.kind, "solid");
+    assert!(f.sweep.is_none(), "{:?}", f.sweep);
+    assert!(f.deviation_mm <= 0.3, "{}", f.deviation_mm);
+    let z = |c: &Option<sweepclay_core::design::CurveSpec>| {
+        c.as_ref().unwrap().control_points.last().unwrap()[1]
+    };
+    let (lo, hi) = (
+        z(&Some(f.design.profile_start.clone())),
+        z(&f.design.profile_end),
+    );
+    assert!(
+        (lo - 64.0).abs() < 0.2 && (hi - 76.0).abs() < 0.2,
+        "{lo} {hi}"
+    );
+    let s = sweepclay_core::slice(&f.design).unwrap();
+    let r = common::check_full(&s);
+    assert!(r.printable, "{}", r.render());
+    // Under a dome rising 4.5 mm above where the wall stops, the top is
+    // no opening: refused by name, not cut off unsaid.
+    let e = trimesh_form("domed-solid").unwrap_err().to_string();
+    assert!(
+        e.contains("closes over its top") && e.contains("75.0 mm"),
+        "{e}"
+    );
+}
+
+#[test]
+fn a_lobed_shoulder_closing_in_is_not_taken_for_a_slanted_cap() {
+    // Three lobes whose shoulder leans in from 45 mm, by 1.2 to 1.5 mm a
+    // millimetre: its faces turn up along three runs of each section, a
+    // shoulder, not a cap across an opening. It is fitted whole, its
+    // rim level at 60 mm, never cut at its shoulder.
+    let r = |a: f64, z: f64| {
+        let lobed = 30.0 * (1.0 + 0.1 * (3.0 * a).cos());
+        lobed * (1.0 - 0.0444 * (z - 45.0).max(0.0))
+    };
+    let f = fit(&solid(r, 60.0, 240, 120), &FitOptions::default()).unwrap();
+    assert!(f.deviation_mm <= 0.3, "{}", f.deviation_mm);
+    let top = |c: &[[f64; 2]]| c.last().unwrap()[1];
+    assert!((top(&f.design.profile_start.control_points) - 60.0).abs() < 0.3);
+    if let Some(end) = &f.design.profile_end {
+        assert!((top(&end.control_points) - 60.0).abs() < 0.3);
+    }
 }

@@ -191,17 +191,30 @@ pub fn fit(mesh: &TriMesh, opts: &FitOptions) -> Result<Fitted> {
             "has no section that goes round its centre at its foot: not a vessel standing on its base (turn it so its opening is up)",
         ));
     }
+    // A solid whose top is a cap that slants (or rises to one side): the
+    // first section cut by the cap along one run of its loop and by the
+    // wall along the rest, more than a lip below the top. (A level rim's
+    // rounding cuts a section all round alike; a lobed or oval shoulder
+    // closing in cuts it in runs a lobe.)
+    let capped = cut[..whole]
+        .iter()
+        .position(|s| s.loops.len() == 1 && runs(&s.up[0]) == 1);
+    if let Some(k) = capped.filter(|&k| k > 0 && height - cut[k].z > RIM_LIP_MM) {
+        if cut[..k].iter().all(|s| s.loops.len() == 1) {
+            return fit_uneven(&cut, k, dz, opts, lo[2], true);
+        }
+    }
     if whole < cut.len() {
         let z = cut[whole].z;
         if height - z > RIM_LIP_MM && cut[whole - 1].loops.len() == 2 {
             // A wall with its thickness whose rim rises round the loop.
-            return fit_uneven(&cut, whole, dz, opts, lo[2]);
+            return fit_uneven(&cut, whole, dz, opts, lo[2], false);
         }
         if height - z > RIM_LIP_MM {
             return Err(Error::invalid(
                 "mesh",
                 format!(
-                    "has an uneven rim: from z = {z:.1} mm up ({:.1} mm below its top) the wall does not go all the way round; a solid's slanted or raised rim is not fitted (a wall with its thickness is; or cut the mesh level there, or draw the rim with the design's `rim` key){}",
+                    "has an uneven rim: from z = {z:.1} mm up ({:.1} mm below its top) the wall does not go all the way round its centre, and no cap across its top says where its rim is (a solid's slanted top, a wall with its thickness are fitted; cut the mesh level there, or draw the rim with the design's `rim` key){}",
                     height - z,
                     if hi[0] - lo[0] > height || hi[1] - lo[1] > height {
                         "; or it lies on its side: --up y (or x) stands it up"
@@ -294,6 +307,14 @@ pub fn fit(mesh: &TriMesh, opts: &FitOptions) -> Result<Fitted> {
         moved: [-c[0], -c[1], -lo[2]],
         sweep,
     })
+}
+
+/// How many runs of `true` a loop's flags make, round the loop (0 for
+/// none or all).
+fn runs(up: &[bool]) -> usize {
+    (0..up.len())
+        .filter(|&i| up[i] && !up[(i + up.len() - 1) % up.len()])
+        .count()
 }
 
 /// The closer of the fits in both frames (radial and normal) of the

@@ -136,6 +136,12 @@ pub(super) fn resample(l: &[[f64; 2]], k: usize) -> Vec<[f64; 2]> {
 
 /// Where the ray `o + t·d` crosses the loop: every t.
 pub(super) fn hits(l: &[[f64; 2]], o: [f64; 2], d: [f64; 2]) -> Vec<f64> {
+    crossings(l, o, d).into_iter().map(|(t, _)| t).collect()
+}
+
+/// Where the ray `o + t·d` crosses the loop: every t, rising, and the
+/// segment it crosses (from point i to i + 1).
+pub(super) fn crossings(l: &[[f64; 2]], o: [f64; 2], d: [f64; 2]) -> Vec<(f64, usize)> {
     let mut ts = Vec::new();
     for i in 0..l.len() {
         let (p, q) = (l[i], l[(i + 1) % l.len()]);
@@ -148,12 +154,12 @@ pub(super) fn hits(l: &[[f64; 2]], o: [f64; 2], d: [f64; 2]) -> Vec<f64> {
         let t = (w[0] * e[1] - w[1] * e[0]) / den;
         let s = (w[0] * d[1] - w[1] * d[0]) / den;
         if (-1e-9..1.0 + 1e-9).contains(&s) {
-            ts.push(t);
+            ts.push((t, i));
         }
     }
     // A ray through a vertex crosses both its edges at one place.
-    ts.sort_by(f64::total_cmp);
-    ts.dedup_by(|a, b| (*a - *b).abs() < 1e-6);
+    ts.sort_by(|a, b| a.0.total_cmp(&b.0));
+    ts.dedup_by(|a, b| (a.0 - b.0).abs() < 1e-6);
     ts
 }
 

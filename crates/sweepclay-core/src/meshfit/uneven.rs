@@ -1,13 +1,16 @@
 //! Uneven rims (docs/MESHES.md, "Uneven rims"): a wall with its
-//! thickness whose rim rises round the loop, fitted along radial rays by
-//! two profiles of different heights blended by the rim's own height,
-//! and, beyond the tolerance, the wall's difference kept as a relief.
+//! thickness, or a solid under a slanted cap, whose rim rises round the
+//! loop, fitted along radial rays by two profiles of different heights
+//! blended by the rim's own height, and, beyond the tolerance, the
+//! wall's difference kept as a relief.
 
 use super::*;
-/// A shell whose rim rises round the loop (docs/MESHES.md, "Uneven
-/// rims"): sections up to `whole` go round, those above are the wall's
-/// higher parts. Along each radial ray the wall's middle is found in
-/// every section it reaches and the ray's rim height H_j where it stops;
+/// A shell (or, `solid`, a solid) whose rim rises round the loop
+/// (docs/MESHES.md, "Uneven rims"): sections up to `whole` go round,
+/// those above are the wall's higher parts. Along each radial ray the
+/// wall's middle (a solid's outside, where it is not the cap across its
+/// top) is found in every section it reaches and the ray's rim height
+/// H_j where it stops;
 /// the design's two profiles of heights Z_s = min H and Z_t = max H are
 /// blended by λ_j = (H_j − Z_s) / (Z_t − Z_s), at the same fraction of
 /// each column's height (as the design's surface is: its offsets blend
@@ -19,6 +22,7 @@ pub(super) fn fit_uneven(
     dz: f64,
     opts: &FitOptions,
     bed: f64,
+    solid: bool,
 ) -> Result<Fitted> {
     let tol = opts.tolerance_mm;
     let (c, psi0) = foot_frame(cut);
@@ -33,6 +37,32 @@ pub(super) fn fit_uneven(
         for (j, p) in psi0.iter().enumerate() {
             let r = p[0].hypot(p[1]).max(1e-9);
             let dir = [p[0] / r, p[1] / r];
+            if solid {
+                // Its outside is where the ray leaves the section last;
+                // on a face turned up, that is the cap, above the rim.
+                let far = sec
+                    .loops
+                    .iter()
+                    .zip(&sec.up)
+                    .filter_map(|(l, up)| {
+                        crossings(l, c, dir)
+                            .into_iter()
+                            .rfind(|&(t, _)| t > 0.0)
+                            .map(|(t, i)| (t, up[i]))
+                    })
+                    .max_by(|a, b| a.0.total_cmp(&b.0));
+                row.push(match far {
+                    Some((t, false)) => Some(t - r),
+                    _ if k >= whole => None,
+                    _ => {
+                        return Err(Error::invalid(
+                            "mesh",
+                            format!("is not a sweep of its foot's loop: its wall at z = {:.1} mm does not go round its foot's centre", zs[k]),
+                        ))
+                    }
+                });
+                continue;
+            }
             let mut ts: Vec<f64> = loops
                 .iter()
                 .flat_map(|l| hits(l, [0.0, 0.0], dir))
@@ -121,6 +151,20 @@ pub(super) fn fit_uneven(
         .fold((f64::INFINITY, f64::NEG_INFINITY), |(a, b), &h| {
             (a.min(h), b.max(h))
         });
+    let top = zs[zs.len() - 1] + 0.5 * dz;
+    if solid && top - zt_hi > RIM_LIP_MM {
+        // A cap that rises well above the wall's highest rim is no
+        // opening but a top closing over (a dome, a shoulder leaning in):
+        // taking its wall alone would leave that top out unsaid.
+        return Err(Error::invalid(
+            "mesh",
+            format!(
+                "closes over its top: from z = {:.1} mm its faces turn within 37° of level and rise to {top:.1} mm, {:.1} mm above where its wall stops at the highest; a vessel is open at its rim (cut the mesh where its opening is)",
+                cut[whole].z,
+                top - zt_hi
+            ),
+        ));
+    }
     // Ψ starts at the lowest rim: λ = 0 there.
     let j0 = (0..jj)
         .min_by(|&a, &b| rim[a].total_cmp(&rim[b]))
@@ -267,7 +311,7 @@ pub(super) fn fit_uneven(
         design,
         deviation_mm: deviation,
         at,
-        kind: "shell",
+        kind: if solid { "solid" } else { "shell" },
         sections: cut.len(),
         moved: [-c[0], -c[1], -bed],
         sweep,
