@@ -1100,7 +1100,9 @@ fn a_vessel_mesh_slices_and_imports_as_a_design() {
 fn a_mesh_that_is_no_sweep_prints_as_it_is_or_is_refused_sweep_only() {
     let tmp = tempfile::tempdir().unwrap();
     let dir = tmp.path();
-    // Twisted lobes: no sweep of one loop comes within 0.3 mm of a twist.
+    // Twisted lobes with a spiral texture: the twist is found (36° drawn
+    // on the printer's floor), and no twisted sweep of one loop comes
+    // within 0.3 mm of the texture, which becomes a relief.
     sweepclay(dir)
         .args(["slice", "twisted-lobes", "-o", "t.gcode", "--stl", "t.stl"])
         .assert()
@@ -1110,6 +1112,7 @@ fn a_mesh_that_is_no_sweep_prints_as_it_is_or_is_refused_sweep_only() {
         .assert()
         .success()
         .stdout(predicate::str::contains("printed as the mesh is"))
+        .stdout(predicate::str::is_match(r"twisted 3[4-7]\.\d+°").unwrap())
         .stdout(predicate::str::contains("a relief of"))
         .stdout(predicate::str::contains("check              printable"));
     sweepclay(dir)
@@ -1130,4 +1133,34 @@ fn a_mesh_that_is_no_sweep_prints_as_it_is_or_is_refused_sweep_only() {
             "is not a sweep of one loop within 0.3 mm",
         ));
     assert!(!dir.join("u.json").exists());
+}
+
+#[test]
+fn a_solid_under_a_slanted_cap_prints_with_its_rim_rising() {
+    // A cylinder trimesh cut by a plane rising from 64 to 76 mm
+    // (scripts/mesh-fixtures.py).
+    let tmp = tempfile::tempdir().unwrap();
+    let dir = tmp.path();
+    let stl = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../sweepclay-core/tests/fixtures/meshes/slanted-solid.stl"
+    );
+    sweepclay(dir)
+        .args(["slice", stl, "-o", "s.gcode"])
+        .assert()
+        .success()
+        .stdout(predicate::str::contains("a solid (fitted at its outside)"))
+        .stdout(predicate::str::contains("two profiles blended round it"))
+        .stdout(predicate::str::contains("check              printable"));
+    sweepclay(dir).args(["check", "s.gcode"]).assert().success();
+    let domed = concat!(
+        env!("CARGO_MANIFEST_DIR"),
+        "/../sweepclay-core/tests/fixtures/meshes/domed-solid.stl"
+    );
+    sweepclay(dir)
+        .args(["slice", domed, "-o", "d.gcode"])
+        .assert()
+        .failure()
+        .stderr(predicate::str::contains("closes over its top"));
+    assert!(!dir.join("d.gcode").exists());
 }

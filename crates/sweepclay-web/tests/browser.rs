@@ -2819,9 +2819,9 @@ async fn a_mesh_opens_as_an_editable_design_and_downloads_its_gcode() {
     let (text, _) =
         download_printable(&c, &downloads, "no G-code of the mesh was downloaded").await;
     assert!(text.contains("; design: old-cup"), "{}", &text[..300]);
-    // A mesh that is no sweep (twisted lobes) opens as the closest sweep
-    // and a relief, prints as it is, and the note says why it could not
-    // be made editable.
+    // A mesh that is no sweep (twisted lobes with a spiral texture)
+    // opens as the closest twisted sweep and a relief, prints as it is,
+    // and the note says its twist and why it could not be made editable.
     let lobes = sweepclay_core::Design::from_json(
         sweepclay_core::examples::example("twisted-lobes").unwrap(),
     )
@@ -2843,9 +2843,12 @@ async fn a_mesh_opens_as_an_editable_design_and_downloads_its_gcode() {
     let note = note.as_str().unwrap().to_string();
     assert!(
         note.contains("printed as the mesh is")
-            && note.contains("could not be made an editable sweep"),
+            && note.contains("could not be made an editable sweep")
+            && note.contains("twisted 3"),
         "{note}"
     );
+    let twist = js(&c, "return window.sweepclay.design.twist_deg").await;
+    assert!((twist.as_f64().unwrap() - 36.0).abs() < 2.0, "{twist}");
     assert_eq!(
         js(&c, "return window.sweepclay.design.relief.u.length").await,
         json!(360)
