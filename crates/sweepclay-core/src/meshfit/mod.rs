@@ -384,9 +384,10 @@ fn closest_in(
 }
 
 /// The closest twisted sweep (docs/MESHES.md, "Twist"): the twist the
-/// sections' shapes turn by ([`twist::estimate`]), then a golden-section
+/// sections' shapes turn by ([`twist::turns`]), then a golden-section
 /// search within 12 % of it for the twist whose untwisted sections the
-/// closest sweep fits best. `None` for a loop that shows no turn.
+/// closest sweep fits best, fitted again on every section in the frame
+/// the estimate fitted best. `None` for a loop that shows no turn.
 fn twisted(
     psi: &[[f64; 2]],
     zs: &[f64],
@@ -412,13 +413,13 @@ fn twisted(
         c.twist = (turn0, t);
         Some(c)
     };
-    // The search fits every fourth section in the frame the estimate
+    // The search fits every eighth section in the frame the estimate
     // fits best, and weighs the whole wall (the root mean square of what
     // is left): the worst place jumps from one facet or lobe to another
     // as the twist changes, and a texture that turns too (a spiral)
     // moves the shapes' own estimate by a few degrees.
-    let frame = fit_at(tau, &[Offset::Radial, Offset::Normal], 4)?.offset;
-    let dev = |t: f64| fit_at(t, &[frame], 4).map_or(f64::INFINITY, |c| c.rms());
+    let frame = fit_at(tau, &[Offset::Radial, Offset::Normal], 8)?.offset;
+    let dev = |t: f64| fit_at(t, &[frame], 8).map_or(f64::INFINITY, |c| c.rms());
     let g = 0.5 * (5f64.sqrt() - 1.0);
     let (mut a, mut b) = (tau * 0.88, tau * 1.12);
     let (mut x1, mut x2) = (b - g * (b - a), a + g * (b - a));
@@ -439,7 +440,7 @@ fn twisted(
         }
     }
     best = lower(lower(best, (f1, x1)), (f2, x2));
-    fit_at(best.1, &[Offset::Radial, Offset::Normal], 1)
+    fit_at(best.1, &[frame], 1)
 }
 
 /// The pair of lower deviation (the first of equal ones).
