@@ -266,7 +266,7 @@ pub fn fit(mesh: &TriMesh, opts: &FitOptions) -> Result<Fitted> {
         }
     };
     if b.deviation > tol {
-        if let Some(t) = twisted(&psi, &zs, &loops, shell, height, tol) {
+        if let Some(t) = twisted(&b.psi, &zs, &loops, shell, height, tol) {
             if t.deviation < b.deviation && twist_holds(&t) {
                 b = t;
             }
@@ -328,20 +328,15 @@ fn closest(
     height: f64,
     tol: f64,
 ) -> std::result::Result<Candidate, String> {
-    closest_in(
-        &[Offset::Radial, Offset::Normal],
-        psi,
-        zs,
-        loops,
-        shell,
-        height,
-        tol,
-    )
+    let both = [Offset::Radial, Offset::Normal];
+    closest_in((&both, false), psi, zs, loops, shell, height, tol)
 }
 
-/// The closest of the fits in the frames `frames`, as [`closest`].
+/// The closest of the fits in the frames `frames.0`, as [`closest`];
+/// with `frames.1`, Ψ is the foot's wall already (the sections are
+/// turned, the foot with them, and D is measured from Ψ as it is).
 fn closest_in(
-    frames: &[Offset],
+    (frames, on_wall): (&[Offset], bool),
     psi: &[[f64; 2]],
     zs: &[f64],
     loops: &[Vec<Vec<[f64; 2]>>],
@@ -358,7 +353,11 @@ fn closest_in(
                 // FORMATS.md): Ψ is the wall at the lowest section (a
                 // shell's middle, not the foot's outside), and D is
                 // measured from it.
-                let base = d[0].clone();
+                let base = if on_wall {
+                    vec![0.0; psi.len()]
+                } else {
+                    d[0].clone()
+                };
                 let psi: Vec<[f64; 2]> = (0..psi.len())
                     .map(|j| {
                         [
@@ -398,28 +397,48 @@ fn twisted(
 ) -> Option<Candidate> {
     let turns = twist::turns(loops, zs, height)?;
     let tau = turns.twist()?;
+    // Ψ is the foot's wall as the untwisted fit found it: the design
+    // turns it by `turn0` and its twist, so the sections turned back by
+    // both lie on it above the floor's top. Where the mesh turns from its
+    // foot, the foot turned back by `turn0` is off Ψ: what the relief
+    // takes.
     let fit_at = |t: f64, frames: &[Offset], every: usize| -> Option<Candidate> {
         let zs: Vec<f64> = zs.iter().copied().step_by(every).collect();
         let loops: Vec<_> = loops.iter().step_by(every).cloned().collect();
         let turn0 = turns.turn0(t);
         let back = twist::untwisted(&loops, &zs, (turn0, t), height);
-        // Ψ is the foot's loop turned back as its sections are.
-        let (s, c) = (-turn0).sin_cos();
-        let psi: Vec<[f64; 2]> = psi
-            .iter()
-            .map(|p| [c * p[0] - s * p[1], s * p[0] + c * p[1]])
-            .collect();
-        let mut c = closest_in(frames, &psi, &zs, &back, shell, height, tol).ok()?;
+        let mut c = closest_in((frames, true), psi, &zs, &back, shell, height, tol).ok()?;
         c.twist = (turn0, t);
         Some(c)
     };
-    // The search fits every eighth section in the frame the estimate
-    // fits best, and weighs the whole wall (the root mean square of what
-    // is left): the worst place jumps from one facet or lobe to another
-    // as the twist changes, and a texture that turns too (a spiral)
-    // moves the shapes' own estimate by a few degrees.
+    // The search reads every eighth section in the frame the estimate
+    // fits best, and weighs how far the sections, turned back, are from
+    // the foot's loop moved out or in: the offsets' spread round each
+    // section (their root mean square about its mean), above a millimetre
+    // over the floor's top. It needs no curves (a fit's curves and its
+    // two profiles' blend take up part of a wrong twist, unevenly from
+    // one twist to the next), and it runs smoothly with the twist.
     let frame = fit_at(tau, &[Offset::Radial, Offset::Normal], 8)?.offset;
-    let dev = |t: f64| fit_at(t, &[frame], 8).map_or(f64::INFINITY, |c| c.rms());
+    let sub: Vec<usize> = (0..zs.len())
+        .step_by(8)
+        .filter(|&k| zs[k] > twist::twist_base() + 1.0)
+        .collect();
+    let dev = |t: f64| -> f64 {
+        let zs: Vec<f64> = sub.iter().map(|&k| zs[k]).collect();
+        let loops: Vec<_> = sub.iter().map(|&k| loops[k].clone()).collect();
+        let back = twist::untwisted(&loops, &zs, (turns.turn0(t), t), height);
+        let Ok((d, _)) = offsets(psi, &zs, &back, frame, shell) else {
+            return f64::INFINITY;
+        };
+        let (sum, n) = d.iter().fold((0.0, 0usize), |(sum, n), row| {
+            let m = row.iter().sum::<f64>() / row.len() as f64;
+            (
+                sum + row.iter().map(|v| (v - m).powi(2)).sum::<f64>(),
+                n + row.len(),
+            )
+        });
+        (sum / n.max(1) as f64).sqrt()
+    };
     let g = 0.5 * (5f64.sqrt() - 1.0);
     let (mut a, mut b) = (tau * 0.88, tau * 1.12);
     let (mut x1, mut x2) = (b - g * (b - a), a + g * (b - a));
@@ -485,16 +504,6 @@ struct Candidate {
 }
 
 impl Candidate {
-    /// The root mean square of what the fit leaves (mm).
-    fn rms(&self) -> f64 {
-        let (sum, n) = self
-            .residual
-            .iter()
-            .flatten()
-            .fold((0.0, 0usize), |(s, n), r| (s + r * r, n + 1));
-        (sum / n.max(1) as f64).sqrt()
-    }
-
     /// A place `at` in the untwisted frame the fit measures in, turned
     /// as the design turns it.
     fn turned(&self, at: [f64; 3], height: f64) -> [f64; 3] {
