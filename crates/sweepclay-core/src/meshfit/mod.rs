@@ -255,7 +255,14 @@ pub fn fit(mesh: &TriMesh, opts: &FitOptions) -> Result<Fitted> {
     let loops: Vec<Vec<Vec<[f64; 2]>>> = cut.iter().map(|s| about(s, c)).collect();
     let zs: Vec<f64> = cut.iter().map(|s| s.z).collect();
     let tol = opts.tolerance_mm;
-    let mut b = match closest(&psi, &zs, &loops, shell, height, tol) {
+    let secs = Sections {
+        zs: &zs,
+        loops: &loops,
+        shell,
+        height,
+        tol,
+    };
+    let mut b = match closest(&psi, &secs) {
         Ok(b) => b,
         // Neither frame finds one wall a ray: the radial reason says where.
         Err(why) => {
@@ -266,7 +273,7 @@ pub fn fit(mesh: &TriMesh, opts: &FitOptions) -> Result<Fitted> {
         }
     };
     if b.deviation > tol {
-        if let Some(t) = twisted(&b.psi, &zs, &loops, shell, height, tol) {
+        if let Some(t) = twisted(&b.psi, &secs) {
             if t.deviation < b.deviation && twist_holds(&t) {
                 b = t;
             }
@@ -317,19 +324,27 @@ fn runs(up: &[bool]) -> usize {
         .count()
 }
 
-/// The closer of the fits in both frames (radial and normal) of the
-/// sections `loops`, or why neither frame finds one wall a ray (the
-/// radial reason, which says where).
-fn closest(
-    psi: &[[f64; 2]],
-    zs: &[f64],
-    loops: &[Vec<Vec<[f64; 2]>>],
+/// The sections a fit reads, about the foot's centre, and what every
+/// fit of them shares.
+#[derive(Clone, Copy)]
+struct Sections<'a> {
+    /// Their heights (mm).
+    zs: &'a [f64],
+    /// Their loops (one, or two nested for a shell).
+    loops: &'a [Vec<Vec<[f64; 2]>>],
+    /// Two nested loops a section: fitted at the wall's middle.
     shell: bool,
+    /// The mesh's height (mm).
     height: f64,
+    /// The tolerance (mm).
     tol: f64,
-) -> std::result::Result<Candidate, String> {
-    let both = [Offset::Radial, Offset::Normal];
-    closest_in((&both, false), psi, zs, loops, shell, height, tol)
+}
+
+/// The closer of the fits in both frames (radial and normal) of the
+/// sections, or why neither frame finds one wall a ray (the radial
+/// reason, which says where).
+fn closest(psi: &[[f64; 2]], secs: &Sections) -> std::result::Result<Candidate, String> {
+    closest_in((&[Offset::Radial, Offset::Normal], false), psi, secs)
 }
 
 /// The closest of the fits in the frames `frames.0`, as [`closest`];
@@ -338,12 +353,15 @@ fn closest(
 fn closest_in(
     (frames, on_wall): (&[Offset], bool),
     psi: &[[f64; 2]],
-    zs: &[f64],
-    loops: &[Vec<Vec<[f64; 2]>>],
-    shell: bool,
-    height: f64,
-    tol: f64,
+    secs: &Sections,
 ) -> std::result::Result<Candidate, String> {
+    let Sections {
+        zs,
+        loops,
+        shell,
+        height,
+        tol,
+    } = *secs;
     let mut best: Option<Candidate> = None;
     let mut why = Vec::new();
     for &offset in frames {
@@ -387,14 +405,14 @@ fn closest_in(
 /// search within 12 % of it for the twist whose untwisted sections the
 /// closest sweep fits best, fitted again on every section in the frame
 /// the estimate fitted best. `None` for a loop that shows no turn.
-fn twisted(
-    psi: &[[f64; 2]],
-    zs: &[f64],
-    loops: &[Vec<Vec<[f64; 2]>>],
-    shell: bool,
-    height: f64,
-    tol: f64,
-) -> Option<Candidate> {
+fn twisted(psi: &[[f64; 2]], secs: &Sections) -> Option<Candidate> {
+    let Sections {
+        zs,
+        loops,
+        shell,
+        height,
+        ..
+    } = *secs;
     let turns = twist::turns(loops, zs, height)?;
     let tau = turns.twist()?;
     // Ψ is the foot's wall as the untwisted fit found it: the design
@@ -407,7 +425,12 @@ fn twisted(
         let loops: Vec<_> = loops.iter().step_by(every).cloned().collect();
         let turn0 = turns.turn0(t);
         let back = twist::untwisted(&loops, &zs, (turn0, t), height);
-        let mut c = closest_in((frames, true), psi, &zs, &back, shell, height, tol).ok()?;
+        let turned = Sections {
+            zs: &zs,
+            loops: &back,
+            ..*secs
+        };
+        let mut c = closest_in((frames, true), psi, &turned).ok()?;
         c.twist = (turn0, t);
         Some(c)
     };
