@@ -117,18 +117,34 @@ impl TriMesh {
     /// meshes for tests and benchmarks (a revolved pot, a lofted oval, a
     /// twisted polygon).
     pub fn solid_of(r: impl Fn(f64, f64) -> f64, h: f64, m: usize, k: usize) -> TriMesh {
+        TriMesh::solid_under(r, |_| h, m, k)
+    }
+
+    /// As [`TriMesh::solid_of`], its wall at angle θ rising to `top(θ)`:
+    /// ring i at `top(θ) · i / k`, the top a fan to a vertex at the mean
+    /// height over o. A rim that slants or rises to one side, under a cap.
+    pub fn solid_under(
+        r: impl Fn(f64, f64) -> f64,
+        top: impl Fn(f64) -> f64,
+        m: usize,
+        k: usize,
+    ) -> TriMesh {
         let mut vertices = Vec::with_capacity(m * (k + 1) + 2);
+        let mut mean = 0.0;
         for i in 0..=k {
-            let z = h * i as f64 / k as f64;
             for j in 0..m {
                 let a = std::f64::consts::TAU * j as f64 / m as f64;
+                let z = top(a) * i as f64 / k as f64;
                 let rr = r(a, z);
                 vertices.push([rr * a.cos(), rr * a.sin(), z]);
+                if i == k {
+                    mean += z / m as f64;
+                }
             }
         }
         let (bottom, top) = (vertices.len() as u32, vertices.len() as u32 + 1);
         vertices.push([0.0, 0.0, 0.0]);
-        vertices.push([0.0, 0.0, h]);
+        vertices.push([0.0, 0.0, mean]);
         let id = |i: usize, j: usize| (i * m + j % m) as u32;
         let mut triangles = Vec::with_capacity(2 * m * (k + 1));
         for i in 0..k {

@@ -18,22 +18,23 @@ pub struct Section {
     /// Closed loops in plan (the last point does not repeat the first).
     pub loops: Vec<Vec<[f64; 2]>>,
     /// For each loop, whether the segment from each point to the next
-    /// lies on a face turned up (its outward normal within 37° of
-    /// vertical, [`UP`]): a cap across a solid's top, not its wall.
+    /// lies on a face within 26° of level ([`UP`]), whichever way its
+    /// normal points: a cap across a solid's top, not its wall.
     pub up: Vec<Vec<bool>>,
 }
 
-/// A face whose outward normal's vertical part exceeds this faces up
-/// (37° from level or flatter): steeper than any wall a clay printer
-/// lays (docs/MESHES.md, "Uneven rims").
-pub const UP: f64 = 0.8;
+/// A face whose unit normal's vertical part exceeds this (either sign)
+/// lies within 26° of level: a wall leaning over 64° from upright, beyond
+/// the default overhang limit (57°) by a margin; a cap across a solid's
+/// top slants less (docs/MESHES.md, "Uneven rims").
+pub const UP: f64 = 0.9;
 
 /// One segment of a section: between the crossings of two edges.
 #[derive(Clone, Copy)]
 struct Seg {
     ends: [u64; 2],
     at: [[f64; 2]; 2],
-    /// Its face turns up ([`UP`]).
+    /// Its face lies within 26° of level ([`UP`]).
     up: bool,
 }
 
@@ -67,7 +68,9 @@ pub fn cut(mesh: &TriMesh, z0: f64, dz: f64, n: usize, bed: f64) -> Result<Vec<S
                 e[2] * f[0] - e[0] * f[2],
                 e[0] * f[1] - e[1] * f[0],
             ];
-            n[2] > UP * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt()
+            // Either way up: a mesh whose faces are flipped (or wound
+            // inside out) has its cap facing down.
+            n[2].abs() > UP * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt()
         };
         for k in first..=last {
             let z = z0 + k as f64 * dz;
@@ -102,7 +105,7 @@ pub fn cut(mesh: &TriMesh, z0: f64, dz: f64, n: usize, bed: f64) -> Result<Vec<S
         .collect()
 }
 
-/// A loop and whether each of its segments faces up.
+/// A loop and whether each of its segments lies on a level face.
 type Loop = (Vec<[f64; 2]>, Vec<bool>);
 
 /// Chains the segments of one section into closed loops.
@@ -230,7 +233,7 @@ mod tests {
         for sec in &s {
             assert_eq!(sec.loops.len(), 1, "at {}", sec.z);
             assert!((signed_area2(&sec.loops[0]).abs() - 200.0).abs() < 1e-9);
-            // Its sides stand: no segment lies on a face turned up.
+            // Its sides stand: no segment lies on a level face.
             assert_eq!(sec.up[0].len(), sec.loops[0].len());
             assert!(sec.up[0].iter().all(|&u| !u));
         }

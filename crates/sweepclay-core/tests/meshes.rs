@@ -369,6 +369,33 @@ fn closed_forms_trimesh_wrote_come_back_as_their_sweeps() {
     let s = sweepclay_core::slice(&f.design).unwrap();
     let r = common::check_full(&s);
     assert!(r.printable, "{}", r.render());
+    // Its faces flipped, every other one or all (wound inside out), it
+    // is the same solid: its cap lies level either way up.
+    let path = format!(
+        "{}/tests/fixtures/meshes/slanted-solid.stl",
+        env!("CARGO_MANIFEST_DIR")
+    );
+    let mesh = TriMesh::read(&path, &std::fs::read(&path).unwrap()).unwrap();
+    for every in [2, 1] {
+        let mut m = mesh.clone();
+        for t in m.triangles.iter_mut().step_by(every) {
+            t.swap(1, 2);
+        }
+        let g = fit(&m, &FitOptions::default()).unwrap();
+        let (a, b) = (
+            z(&Some(g.design.profile_start.clone())),
+            z(&g.design.profile_end),
+        );
+        assert!(
+            (a - lo).abs() < 1e-6 && (b - hi).abs() < 1e-6 && g.sweep.is_none(),
+            "flipped every {every}: {a} {b}"
+        );
+        assert!(
+            (g.deviation_mm - f.deviation_mm).abs() < 0.02,
+            "{}",
+            g.deviation_mm
+        );
+    }
     // Under a dome rising 4.5 mm above where the wall stops, the top is
     // no opening: refused by name, not cut off unsaid.
     let e = trimesh_form("domed-solid").unwrap_err().to_string();
@@ -395,4 +422,27 @@ fn a_lobed_shoulder_closing_in_is_not_taken_for_a_slanted_cap() {
     if let Some(end) = &f.design.profile_end {
         assert!((top(&end.control_points) - 60.0).abs() < 0.3);
     }
+}
+
+#[test]
+fn a_wall_turned_steeply_by_a_twist_is_not_taken_for_a_cap() {
+    // Five lobes turned 67° over 26 mm (random mesh seed 7): their flanks
+    // lean within 26° of level in places, one run of a section here and
+    // there, never up to the top. It is a level pot, fitted whole.
+    let (h, tw) = (28.71989525104662, -1.1773761397919638);
+    let r = move |a: f64, z: f64| {
+        let t = z / h;
+        let turn = ((z - 2.5) / (h - 2.5)).clamp(0.0, 1.0);
+        let oval = 1.0 / (1.0 + (1.0438083822480921f64.powi(2) - 1.0) * a.sin().powi(2)).sqrt();
+        let lobes = 1.0 + 0.08163899121019429 * (5.0 * (a - tw * turn)).cos();
+        29.754962495561138 * oval * lobes - 5.557223099679608 * t
+            + 6.7816940719454255 * (std::f64::consts::PI * t).sin()
+    };
+    let f = fit(
+        &solid(r, h, 240, (h / 0.5) as usize),
+        &FitOptions::default(),
+    )
+    .unwrap();
+    assert!(f.deviation_mm <= 0.3, "{}", f.deviation_mm);
+    assert!(f.design.twist_deg != 0.0);
 }

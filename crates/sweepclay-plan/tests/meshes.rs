@@ -26,7 +26,8 @@ fn seed() -> RngSeed {
 /// `twist` radians from foot to rim (or, `from_floor`, from 2.5 mm up, as
 /// a design's twist turns above its floor), its radius flaring by
 /// `flare` and bellying by `belly` (mm), an oval of `oval` (ratio of its
-/// axes).
+/// axes), its top a cap rising `slant` mm a millimetre across it (a
+/// slanted rim).
 #[derive(Clone, Debug)]
 struct Form {
     radius: f64,
@@ -38,6 +39,7 @@ struct Form {
     belly: f64,
     oval: f64,
     from_floor: bool,
+    slant: f64,
 }
 
 impl Form {
@@ -54,9 +56,9 @@ impl Form {
     }
 
     fn mesh(&self) -> TriMesh {
-        TriMesh::solid_of(
+        TriMesh::solid_under(
             |a, z| self.r(a, z),
-            self.height,
+            |a| self.height + self.slant * self.radius * a.cos(),
             240,
             (self.height / 0.5) as usize,
         )
@@ -72,18 +74,22 @@ fn form() -> impl Strategy<Value = Form> {
         -1.2..1.2f64,
         (-6.0..10.0f64, -4.0..8.0f64),
         (1.0..1.4f64, any::<bool>()),
+        prop_oneof![Just(0.0), 0.0..0.15f64],
     )
         .prop_map(
-            |(radius, height, lobes, depth, twist, (flare, belly), (oval, from_floor))| Form {
-                radius,
-                height,
-                lobes,
-                depth,
-                twist,
-                flare,
-                belly,
-                oval,
-                from_floor,
+            |(radius, height, lobes, depth, twist, (flare, belly), (oval, from_floor), slant)| {
+                Form {
+                    radius,
+                    height,
+                    lobes,
+                    depth,
+                    twist,
+                    flare,
+                    belly,
+                    oval,
+                    from_floor,
+                    slant,
+                }
             },
         )
 }
@@ -125,11 +131,19 @@ proptest! {
                 prop_assert!(r.printable, "{f:?}: {}", r.failures.join("; "));
                 let kind = if job.design().relief.is_some() { "relief" } else { "sweep" };
                 let twisted = if job.design().twist_deg == 0.0 { "" } else { ", twisted" };
-                eprintln!("outcome: printable, {kind}{twisted}");
+                let uneven = if job.design().profile_end.as_ref().is_some_and(|e| {
+                    e.control_points.last().map(|p| p[1])
+                        != job.design().profile_start.control_points.last().map(|p| p[1])
+                }) {
+                    ", uneven rim"
+                } else {
+                    ""
+                };
+                eprintln!("outcome: printable, {kind}{twisted}{uneven}");
             }
             Err(Unchecked::Design(e)) => {
                 prop_assert!(!e.to_string().is_empty(), "{f:?}");
-                eprintln!("outcome: plan refused: {e}");
+                eprintln!("outcome: plan refused: {f:?}: {e}");
             }
             Err(Unchecked::Io(e)) => prop_assert!(false, "{f:?}: {e}"),
         }

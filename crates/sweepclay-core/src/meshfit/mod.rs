@@ -191,18 +191,30 @@ pub fn fit(mesh: &TriMesh, opts: &FitOptions) -> Result<Fitted> {
             "has no section that goes round its centre at its foot: not a vessel standing on its base (turn it so its opening is up)",
         ));
     }
-    // A solid whose top is a cap that slants (or rises to one side): the
-    // first section cut by the cap along one run of its loop and by the
-    // wall along the rest, more than a lip below the top. (A level rim's
-    // rounding cuts a section all round alike; a lobed or oval shoulder
-    // closing in cuts it in runs a lobe.)
-    let capped = cut[..whole]
-        .iter()
-        .position(|s| s.loops.len() == 1 && runs(&s.up[0]) == 1);
-    if let Some(k) = capped.filter(|&k| k > 0 && height - cut[k].z > RIM_LIP_MM) {
-        if cut[..k].iter().all(|s| s.loops.len() == 1) {
+    // A solid whose top is a cap that slants (or rises to one side):
+    // every section from the first the cap cuts up to the top is cut by
+    // it along one run of its loop (and by the wall along the rest), or
+    // by it alone. A level rim's rounding cuts a section all round alike;
+    // a lobed shoulder closing in, or a wall turned steeply by a twist,
+    // cuts sections in a run a lobe, and not every one up to the top.
+    let cap = |s: &sections::Section| {
+        s.loops.len() == 1
+            && s.up[0].iter().any(|&u| u)
+            && (runs(&s.up[0]) == 1 || s.up[0].iter().all(|&u| u))
+    };
+    let mut first = whole;
+    while first > 0 && cap(&cut[first - 1]) {
+        first -= 1;
+    }
+    let capped = (first < whole).then_some(first);
+    let mut whole = whole;
+    if let Some(k) = capped.filter(|&k| k > 0 && cut[..k].iter().all(|s| s.loops.len() == 1)) {
+        if height - cut[k].z > RIM_LIP_MM {
             return fit_uneven(&cut, k, dz, opts, lo[2], true);
         }
+        // Within the lip the wall ends where the cap begins, as a level
+        // rim's rounding ends it: the design's rim is the top.
+        whole = k;
     }
     if whole < cut.len() {
         let z = cut[whole].z;
@@ -672,10 +684,19 @@ fn candidate(g: &Frame, d: &[Vec<f64>], s: &[f64], two: Option<(&[f64], &[f64])>
     } = *g;
     let profile = |v: &[f64]| -> Vec<[f64; 2]> {
         // From the bed to the rim: the lowest and highest sections'
-        // values held to z 0 and the top.
+        // values held to z 0 and the top, through a lip as far apart as
+        // the sections (one far point there let the curve through them
+        // turn back down).
         let mut pts: Vec<[f64; 2]> = vec![[v[0], 0.0]];
         pts.extend(v.iter().zip(zs).map(|(&x, &z)| [x, z]));
-        pts.push([v[v.len() - 1], height]);
+        let last = v[v.len() - 1];
+        let step = zs.get(1).map_or(height, |z1| z1 - zs[0]).max(1e-3);
+        let mut z = zs[zs.len() - 1] + step;
+        while z < height - 0.5 * step {
+            pts.push([last, z]);
+            z += step;
+        }
+        pts.push([last, height]);
         profile_through(&pts, tol)
     };
     let start = profile(s);

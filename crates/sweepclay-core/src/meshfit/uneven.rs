@@ -39,7 +39,7 @@ pub(super) fn fit_uneven(
             let dir = [p[0] / r, p[1] / r];
             if solid {
                 // Its outside is where the ray leaves the section last;
-                // on a face turned up, that is the cap, above the rim.
+                // on a face lying level, that is the cap, above the rim.
                 let far = sec
                     .loops
                     .iter()
@@ -53,7 +53,10 @@ pub(super) fn fit_uneven(
                     .max_by(|a, b| a.0.total_cmp(&b.0));
                 row.push(match far {
                     Some((t, false)) => Some(t - r),
-                    _ if k >= whole => None,
+                    // The cap, where it reaches lower than the section
+                    // that starts it all round (a faceted dome's).
+                    Some((_, true)) => None,
+                    None if k >= whole => None,
                     _ => {
                         return Err(Error::invalid(
                             "mesh",
@@ -159,7 +162,7 @@ pub(super) fn fit_uneven(
         return Err(Error::invalid(
             "mesh",
             format!(
-                "closes over its top: from z = {:.1} mm its faces turn within 37° of level and rise to {top:.1} mm, {:.1} mm above where its wall stops at the highest; a vessel is open at its rim (cut the mesh where its opening is)",
+                "closes over its top: from z = {:.1} mm its faces turn within 26° of level and rise to {top:.1} mm, {:.1} mm above where its wall stops at the highest; a vessel is open at its rim (cut the mesh where its opening is)",
                 cut[whole].z,
                 top - zt_hi
             ),
