@@ -29,14 +29,19 @@ def revolved(profile, sections):
     return trimesh.creation.revolve(np.array(pts), sections=sections)
 
 
-def lofted_oval(a, b, h, rings, around):
-    """An oval whose half-axes a(z) and b(z) change with height, capped."""
+def lofted_oval(a, b, h, rings, around, radius=None):
+    """An oval whose half-axes a(z) and b(z) change with height, capped;
+    or, given `radius(t, z)`, the loop of that radius round the axis."""
     verts, faces = [], []
     for i in range(rings + 1):
         z = h * i / rings
         for j in range(around):
             t = 2 * np.pi * j / around
-            verts.append((a(z) * np.cos(t), b(z) * np.sin(t), z))
+            if radius is not None:
+                r = radius(t, z)
+                verts.append((r * np.cos(t), r * np.sin(t), z))
+            else:
+                verts.append((a(z) * np.cos(t), b(z) * np.sin(t), z))
     for i in range(rings):
         for j in range(around):
             p, q = i * around + j, i * around + (j + 1) % around
@@ -67,6 +72,15 @@ def main():
         lambda z: 40.0 + 6.0 * z / 70.0,
         lambda z: 28.0 - 4.0 * (z / 70.0) ** 2,
         70.0, 20, 96,
+    )
+    # Twelve flutes 1.5 mm deep on a flaring round pot, rising from a
+    # plain foot between 2.5 and 12.5 mm (half a cosine), their sine
+    # starting at 30°: r = 35 + 0.08 z + 1.5 e(z) sin(12 t + 30°).
+    def rise(z):
+        return 0.0 if z <= 2.5 else 1.0 if z >= 12.5 else 0.5 - 0.5 * np.cos(np.pi * (z - 2.5) / 10.0)
+    forms["fluted"] = lofted_oval(
+        lambda z: 1.0, lambda z: 1.0, 70.0, 20, 120,
+        radius=lambda t, z: 35.0 + 0.08 * z + 1.5 * rise(z) * np.sin(12 * t + np.radians(30.0)),
     )
     # A pentagon (rounded by nothing: its corners are vertices) swept
     # straight up 70 mm, turning 0.6 rad from its foot.

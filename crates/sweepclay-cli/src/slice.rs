@@ -106,12 +106,20 @@ pub(crate) fn mesh_design(
         eprintln!("note: {shown}: {n}");
     }
     let f = m.fitted;
-    // A twist found in the mesh is the design's own (docs/MESHES.md).
-    let twist = if f.design.twist_deg == 0.0 {
+    // A twist and ribs found in the mesh are the design's own twist and
+    // texture (docs/MESHES.md).
+    let mut twist = if f.design.twist_deg == 0.0 {
         String::new()
     } else {
         format!(", twisted {}°", f.design.twist_deg)
     };
+    for t in &f.design.texture {
+        twist += &format!(
+            ", a {} texture of {} ribs",
+            t.label(),
+            t.count.unwrap_or(0.0)
+        );
+    }
     if let (Some((dev, at)), Some(r)) = (f.sweep, &f.design.relief) {
         say!(
             "{shown}: {} triangles, a {}; no sweep of one loop within {tolerance} mm (the closest, {}{twist}, differs by {dev:.2} mm at ({:.1}, {:.1}, {:.1}) mm): printed as the mesh is, that sweep and a relief of {} heights × {} places over it, within {:.2} mm of its {} sections; its foot's centre moved to o (editing its curves reshapes the sweep under the relief; --sweep-only refuses such a mesh)",

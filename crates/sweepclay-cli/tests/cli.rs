@@ -1113,6 +1113,9 @@ fn a_mesh_that_is_no_sweep_prints_as_it_is_or_is_refused_sweep_only() {
         .success()
         .stdout(predicate::str::contains("printed as the mesh is"))
         .stdout(predicate::str::is_match(r"twisted 3[4-7]\.\d+°").unwrap())
+        .stdout(predicate::str::contains(
+            "a spiral 0.8 mm texture of 10 ribs",
+        ))
         .stdout(predicate::str::contains("a relief of"))
         .stdout(predicate::str::contains("check              printable"));
     sweepclay(dir)

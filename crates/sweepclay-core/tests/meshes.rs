@@ -237,6 +237,26 @@ fn the_bundled_vessels_come_back_from_their_own_stl() {
                 f.sweep
             );
             assert_eq!(f.kind, "shell", "{name}");
+            // Ribs come back as the texture they were drawn as: the
+            // fluted cup's 16 flutes (one profile), the twisted lobes'
+            // spiral of 10 ribs rising one rib in 80 mm.
+            let tex: Vec<_> = f
+                .design
+                .texture
+                .iter()
+                .map(|t| (t.kind.name(), t.count, t.pitch.map(f64::round)))
+                .collect();
+            match *name {
+                "fluted-cup" => {
+                    assert_eq!(tex, [("flute", Some(16.0), None)], "{name}");
+                    assert!(f.design.profile_end.is_none(), "{name}");
+                }
+                "twisted-lobes" => {
+                    assert_eq!(tex, [("spiral", Some(10.0), Some(80.0))], "{name}");
+                    assert!((f.design.twist_deg - 36.0).abs() < 0.5, "{name}");
+                }
+                _ => assert!(tex.is_empty(), "{name}: {tex:?}"),
+            }
             let mut again = f.design;
             again.printer = d.printer.clone();
             again.params = d.params.clone();
@@ -329,6 +349,20 @@ fn closed_forms_trimesh_wrote_come_back_as_their_sweeps() {
         let r = common::check_full(&s);
         assert!(r.printable, "{name}: {}", r.render());
     }
+    // Twelve flutes 1.5 mm deep rising from a plain foot over 10 mm: one
+    // profile and a flute texture (not two profiles blended by a wavy
+    // curve), faded in as the mesh is.
+    let f = trimesh_form("fluted").unwrap();
+    assert!(f.sweep.is_none() && f.design.profile_end.is_none());
+    assert!(f.deviation_mm <= 0.3, "{}", f.deviation_mm);
+    let t = &f.design.texture[0];
+    assert_eq!((t.kind.name(), t.count), ("flute", Some(12.0)));
+    // (Its 120 facets cut each crest by a few hundredths.)
+    assert!((t.amplitude - 1.5).abs() < 0.1, "{}", t.amplitude);
+    assert!((t.fade_in - 10.0).abs() < 1.5, "{}", t.fade_in);
+    let s = sweepclay_core::slice(&f.design).unwrap();
+    let r = common::check_full(&s);
+    assert!(r.printable, "{}", r.render());
     // The cylinder's 64 facets are within 0.05 mm of its circle, and the
     // design's height is the mesh's.
     let f = trimesh_form("cylinder").unwrap();

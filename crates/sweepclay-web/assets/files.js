@@ -106,8 +106,11 @@ async function openMesh(file) {
   setDesign(body.design, { fit: true });
   const kind = body.kind === 'shell' ? 'a wall with its thickness, fitted at its middle' : 'a solid, fitted at its outside';
   const units = body.note ? `; ${body.note}` : '';
-  // A twist found in the mesh is the design's own (docs/MESHES.md, "Twist").
-  const twist = body.design.twist_deg ? `, twisted ${body.design.twist_deg}°` : '';
+  // A twist and ribs found in the mesh are the design's own twist and
+  // texture (docs/MESHES.md, "Twist", "Ribs").
+  const ribs = (body.design.texture || [])
+    .map((t) => `, ${t.count} ${t.kind === 'spiral' ? 'spiral ribs' : 'flutes'} ${t.amplitude} mm deep`).join('');
+  const twist = (body.design.twist_deg ? `, twisted ${body.design.twist_deg}°` : '') + ribs;
   if (body.sweep) {
     // No sweep within the tolerance: the design is the closest sweep and
     // a relief, and prints as the mesh is (docs/MESHES.md).

@@ -16,6 +16,7 @@ const TEXTURE_FIELDS = [
   ['pitch', 'ribs move on one over', 10, 400, 5, 'mm of height', ['spiral']],
   ['fade_in', 'fade in above the foot', 0, 40, 1, 'mm', ['ripple', 'flute', 'spiral', 'image']],
   ['fade_out', 'fade out below the lip', 0, 40, 1, 'mm', ['ripple', 'flute', 'spiral', 'image']],
+  ['phase_deg', 'start the wave at', -180, 180, 5, '°', ['ripple', 'flute', 'spiral']],
 ];
 const TEXTURE_NAMES = { ripple: 'rings (ripple)', flute: 'ribs (flutes)', spiral: 'spiral ribs', image: 'your picture' };
 
@@ -145,7 +146,7 @@ function textureBox(t, k) {
     inp.addEventListener('input', () => { out.value = `${inp.value}${unit ? ` ${unit}` : ''}`; });
     inp.addEventListener('change', () => edit((d) => {
       const v = Number(inp.value);
-      if (key.startsWith('fade') && !v) delete d.texture[k][key];
+      if ((key.startsWith('fade') || key === 'phase_deg') && !v) delete d.texture[k][key];
       else d.texture[k][key] = v;
     }, true));
     l.append(inp, out);

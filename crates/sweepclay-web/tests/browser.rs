@@ -2844,7 +2844,8 @@ async fn a_mesh_opens_as_an_editable_design_and_downloads_its_gcode() {
     assert!(
         note.contains("printed as the mesh is")
             && note.contains("could not be made an editable sweep")
-            && note.contains("twisted 3"),
+            && note.contains("twisted 3")
+            && note.contains("10 spiral ribs"),
         "{note}"
     );
     let twist = js(&c, "return window.sweepclay.design.twist_deg").await;

@@ -24,6 +24,7 @@ use crate::relief::Relief;
 use crate::sections::{self, signed_area2};
 
 mod rays;
+mod ribs;
 mod through;
 mod twist;
 mod uneven;
@@ -291,6 +292,19 @@ pub fn fit(mesh: &TriMesh, opts: &FitOptions) -> Result<Fitted> {
             }
         }
     }
+    // Ribs the sweep could not follow, or that two profiles' blend took
+    // up, are a texture: when that brings the design within the
+    // tolerance (with one profile, where two were), or takes a quarter
+    // off how far it is (a picture's pattern is no rib, and a rib found
+    // in it takes next to nothing off).
+    if b.deviation > tol || b.two {
+        if let Some(t) = textured(&b, &zs, height, tol) {
+            let within = t.deviation <= tol && (b.deviation > tol || !t.two);
+            if within || (b.deviation > tol && t.deviation < 0.75 * b.deviation) {
+                b = t;
+            }
+        }
+    }
     let at = b.turned(b.at, height);
     let sweep = (b.deviation > opts.tolerance_mm && opts.relief).then_some((b.deviation, at));
     if b.deviation > opts.tolerance_mm && !opts.relief {
@@ -497,6 +511,61 @@ fn twisted(psi: &[[f64; 2]], secs: &Sections) -> Option<Candidate> {
     fit_at(best.1, &[frame], 1)
 }
 
+/// The candidate's fit again with ribs taken out of its offsets as the
+/// design's texture ([`ribs::find`]): the ribs its offsets hold, and
+/// those left in what it does not fit (where two profiles' blend took
+/// up the loop's own change); the closer of the two fits, one profile
+/// first. `None` where there are none.
+fn textured(b: &Candidate, zs: &[f64], height: f64, tol: f64) -> Option<Candidate> {
+    let m = b.psi.len();
+    let mut u = crate::curves::arc_lengths(&b.psi);
+    let perimeter = u[m - 1] + crate::bspline::dist(b.psi[m - 1], b.psi[0]);
+    for x in &mut u {
+        *x /= perimeter;
+    }
+    let base = twist::twist_base();
+    let refit = |spec: crate::texture::TextureSpec| -> Candidate {
+        let field = crate::texture::Field::new(
+            std::slice::from_ref(&spec),
+            perimeter,
+            height,
+            true,
+            1.0,
+            1.0,
+        );
+        let d: Vec<Vec<f64>> =
+            b.d.iter()
+                .zip(zs)
+                .map(|(row, &z)| {
+                    row.iter()
+                        .zip(&u)
+                        .map(|(v, &u)| v - field.at(u, z, height, base))
+                        .collect()
+                })
+                .collect();
+        let mut c = fit_offsets(&b.psi, zs, &d, b.offset, height, tol);
+        // The refit may start Ψ elsewhere (where its blend is 0): the
+        // ribs' phase moves with it.
+        let start = b.psi.iter().position(|p| *p == c.psi[0]).unwrap_or(0);
+        let mut spec = spec;
+        let turns = spec.count.unwrap_or(0.0) * u[start];
+        let phase = (spec.phase_deg + 360.0 * turns + 180.0).rem_euclid(360.0) - 180.0;
+        spec.phase_deg = (phase * 10.0).round() / 10.0;
+        c.twist = b.twist;
+        c.texture = Some(spec);
+        c
+    };
+    [&b.d, &b.residual]
+        .into_iter()
+        .filter_map(|d| ribs::find(d, zs, &u, (base, height), perimeter))
+        .map(refit)
+        .min_by(|x, y| {
+            let rank = |c: &Candidate| (c.deviation > tol, c.two, c.deviation);
+            let (a, b) = (rank(x), rank(y));
+            (a.0, a.1).cmp(&(b.0, b.1)).then(a.2.total_cmp(&b.2))
+        })
+}
+
 /// The pair of lower deviation (the first of equal ones).
 fn lower(a: (f64, f64), b: (f64, f64)) -> (f64, f64) {
     if b.0 < a.0 {
@@ -532,6 +601,10 @@ struct Candidate {
     /// The mesh's offsets less the design's, section by section and ray
     /// by ray (mm).
     residual: Vec<Vec<f64>>,
+    /// The offsets fitted, section by section and ray by ray (mm).
+    d: Vec<Vec<f64>>,
+    /// Ribs taken out of the offsets as the design's texture.
+    texture: Option<crate::texture::TextureSpec>,
     /// The angle the loop is turned by and the twist (radians; 0 for
     /// none): the sections were fitted turned back by both, the first
     /// from the foot, the second as the design turns.
@@ -567,6 +640,9 @@ impl Candidate {
             "profile_start": CurveSpec { control_points: self.start.clone(), points: None },
             "trajectory": traj,
         });
+        if let Some(t) = &self.texture {
+            v["texture"] = serde_json::json!([t]);
+        }
         if self.twist.1 != 0.0 {
             // To a hundredth of a degree: 0.01° turns a 100 mm pot's rim
             // by 9 µm.
@@ -751,6 +827,8 @@ fn candidate(g: &Frame, d: &[Vec<f64>], s: &[f64], two: Option<(&[f64], &[f64])>
         deviation: worst.0,
         at: worst.1,
         residual,
+        d: d.to_vec(),
+        texture: None,
         twist: (0.0, 0.0),
     }
 }

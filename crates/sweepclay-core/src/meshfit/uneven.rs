@@ -277,6 +277,8 @@ pub(super) fn fit_uneven(
         deviation: worst.0,
         at: worst.1,
         residual,
+        d: Vec::new(),
+        texture: None,
         twist: (0.0, 0.0),
     };
     let sweep = (cand.deviation > tol && opts.relief && rim_worst.0 <= tol)

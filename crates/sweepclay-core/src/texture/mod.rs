@@ -108,6 +108,11 @@ pub struct TextureSpec {
     /// Fall to nothing over the last this many mm below the rim.
     #[serde(default, skip_serializing_if = "is_zero")]
     pub fade_out: f64,
+    /// Ripple, flute and spiral: where the sine starts (degrees, added to
+    /// its angle: 90 makes it a cosine). A mesh's ribs or rings fitted
+    /// back lie wherever they lie (docs/MESHES.md, "Textures").
+    #[serde(default, skip_serializing_if = "is_zero")]
+    pub phase_deg: f64,
     /// The decoded image (grey values), filled by [`TextureSpec::load`]
     /// from `png_base64` or by the CLI from `path`.
     #[serde(skip)]
@@ -134,6 +139,7 @@ impl TextureSpec {
         finite("amplitude", self.amplitude, -50.0, 50.0)?;
         finite("fade_in", self.fade_in, 0.0, 10_000.0)?;
         finite("fade_out", self.fade_out, 0.0, 10_000.0)?;
+        finite("phase_deg", self.phase_deg, -360.0, 360.0)?;
         let need = |name: &str, v: Option<f64>| -> Result<f64> {
             v.ok_or_else(|| Error::invalid(key, format!("a {} needs `{name}`", self.kind.name())))
         };
@@ -208,11 +214,12 @@ impl TextureSpec {
             ("deg_per_mm", self.deg_per_mm.is_some()),
             ("path", self.path.is_some()),
             ("png_base64", self.png_base64.is_some()),
+            ("phase_deg", self.phase_deg != 0.0),
         ];
         let reads: &[&str] = match self.kind {
-            Kind::Ripple => &["period"],
-            Kind::Flute => &["count", "period"],
-            Kind::Spiral => &["count", "pitch", "deg_per_mm"],
+            Kind::Ripple => &["period", "phase_deg"],
+            Kind::Flute => &["count", "period", "phase_deg"],
+            Kind::Spiral => &["count", "pitch", "deg_per_mm", "phase_deg"],
             Kind::Image => &["path", "png_base64"],
         };
         match given
@@ -447,10 +454,11 @@ impl Field {
             .iter()
             .map(|e| {
                 let s = &e.spec;
+                let p = s.phase_deg.to_radians();
                 let g = match s.kind {
-                    Kind::Ripple => (TAU * z / s.period.unwrap_or(1.0)).sin(),
-                    Kind::Flute => (TAU * e.ribs * u).sin(),
-                    Kind::Spiral => (TAU * (e.ribs * u + z * e.turn_per_mm)).sin(),
+                    Kind::Ripple => (TAU * z / s.period.unwrap_or(1.0) + p).sin(),
+                    Kind::Flute => (TAU * e.ribs * u + p).sin(),
+                    Kind::Spiral => (TAU * (e.ribs * u + z * e.turn_per_mm) + p).sin(),
                     Kind::Image => e
                         .image
                         .as_ref()
@@ -521,6 +529,28 @@ mod tests {
             r#"{{"kind": "ripple", "amplitude": {a}, "period": {p}}}"#
         ))
         .unwrap()
+    }
+
+    #[test]
+    fn a_phase_starts_the_wave_later() {
+        // A quarter turn makes the ripple's sine a cosine.
+        let mut r = ripple(2.0, 10.0);
+        r.phase_deg = 90.0;
+        let f = Field::new(&[r.clone()], 100.0, 50.0, false, 1.0, 1.0);
+        assert!((f.at(0.3, 0.0, 50.0, 0.0) - 2.0).abs() < 1e-12);
+        assert!((f.at(0.3, 5.0, 50.0, 0.0) + 2.0).abs() < 1e-12);
+        // Written only when not 0, checked in range, read by three kinds.
+        assert!(serde_json::to_string(&ripple(2.0, 10.0))
+            .unwrap()
+            .find("phase")
+            .is_none());
+        r.phase_deg = 400.0;
+        let e = r.validate("texture[0]", true).unwrap_err().to_string();
+        assert!(e.starts_with("texture[0].phase_deg"), "{e}");
+        let img: TextureSpec =
+            serde_json::from_str(r#"{"kind": "image", "amplitude": 1, "phase_deg": 30}"#).unwrap();
+        let e = img.check_keys("texture[0]").unwrap_err().to_string();
+        assert!(e.starts_with("texture[0].phase_deg"), "{e}");
     }
 
     #[test]
