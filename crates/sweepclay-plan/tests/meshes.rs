@@ -139,7 +139,8 @@ proptest! {
                 } else {
                     ""
                 };
-                eprintln!("outcome: printable, {kind}{twisted}{uneven}");
+                let ribs = if job.design().texture.is_empty() { "" } else { ", ribs" };
+                eprintln!("outcome: printable, {kind}{twisted}{ribs}{uneven}");
             }
             Err(Unchecked::Design(e)) => {
                 prop_assert!(!e.to_string().is_empty(), "{f:?}");
