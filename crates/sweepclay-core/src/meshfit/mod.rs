@@ -24,12 +24,14 @@ use crate::relief::Relief;
 use crate::sections::{self, signed_area2};
 
 mod rays;
+mod relief;
 mod ribs;
 mod through;
 mod twist;
 mod uneven;
 
 use rays::*;
+use relief::*;
 use through::*;
 use uneven::*;
 
@@ -286,8 +288,8 @@ pub fn fit(mesh: &TriMesh, opts: &FitOptions) -> Result<Fitted> {
         }
     };
     if b.deviation > tol {
-        if let Some(t) = twisted(&b.psi, &secs) {
-            if t.deviation < b.deviation && twist_holds(&t) {
+        if let Some(t) = twist::twisted(&b.psi, &secs) {
+            if t.deviation < b.deviation && twist::holds(&t) {
                 b = t;
             }
         }
@@ -298,7 +300,7 @@ pub fn fit(mesh: &TriMesh, opts: &FitOptions) -> Result<Fitted> {
     // off how far it is (a picture's pattern is no rib, and a rib found
     // in it takes next to nothing off).
     if b.deviation > tol || b.two {
-        if let Some(t) = textured(&b, &zs, height, tol) {
+        if let Some(t) = ribs::textured(&b, &zs, height, tol) {
             let within = t.deviation <= tol && (b.deviation > tol || !t.two);
             if within || (b.deviation > tol && t.deviation < 0.75 * b.deviation) {
                 b = t;
@@ -424,168 +426,6 @@ fn closest_in(
         }
     }
     best.ok_or_else(|| why.swap_remove(0))
-}
-
-/// The closest twisted sweep (docs/MESHES.md, "Twist"): the twist the
-/// sections' shapes turn by ([`twist::turns`]), then a golden-section
-/// search within 12 % of it for the twist whose untwisted sections the
-/// closest sweep fits best, fitted again on every section in the frame
-/// the estimate fitted best. `None` for a loop that shows no turn.
-fn twisted(psi: &[[f64; 2]], secs: &Sections) -> Option<Candidate> {
-    let Sections {
-        zs,
-        loops,
-        shell,
-        height,
-        ..
-    } = *secs;
-    let turns = twist::turns(loops, zs, height)?;
-    let tau = turns.twist()?;
-    // Ψ is the foot's wall as the untwisted fit found it: the design
-    // turns it by `turn0` and its twist, so the sections turned back by
-    // both lie on it above the floor's top. Where the mesh turns from its
-    // foot, the foot turned back by `turn0` is off Ψ: what the relief
-    // takes.
-    let fit_at = |t: f64, frames: &[Offset], every: usize| -> Option<Candidate> {
-        let zs: Vec<f64> = zs.iter().copied().step_by(every).collect();
-        let loops: Vec<_> = loops.iter().step_by(every).cloned().collect();
-        let turn0 = turns.turn0(t);
-        let back = twist::untwisted(&loops, &zs, (turn0, t), height);
-        let turned = Sections {
-            zs: &zs,
-            loops: &back,
-            ..*secs
-        };
-        let mut c = closest_in((frames, true), psi, &turned).ok()?;
-        c.twist = (turn0, t);
-        Some(c)
-    };
-    // The search reads every eighth section in the frame the estimate
-    // fits best, and weighs how far the sections, turned back, are from
-    // the foot's loop moved out or in: the offsets' spread round each
-    // section (their root mean square about its mean), above a millimetre
-    // over the floor's top. It needs no curves (a fit's curves and its
-    // two profiles' blend take up part of a wrong twist, unevenly from
-    // one twist to the next), and it runs smoothly with the twist.
-    let frame = fit_at(tau, &[Offset::Radial, Offset::Normal], 8)?.offset;
-    let sub: Vec<usize> = (0..zs.len())
-        .step_by(8)
-        .filter(|&k| zs[k] > twist::twist_base() + 1.0)
-        .collect();
-    let dev = |t: f64| -> f64 {
-        let zs: Vec<f64> = sub.iter().map(|&k| zs[k]).collect();
-        let loops: Vec<_> = sub.iter().map(|&k| loops[k].clone()).collect();
-        let back = twist::untwisted(&loops, &zs, (turns.turn0(t), t), height);
-        let Ok((d, _)) = offsets(psi, &zs, &back, frame, shell) else {
-            return f64::INFINITY;
-        };
-        let (sum, n) = d.iter().fold((0.0, 0usize), |(sum, n), row| {
-            let m = row.iter().sum::<f64>() / row.len() as f64;
-            (
-                sum + row.iter().map(|v| (v - m).powi(2)).sum::<f64>(),
-                n + row.len(),
-            )
-        });
-        (sum / n.max(1) as f64).sqrt()
-    };
-    let g = 0.5 * (5f64.sqrt() - 1.0);
-    let (mut a, mut b) = (tau * 0.88, tau * 1.12);
-    let (mut x1, mut x2) = (b - g * (b - a), a + g * (b - a));
-    let (mut f1, mut f2) = (dev(x1), dev(x2));
-    let mut best = (dev(tau), tau);
-    // Seven narrowings leave a thirtieth of the bracket: under 0.4 % of
-    // the twist.
-    for _ in 0..7 {
-        best = lower(lower(best, (f1, x1)), (f2, x2));
-        if f1 <= f2 {
-            (b, x2, f2) = (x2, x1, f1);
-            x1 = b - g * (b - a);
-            f1 = dev(x1);
-        } else {
-            (a, x1, f1) = (x1, x2, f2);
-            x2 = a + g * (b - a);
-            f2 = dev(x2);
-        }
-    }
-    best = lower(lower(best, (f1, x1)), (f2, x2));
-    fit_at(best.1, &[frame], 1)
-}
-
-/// The candidate's fit again with ribs taken out of its offsets as the
-/// design's texture ([`ribs::find`]): the ribs its offsets hold, and
-/// those left in what it does not fit (where two profiles' blend took
-/// up the loop's own change); the closer of the two fits, one profile
-/// first. `None` where there are none.
-fn textured(b: &Candidate, zs: &[f64], height: f64, tol: f64) -> Option<Candidate> {
-    let m = b.psi.len();
-    let mut u = crate::curves::arc_lengths(&b.psi);
-    let perimeter = u[m - 1] + crate::bspline::dist(b.psi[m - 1], b.psi[0]);
-    for x in &mut u {
-        *x /= perimeter;
-    }
-    let base = twist::twist_base();
-    let refit = |spec: crate::texture::TextureSpec| -> Candidate {
-        let field = crate::texture::Field::new(
-            std::slice::from_ref(&spec),
-            perimeter,
-            height,
-            true,
-            1.0,
-            1.0,
-        );
-        let d: Vec<Vec<f64>> =
-            b.d.iter()
-                .zip(zs)
-                .map(|(row, &z)| {
-                    row.iter()
-                        .zip(&u)
-                        .map(|(v, &u)| v - field.at(u, z, height, base))
-                        .collect()
-                })
-                .collect();
-        let mut c = fit_offsets(&b.psi, zs, &d, b.offset, height, tol);
-        // The refit may start Ψ elsewhere (where its blend is 0): the
-        // ribs' phase moves with it.
-        let start = b.psi.iter().position(|p| *p == c.psi[0]).unwrap_or(0);
-        let mut spec = spec;
-        let turns = spec.count.unwrap_or(0.0) * u[start];
-        let phase = (spec.phase_deg + 360.0 * turns + 180.0).rem_euclid(360.0) - 180.0;
-        spec.phase_deg = (phase * 10.0).round() / 10.0;
-        c.twist = b.twist;
-        c.texture = Some(spec);
-        c
-    };
-    [&b.d, &b.residual]
-        .into_iter()
-        .filter_map(|d| ribs::find(d, zs, &u, (base, height), perimeter))
-        .map(refit)
-        .min_by(|x, y| {
-            let rank = |c: &Candidate| (c.deviation > tol, c.two, c.deviation);
-            let (a, b) = (rank(x), rank(y));
-            (a.0, a.1).cmp(&(b.0, b.1)).then(a.2.total_cmp(&b.2))
-        })
-}
-
-/// The pair of lower deviation (the first of equal ones).
-fn lower(a: (f64, f64), b: (f64, f64)) -> (f64, f64) {
-    if b.0 < a.0 {
-        b
-    } else {
-        a
-    }
-}
-
-/// Whether the design's own rules take the fitted twist: one that leans
-/// the wall across itself beyond the overhang limit is refused by
-/// `twist_deg`, and the mesh is fitted untwisted instead.
-fn twist_holds(c: &Candidate) -> bool {
-    let Ok(d) = Design::from_json(&c.json("twist")) else {
-        return false;
-    };
-    !matches!(
-        crate::surface::sample_surface(&d),
-        Err(Error::Invalid { ref key, .. }) if key == "twist_deg"
-    )
 }
 
 /// A fitted form and its largest difference from the mesh.
@@ -830,66 +670,5 @@ fn candidate(g: &Frame, d: &[Vec<f64>], s: &[f64], two: Option<(&[f64], &[f64])>
         d: d.to_vec(),
         texture: None,
         twist: (0.0, 0.0),
-    }
-}
-
-/// Most rows a fitted relief keeps (and the top section): one every
-/// [`RELIEF_ROW_MM`] or more, so a design file stays a few hundred
-/// kilobytes.
-const MAX_RELIEF_ROWS: usize = 120;
-/// The least height between a relief's rows (mm): a twisted square's
-/// corner, 1 mm apart, left the surface 0.32 mm off its mesh between
-/// rows; 0.5 mm holds it within 0.3.
-const RELIEF_ROW_MM: f64 = 0.5;
-
-/// A candidate's residual as a relief (docs/MESHES.md, "Printed as the
-/// mesh is"): rows at every few sections (at least [`RELIEF_ROW_MM`]
-/// apart, at most [`MAX_RELIEF_ROWS`], the lowest and highest kept;
-/// closer, down to every section, while the design is farther than
-/// `tol` from a section between them), a column at each ray, placed by
-/// its arc length along Ψ, offsets to 0.01 mm. With it, the design's
-/// largest difference from every section and where it lies.
-fn relief_of(b: &Candidate, zs: &[f64], dz: f64, tol: f64) -> (Relief, (f64, [f64; 3])) {
-    let n = zs.len();
-    // Ψ is the design's closed polyline: each ray's place is its arc
-    // length from the first point, as the design's columns are placed.
-    let m = b.psi.len();
-    let mut u = crate::curves::arc_lengths(&b.psi);
-    let total = u[m - 1] + crate::bspline::dist(b.psi[m - 1], b.psi[0]);
-    for x in &mut u {
-        *x /= total;
-    }
-    let round = |v: f64| (v * 100.0).round() / 100.0;
-    let mut step = ((RELIEF_ROW_MM / dz).ceil() as usize)
-        .max(n.div_ceil(MAX_RELIEF_ROWS))
-        .max(1);
-    loop {
-        let mut rows: Vec<usize> = (0..n).step_by(step).collect();
-        if rows.last() != Some(&(n - 1)) {
-            rows.push(n - 1);
-        }
-        let relief = Relief {
-            z: rows.iter().map(|&k| zs[k]).collect(),
-            u: u.clone(),
-            offsets: rows
-                .iter()
-                .map(|&k| b.residual[k].iter().map(|&v| round(v)).collect())
-                .collect(),
-        };
-        let mut worst = (0.0f64, [0.0; 3]);
-        for (k, &z) in zs.iter().enumerate() {
-            for (j, &r) in b.residual[k].iter().enumerate() {
-                let e = (r - relief.at(u[j], z)).abs();
-                if e > worst.0 {
-                    worst = (e, [b.psi[j][0], b.psi[j][1], z]);
-                }
-            }
-        }
-        // A form that changes faster than the rows (a low-poly mesh's
-        // facets) keeps rows closer, down to every section.
-        if worst.0 <= tol || step == 1 {
-            return (relief, worst);
-        }
-        step = step.div_ceil(2);
     }
 }

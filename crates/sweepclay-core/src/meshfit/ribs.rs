@@ -8,6 +8,7 @@
 //! flute) or turn (a spiral, its pitch the phase's least-squares slope).
 //! Rings (a ripple) change with height alone: the profile carries them.
 
+use super::*;
 use crate::texture::{Kind, TextureSpec};
 use std::f64::consts::{PI, TAU};
 
@@ -143,6 +144,61 @@ pub(super) fn find(
 /// An angle in degrees brought within −180 to 180.
 fn wrap_deg(a: f64) -> f64 {
     (a + 180.0).rem_euclid(360.0) - 180.0
+}
+
+/// The candidate's fit again with ribs taken out of its offsets as the
+/// design's texture ([`ribs::find`]): the ribs its offsets hold, and
+/// those left in what it does not fit (where two profiles' blend took
+/// up the loop's own change); the closer of the two fits, one profile
+/// first. `None` where there are none.
+pub(super) fn textured(b: &Candidate, zs: &[f64], height: f64, tol: f64) -> Option<Candidate> {
+    let m = b.psi.len();
+    let mut u = crate::curves::arc_lengths(&b.psi);
+    let perimeter = u[m - 1] + crate::bspline::dist(b.psi[m - 1], b.psi[0]);
+    for x in &mut u {
+        *x /= perimeter;
+    }
+    let base = super::twist::twist_base();
+    let refit = |spec: crate::texture::TextureSpec| -> Candidate {
+        let field = crate::texture::Field::new(
+            std::slice::from_ref(&spec),
+            perimeter,
+            height,
+            true,
+            1.0,
+            1.0,
+        );
+        let d: Vec<Vec<f64>> =
+            b.d.iter()
+                .zip(zs)
+                .map(|(row, &z)| {
+                    row.iter()
+                        .zip(&u)
+                        .map(|(v, &u)| v - field.at(u, z, height, base))
+                        .collect()
+                })
+                .collect();
+        let mut c = fit_offsets(&b.psi, zs, &d, b.offset, height, tol);
+        // The refit may start Ψ elsewhere (where its blend is 0): the
+        // ribs' phase moves with it.
+        let start = b.psi.iter().position(|p| *p == c.psi[0]).unwrap_or(0);
+        let mut spec = spec;
+        let turns = spec.count.unwrap_or(0.0) * u[start];
+        let phase = (spec.phase_deg + 360.0 * turns + 180.0).rem_euclid(360.0) - 180.0;
+        spec.phase_deg = (phase * 10.0).round() / 10.0;
+        c.twist = b.twist;
+        c.texture = Some(spec);
+        c
+    };
+    [&b.d, &b.residual]
+        .into_iter()
+        .filter_map(|d| ribs::find(d, zs, &u, (base, height), perimeter))
+        .map(refit)
+        .min_by(|x, y| {
+            let rank = |c: &Candidate| (c.deviation > tol, c.two, c.deviation);
+            let (a, b) = (rank(x), rank(y));
+            (a.0, a.1).cmp(&(b.0, b.1)).then(a.2.total_cmp(&b.2))
+        })
 }
 
 #[cfg(test)]

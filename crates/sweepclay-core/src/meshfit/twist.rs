@@ -206,6 +206,113 @@ pub(super) fn turns(loops: &[Vec<Vec<[f64; 2]>>], zs: &[f64], height: f64) -> Op
     Some(t)
 }
 
+/// The closest twisted sweep (docs/MESHES.md, "Twist"): the twist the
+/// sections' shapes turn by ([`twist::turns`]), then a golden-section
+/// search within 12 % of it for the twist whose untwisted sections the
+/// closest sweep fits best, fitted again on every section in the frame
+/// the estimate fitted best. `None` for a loop that shows no turn.
+pub(super) fn twisted(psi: &[[f64; 2]], secs: &Sections) -> Option<Candidate> {
+    let Sections {
+        zs,
+        loops,
+        shell,
+        height,
+        ..
+    } = *secs;
+    let turns = turns(loops, zs, height)?;
+    let tau = turns.twist()?;
+    // Ψ is the foot's wall as the untwisted fit found it: the design
+    // turns it by `turn0` and its twist, so the sections turned back by
+    // both lie on it above the floor's top. Where the mesh turns from its
+    // foot, the foot turned back by `turn0` is off Ψ: what the relief
+    // takes.
+    let fit_at = |t: f64, frames: &[Offset], every: usize| -> Option<Candidate> {
+        let zs: Vec<f64> = zs.iter().copied().step_by(every).collect();
+        let loops: Vec<_> = loops.iter().step_by(every).cloned().collect();
+        let turn0 = turns.turn0(t);
+        let back = untwisted(&loops, &zs, (turn0, t), height);
+        let turned = Sections {
+            zs: &zs,
+            loops: &back,
+            ..*secs
+        };
+        let mut c = closest_in((frames, true), psi, &turned).ok()?;
+        c.twist = (turn0, t);
+        Some(c)
+    };
+    // The search reads every eighth section in the frame the estimate
+    // fits best, and weighs how far the sections, turned back, are from
+    // the foot's loop moved out or in: the offsets' spread round each
+    // section (their root mean square about its mean), above a millimetre
+    // over the floor's top. It needs no curves (a fit's curves and its
+    // two profiles' blend take up part of a wrong twist, unevenly from
+    // one twist to the next), and it runs smoothly with the twist.
+    let frame = fit_at(tau, &[Offset::Radial, Offset::Normal], 8)?.offset;
+    let sub: Vec<usize> = (0..zs.len())
+        .step_by(8)
+        .filter(|&k| zs[k] > twist_base() + 1.0)
+        .collect();
+    let dev = |t: f64| -> f64 {
+        let zs: Vec<f64> = sub.iter().map(|&k| zs[k]).collect();
+        let loops: Vec<_> = sub.iter().map(|&k| loops[k].clone()).collect();
+        let back = untwisted(&loops, &zs, (turns.turn0(t), t), height);
+        let Ok((d, _)) = offsets(psi, &zs, &back, frame, shell) else {
+            return f64::INFINITY;
+        };
+        let (sum, n) = d.iter().fold((0.0, 0usize), |(sum, n), row| {
+            let m = row.iter().sum::<f64>() / row.len() as f64;
+            (
+                sum + row.iter().map(|v| (v - m).powi(2)).sum::<f64>(),
+                n + row.len(),
+            )
+        });
+        (sum / n.max(1) as f64).sqrt()
+    };
+    let g = 0.5 * (5f64.sqrt() - 1.0);
+    let (mut a, mut b) = (tau * 0.88, tau * 1.12);
+    let (mut x1, mut x2) = (b - g * (b - a), a + g * (b - a));
+    let (mut f1, mut f2) = (dev(x1), dev(x2));
+    let mut best = (dev(tau), tau);
+    // Seven narrowings leave a thirtieth of the bracket: under 0.4 % of
+    // the twist.
+    for _ in 0..7 {
+        best = lower(lower(best, (f1, x1)), (f2, x2));
+        if f1 <= f2 {
+            (b, x2, f2) = (x2, x1, f1);
+            x1 = b - g * (b - a);
+            f1 = dev(x1);
+        } else {
+            (a, x1, f1) = (x1, x2, f2);
+            x2 = a + g * (b - a);
+            f2 = dev(x2);
+        }
+    }
+    best = lower(lower(best, (f1, x1)), (f2, x2));
+    fit_at(best.1, &[frame], 1)
+}
+
+/// The pair of lower deviation (the first of equal ones).
+fn lower(a: (f64, f64), b: (f64, f64)) -> (f64, f64) {
+    if b.0 < a.0 {
+        b
+    } else {
+        a
+    }
+}
+
+/// Whether the design's own rules take the fitted twist: one that leans
+/// the wall across itself beyond the overhang limit is refused by
+/// `twist_deg`, and the mesh is fitted untwisted instead.
+pub(super) fn holds(c: &Candidate) -> bool {
+    let Ok(d) = Design::from_json(&c.json("twist")) else {
+        return false;
+    };
+    !matches!(
+        crate::surface::sample_surface(&d),
+        Err(Error::Invalid { ref key, .. }) if key == "twist_deg"
+    )
+}
+
 #[cfg(test)]
 mod tests {
     use super::*;
