@@ -2184,7 +2184,8 @@ async fn a_vessels_surface_is_closed_round_its_loop_and_its_sliders_fit() {
             assert!(n > 0, "{example}: a wall's two ends are open");
         }
     }
-    // The ripple's sliders, on a desktop and on a phone's Settings tab.
+    // The ripple's sliders (the twist; depth, period, fades and where
+    // the wave starts), on a desktop and on a phone's Settings tab.
     c.goto(&format!("{base}/?example=ripple-vase"))
         .await
         .unwrap();
@@ -2200,7 +2201,7 @@ async fn a_vessels_surface_is_closed_round_its_loop_and_its_sliders_fit() {
     let desk = js(&c, fits).await;
     assert_eq!(
         desk,
-        json!([0, 5, true]),
+        json!([0, 6, true]),
         "desktop: overflow, outputs, all in sight"
     );
     c.set_window_size(390, 844).await.unwrap();
