@@ -455,19 +455,16 @@ impl Candidate {
     /// A place `at` in the untwisted frame the fit measures in, turned
     /// as the design turns it.
     fn turned(&self, at: [f64; 3], height: f64) -> [f64; 3] {
-        let (s, c) = (self.twist.0 + twist::turn_at(self.twist.1, at[2], height)).sin_cos();
-        [c * at[0] - s * at[1], s * at[0] + c * at[1], at[2]]
+        let angle = self.twist.0 + twist::turn_at(self.twist.1, at[2], height);
+        let [x, y] = turn_by([at[0], at[1]], angle.sin_cos());
+        [x, y, at[2]]
     }
 
     fn json(&self, name: &str) -> String {
         // The loop fitted in the frame turned back by the first angle,
         // turned forward: every ray and offset turns with it.
-        let (s, c) = self.twist.0.sin_cos();
-        let psi = self
-            .psi
-            .iter()
-            .map(|p| [c * p[0] - s * p[1], s * p[0] + c * p[1]])
-            .collect();
+        let forward = self.twist.0.sin_cos();
+        let psi = self.psi.iter().map(|&p| turn_by(p, forward)).collect();
         let traj = TrajectorySpec {
             control_points: None,
             points: Some(psi),

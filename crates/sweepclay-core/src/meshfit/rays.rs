@@ -83,6 +83,23 @@ pub(super) fn perimeter(l: &[[f64; 2]]) -> f64 {
         .sum()
 }
 
+/// `p` turned about o by the angle whose sine and cosine are `(s, c)`.
+pub(super) fn turn_by(p: [f64; 2], (s, c): (f64, f64)) -> [f64; 2] {
+    [c * p[0] - s * p[1], s * p[0] + c * p[1]]
+}
+
+/// Where each point of the closed polyline Ψ lies along it: its arc
+/// length from the first point as a fraction of the whole loop, as the
+/// design places its columns; and the loop's length (mm).
+pub(super) fn places(psi: &[[f64; 2]]) -> (Vec<f64>, f64) {
+    let mut u = crate::curves::arc_lengths(psi);
+    let total = perimeter(psi);
+    for x in &mut u {
+        *x /= total;
+    }
+    (u, total)
+}
+
 /// A loop's vertex that turns by more than this is a corner (radians):
 /// a 20° bend.
 const CORNER: f64 = 0.35;

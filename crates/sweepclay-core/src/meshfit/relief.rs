@@ -25,12 +25,7 @@ pub(super) fn relief_of(b: &Candidate, zs: &[f64], dz: f64, tol: f64) -> (Relief
     let n = zs.len();
     // Ψ is the design's closed polyline: each ray's place is its arc
     // length from the first point, as the design's columns are placed.
-    let m = b.psi.len();
-    let mut u = crate::curves::arc_lengths(&b.psi);
-    let total = u[m - 1] + crate::bspline::dist(b.psi[m - 1], b.psi[0]);
-    for x in &mut u {
-        *x /= total;
-    }
+    let (u, _) = places(&b.psi);
     let round = |v: f64| (v * 100.0).round() / 100.0;
     let mut step = ((RELIEF_ROW_MM / dz).ceil() as usize)
         .max(n.div_ceil(MAX_RELIEF_ROWS))

@@ -1,4 +1,4 @@
-//! Ribs found in a mesh (docs/MESHES.md, "Textures"): flutes (ribs
+//! Ribs found in a mesh (docs/MESHES.md, "Ribs"): flutes (ribs
 //! standing upright) and spirals (ribs that turn as they rise) are the
 //! design's `flute` and `spiral` textures. What each section's offsets
 //! change round the loop, less their mean, is read harmonic by harmonic
@@ -117,7 +117,6 @@ pub(super) fn find(
         (a + (z - mz) * (p - mp), b + (z - mz).powi(2))
     });
     let slope = sxy / sxx.max(1e-12);
-    let round = |v: f64, k: f64| (v * k).round() / k;
     let span = z[z.len() - 1] - z[0];
     // A fade under a millimetre is the sections' spacing, not a fade.
     let fade = |f: f64| if f < 1.0 { 0.0 } else { round(f, 10.0) };
@@ -137,29 +136,29 @@ pub(super) fn find(
         spec.pitch = Some(round(TAU / slope, 100.0));
         mp - slope * mz
     };
-    spec.phase_deg = round(wrap_deg(start.to_degrees()), 10.0);
+    spec.phase_deg = phase_deg(start.to_degrees());
     Some(spec)
 }
 
-/// An angle in degrees brought within −180 to 180.
-fn wrap_deg(a: f64) -> f64 {
-    (a + 180.0).rem_euclid(360.0) - 180.0
+/// `v` to the nearest 1/`k`.
+fn round(v: f64, k: f64) -> f64 {
+    (v * k).round() / k
+}
+
+/// A phase in degrees brought within −180 to 180, to a tenth.
+fn phase_deg(a: f64) -> f64 {
+    round((a + 180.0).rem_euclid(360.0) - 180.0, 10.0)
 }
 
 /// The candidate's fit again with ribs taken out of its offsets as the
-/// design's texture ([`ribs::find`]): the ribs its offsets hold, and
+/// design's texture ([`find`]): the ribs its offsets hold, and
 /// those left in what it does not fit (where two profiles' blend took
 /// up the loop's own change); the closer of the two fits, one profile
 /// first. `None` where there are none.
 pub(super) fn textured(b: &Candidate, zs: &[f64], height: f64, tol: f64) -> Option<Candidate> {
-    let m = b.psi.len();
-    let mut u = crate::curves::arc_lengths(&b.psi);
-    let perimeter = u[m - 1] + crate::bspline::dist(b.psi[m - 1], b.psi[0]);
-    for x in &mut u {
-        *x /= perimeter;
-    }
+    let (u, perimeter) = places(&b.psi);
     let base = super::twist::twist_base();
-    let refit = |spec: crate::texture::TextureSpec| -> Candidate {
+    let refit = |spec: TextureSpec| -> Candidate {
         let field = crate::texture::Field::new(
             std::slice::from_ref(&spec),
             perimeter,
@@ -184,15 +183,14 @@ pub(super) fn textured(b: &Candidate, zs: &[f64], height: f64, tol: f64) -> Opti
         let start = b.psi.iter().position(|p| *p == c.psi[0]).unwrap_or(0);
         let mut spec = spec;
         let turns = spec.count.unwrap_or(0.0) * u[start];
-        let phase = (spec.phase_deg + 360.0 * turns + 180.0).rem_euclid(360.0) - 180.0;
-        spec.phase_deg = (phase * 10.0).round() / 10.0;
+        spec.phase_deg = phase_deg(spec.phase_deg + 360.0 * turns);
         c.twist = b.twist;
         c.texture = Some(spec);
         c
     };
     [&b.d, &b.residual]
         .into_iter()
-        .filter_map(|d| ribs::find(d, zs, &u, (base, height), perimeter))
+        .filter_map(|d| find(d, zs, &u, (base, height), perimeter))
         .map(refit)
         .min_by(|x, y| {
             let rank = |c: &Candidate| (c.deviation > tol, c.two, c.deviation);

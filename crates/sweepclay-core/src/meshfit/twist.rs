@@ -38,13 +38,9 @@ pub(super) fn untwisted(
         .iter()
         .zip(zs)
         .map(|(sec, &z)| {
-            let (s, c) = (-turn0 - turn_at(tau, z, height)).sin_cos();
+            let back = (-turn0 - turn_at(tau, z, height)).sin_cos();
             sec.iter()
-                .map(|l| {
-                    l.iter()
-                        .map(|p| [c * p[0] - s * p[1], s * p[0] + c * p[1]])
-                        .collect()
-                })
+                .map(|l| l.iter().map(|&p| turn_by(p, back)).collect())
                 .collect()
         })
         .collect()
