@@ -95,7 +95,11 @@ pub fn run(a: SendArgs) -> Result<i32> {
             path.display()
         );
     }
-    let secret = keys::lookup(keys_file.as_deref(), &url).map_err(|e| anyhow::anyhow!("{e}"))?;
+    // The environment's key is for the one host this command names.
+    let secret = match keys::from_env() {
+        Some(k) => Some(k),
+        None => keys::lookup(keys_file.as_deref(), &url).map_err(|e| anyhow::anyhow!("{e}"))?,
+    };
 
     let bytes = crate::read_capped(&a.file, MAX_SEND_BYTES).map_err(|e| anyhow::anyhow!(e))?;
     // The check first: a file that fails it is not sent without --force.

@@ -4,8 +4,10 @@
 //! log (docs/PRINTING.md, "Keys").
 //!
 //! The directory is `$SWEEPCLAY_CONFIG_DIR`, else
-//! `$XDG_CONFIG_HOME/sweepclay`, else `~/.config/sweepclay`. For one
-//! command, `$SWEEPCLAY_HOST_KEY` overrides the file.
+//! `$XDG_CONFIG_HOME/sweepclay`, else `~/.config/sweepclay`. For one CLI
+//! command, `$SWEEPCLAY_HOST_KEY` overrides the file; the server never
+//! reads it. The file is also the list of hosts the user saved: a host
+//! saved without a key maps to `""`, and the server talks to no other.
 
 use crate::normalize_url;
 use std::collections::BTreeMap;
@@ -62,29 +64,90 @@ pub fn read(path: &Path) -> Result<BTreeMap<String, String>, String> {
     })
 }
 
-/// The key for `url` in the keys file, or `$SWEEPCLAY_HOST_KEY`.
+/// The key saved for `url` in the keys file, if any. A host saved
+/// without a key is `None` too: [`saved`] tells them apart.
 pub fn lookup(path: Option<&Path>, url: &str) -> Result<Option<String>, String> {
-    if let Some(k) = std::env::var_os("SWEEPCLAY_HOST_KEY") {
-        return Ok(Some(k.to_string_lossy().into_owned()));
-    }
+    Ok(saved(path, url)?.flatten())
+}
+
+/// Whether `url` is a host saved in the keys file (`Some`), and its key
+/// if it has one. The server talks only to saved hosts
+/// (docs/PRINTING.md, "What the link sends where").
+pub fn saved(path: Option<&Path>, url: &str) -> Result<Option<Option<String>>, String> {
     match path {
-        Some(p) => Ok(read(p)?.remove(&normalize_url(url))),
+        Some(p) => Ok(read(p)?
+            .remove(&normalize_url(url))
+            .map(|k| Some(k).filter(|k| !k.is_empty()))),
         None => Ok(None),
     }
 }
 
-/// Saves `key` for `url` (an empty key forgets it), written whole to a
-/// temporary file readable by its owner only, then renamed over the old.
+/// `$SWEEPCLAY_HOST_KEY`: a key for the one host a command names. Only the
+/// CLI reads it; the server never does, since a request could name any
+/// host (docs/PRINTING.md, "Keys").
+pub fn from_env() -> Option<String> {
+    std::env::var_os(ENV_KEY)
+        .map(|k| k.to_string_lossy().trim().to_string())
+        .filter(|k| !k.is_empty())
+}
+
+/// The environment variable [`from_env`] reads.
+pub const ENV_KEY: &str = "SWEEPCLAY_HOST_KEY";
+
+/// What [`update`] does to one host's entry.
+#[derive(Clone, Debug, PartialEq)]
+pub enum Change<'a> {
+    /// Save the host with this key (an empty key: the host takes none).
+    Key(&'a str),
+    /// Save the host, keeping the key it has (none if it is new).
+    Keep,
+    /// Forget the host and its key.
+    Forget,
+}
+
+/// Saves `key` for `url` (an empty key forgets it), as `sweepclay send
+/// --save-key` does.
 pub fn save(path: &Path, url: &str, key: &str) -> Result<(), String> {
-    let mut keys = read(path)?;
-    let url = normalize_url(url);
     if key.is_empty() {
-        keys.remove(&url);
+        update(path, url, Change::Forget)
     } else {
-        keys.insert(url, key.to_string());
+        update(path, url, Change::Key(key))
     }
+}
+
+/// Serialises read-modify-writes of the keys file within this process;
+/// the file lock below does it across processes.
+static WRITING: std::sync::Mutex<()> = std::sync::Mutex::new(());
+
+/// Changes one host's entry: read, change and write whole under a lock, so
+/// saves at once never lose one another; written to a temporary file
+/// readable by its owner only, then renamed over the old.
+pub fn update(path: &Path, url: &str, change: Change<'_>) -> Result<(), String> {
     let dir = path.parent().unwrap_or(Path::new("."));
     std::fs::create_dir_all(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
+    let _in_process = WRITING.lock().unwrap_or_else(|p| p.into_inner());
+    let lock_path = path.with_extension("lock");
+    let lock = std::fs::OpenOptions::new()
+        .create(true)
+        .truncate(false)
+        .write(true)
+        .open(&lock_path)
+        .map_err(|e| format!("{}: {e}", lock_path.display()))?;
+    lock.lock()
+        .map_err(|e| format!("{}: {e}", lock_path.display()))?;
+    let mut keys = read(path)?;
+    let url = normalize_url(url);
+    match change {
+        Change::Key(k) => {
+            keys.insert(url, k.to_string());
+        }
+        Change::Keep => {
+            keys.entry(url).or_default();
+        }
+        Change::Forget => {
+            keys.remove(&url);
+        }
+    }
     // tempfile creates its files 0600 on Unix.
     let mut tmp =
         tempfile::NamedTempFile::new_in(dir).map_err(|e| format!("{}: {e}", dir.display()))?;
@@ -94,6 +157,7 @@ pub fn save(path: &Path, url: &str, key: &str) -> Result<(), String> {
         .map_err(|e| format!("{}: {e}", path.display()))?;
     tmp.persist(path)
         .map_err(|e| format!("{}: {}", path.display(), e.error))?;
+    // The lock is released when `lock` is dropped.
     Ok(())
 }
 
@@ -121,7 +185,37 @@ mod tests {
         }
         save(&path, "http://octopi.local", "").unwrap();
         assert_eq!(read(&path).unwrap().len(), 1);
+        update(&path, "http://moonraker.local", Change::Keep).unwrap();
+        assert_eq!(
+            saved(Some(&path), "http://moonraker.local/"),
+            Ok(Some(None))
+        );
+        assert_eq!(saved(Some(&path), "http://other.local"), Ok(None));
+        update(&path, "http://duet.local", Change::Keep).unwrap();
+        assert_eq!(
+            lookup(Some(&path), "http://duet.local"),
+            Ok(Some("K2".into()))
+        );
         std::fs::write(&path, "[1,2]").unwrap();
         assert!(read(&path).unwrap_err().contains("not a keys file"));
+    }
+}
+
+#[cfg(test)]
+mod concurrent {
+    use super::*;
+
+    #[test]
+    fn saves_at_once_lose_none() {
+        // Before the lock, 50 saves at once kept 3 (issue: reliability 4).
+        let dir = tempfile::tempdir().unwrap();
+        let path = path_in(dir.path());
+        std::thread::scope(|s| {
+            for i in 0..50 {
+                let path = &path;
+                s.spawn(move || save(path, &format!("http://printer{i}.local"), "K").unwrap());
+            }
+        });
+        assert_eq!(read(&path).unwrap().len(), 50);
     }
 }

@@ -128,6 +128,20 @@ pub enum LinkError {
         /// The host's message, shortened.
         message: String,
     },
+    /// The host answered with a redirect. None is followed: the key would
+    /// go with it to wherever the redirect points (docs/PRINTING.md,
+    /// "What the link sends where").
+    #[error("{host} at {url} answered with a redirect (HTTP {status}) to {to}; sweepclay follows no redirect, so the key never leaves the address you saved: if that is your printer's address, put it in the printer profile")]
+    Redirect {
+        /// The host's name in messages.
+        host: &'static str,
+        /// Its address.
+        url: String,
+        /// The HTTP status.
+        status: u16,
+        /// Where it pointed, without any query (which may carry a secret).
+        to: String,
+    },
     /// An answer that is not the host's API (another program on the port).
     #[error("{host} at {url} answered something that is not its API ({why}): is the kind right?")]
     BadAnswer {
@@ -165,6 +179,13 @@ const SHORT: Duration = Duration::from_secs(15);
 const UPLOAD: Duration = Duration::from_secs(600);
 /// The most of a host's error text a message quotes.
 const QUOTE: usize = 200;
+/// The most of an answer read (bytes): a status or a file list is
+/// kilobytes; an answer past this is not the host's API, and reading it
+/// whole could exhaust the server's memory.
+pub const MAX_ANSWER: usize = 4 << 20;
+/// The most of a refusal's text read (bytes): only [`QUOTE`] characters
+/// of it are ever shown.
+const MAX_REFUSAL: usize = 64 << 10;
 
 /// A print host: its kind, address and secret.
 #[derive(Clone)]
@@ -234,6 +255,9 @@ impl Link {
             .connect_timeout(CONNECT)
             // Printers sit on the local network: no system proxy.
             .no_proxy()
+            // A redirect would carry the key (a header, or a Duet's
+            // password in the query) to wherever it points: follow none.
+            .redirect(reqwest::redirect::Policy::none())
             .build()
             .map_err(|e| LinkError::Address {
                 url: url.to_string(),
@@ -302,13 +326,16 @@ impl Link {
         self.base.join(path).unwrap_or_else(|_| self.base.clone())
     }
 
-    /// Sends a request; a failure to connect is [`LinkError::Unreachable`].
+    /// Sends a request; a failure to connect is [`LinkError::Unreachable`],
+    /// and a redirect is [`LinkError::Redirect`] (never followed).
     async fn send(
         &self,
         req: reqwest::RequestBuilder,
         timeout: Duration,
     ) -> Result<reqwest::Response, LinkError> {
-        req.timeout(timeout).send().await.map_err(|e| {
+        // The timeout runs until the answer's body is read, so a host that
+        // trickles an endless answer is cut off too.
+        let resp = req.timeout(timeout).send().await.map_err(|e| {
             let why = if e.is_timeout() {
                 format!("no answer within {} s", timeout.as_secs())
             } else if e.is_connect() {
@@ -321,12 +348,74 @@ impl Link {
                 url: self.url(),
                 why,
             }
-        })
+        })?;
+        if resp.status().is_redirection() {
+            let to = resp
+                .headers()
+                .get(reqwest::header::LOCATION)
+                .and_then(|l| l.to_str().ok())
+                .map(|l| quote(l.split(['?', '#']).next().unwrap_or("")))
+                .filter(|l| !l.is_empty())
+                .unwrap_or_else(|| "an address it did not give".to_string());
+            return Err(LinkError::Redirect {
+                host: self.kind.title(),
+                url: self.url(),
+                status: resp.status().as_u16(),
+                to,
+            });
+        }
+        Ok(resp)
     }
 
-    /// A JSON answer, or [`LinkError::BadAnswer`].
+    /// At most `cap` bytes of an answer's body, or `None` (with what was
+    /// read) when it runs past them: no answer is read into memory whole.
+    async fn capped(
+        &self,
+        mut resp: reqwest::Response,
+        cap: usize,
+    ) -> Result<(Vec<u8>, bool), LinkError> {
+        if resp.content_length().is_some_and(|n| n > cap as u64) {
+            return Ok((Vec::new(), false));
+        }
+        let mut body = Vec::new();
+        loop {
+            match resp.chunk().await {
+                Ok(Some(c)) if body.len() + c.len() > cap => {
+                    let room = cap - body.len();
+                    body.extend_from_slice(&c[..room]);
+                    return Ok((body, false));
+                }
+                Ok(Some(c)) => body.extend_from_slice(&c),
+                Ok(None) => return Ok((body, true)),
+                Err(e) if e.is_timeout() => {
+                    return Err(LinkError::Unreachable {
+                        host: self.kind.title(),
+                        url: self.url(),
+                        why: "the answer did not finish in time".to_string(),
+                    })
+                }
+                Err(e) => return Err(self.bad(plain(&e))),
+            }
+        }
+    }
+
+    /// A refusal's text, read to at most [`MAX_REFUSAL`] bytes (only its
+    /// start is ever quoted).
+    async fn text(&self, resp: reqwest::Response) -> String {
+        match self.capped(resp, MAX_REFUSAL).await {
+            Ok((b, _)) => String::from_utf8_lossy(&b).into_owned(),
+            Err(_) => String::new(),
+        }
+    }
+
+    /// A JSON answer of at most [`MAX_ANSWER`] bytes, or
+    /// [`LinkError::BadAnswer`].
     async fn json(&self, resp: reqwest::Response) -> Result<serde_json::Value, LinkError> {
-        let text = resp.text().await.map_err(|e| self.bad(plain(&e)))?;
+        let (body, whole) = self.capped(resp, MAX_ANSWER).await?;
+        if !whole {
+            return Err(self.bad(format!("an answer larger than {} MiB", MAX_ANSWER >> 20)));
+        }
+        let text = String::from_utf8_lossy(&body);
         serde_json::from_str(&text).map_err(|_| self.bad(format!("not JSON: {}", quote(&text))))
     }
 

@@ -30,7 +30,7 @@ fn says_no_klippy(text: &str) -> bool {
 
 async fn failure(link: &Link, resp: reqwest::Response) -> LinkError {
     let status = resp.status().as_u16();
-    let text = resp.text().await.unwrap_or_default();
+    let text = link.text(resp).await;
     let message = serde_json::from_str::<serde_json::Value>(&text)
         .ok()
         .and_then(|v| {

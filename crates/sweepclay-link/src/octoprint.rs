@@ -19,7 +19,7 @@ fn with_key(link: &Link, req: reqwest::RequestBuilder) -> reqwest::RequestBuilde
 /// The error for a non-success answer.
 async fn failure(link: &Link, resp: reqwest::Response, doing: Doing) -> LinkError {
     let status = resp.status().as_u16();
-    let text = resp.text().await.unwrap_or_default();
+    let text = link.text(resp).await;
     match status {
         // Without a valid key OctoPrint takes a POST for a browser's and
         // refuses it for its CSRF token.
@@ -113,7 +113,7 @@ async fn status_of(link: &Link) -> Result<Status, LinkError> {
                 host: HOST,
                 what: "API key",
             },
-            _ => link.refused(status, &resp.text().await.unwrap_or_default()),
+            _ => link.refused(status, &link.text(resp).await),
         });
     }
     let v = link.json(resp).await?;

@@ -77,7 +77,7 @@ async fn connect(link: &Link) -> Result<Session, LinkError> {
     let resp = link.send(req, SHORT).await?;
     let status = resp.status().as_u16();
     if !resp.status().is_success() {
-        return Err(link.refused(status, &resp.text().await.unwrap_or_default()));
+        return Err(link.refused(status, &link.text(resp).await));
     }
     let v = link.json(resp).await?;
     match v.get("err").and_then(|e| e.as_i64()) {
@@ -129,7 +129,7 @@ async fn answer(link: &Link, resp: reqwest::Response) -> Result<serde_json::Valu
             host: HOST,
             what: "password",
         }),
-        _ => Err(link.refused(status, &resp.text().await.unwrap_or_default())),
+        _ => Err(link.refused(status, &link.text(resp).await)),
     }
 }
 

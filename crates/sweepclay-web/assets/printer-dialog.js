@@ -163,9 +163,10 @@ $('printer-form').addEventListener('submit', (e) => {
     $('pr-error').textContent = bad[1];
     return;
   }
-  // The key goes to this computer's keys file, never into the design.
-  const key = $('pr-host-key').value;
-  if (hostKind && key) saveHostKey(hostUrl, key);
+  // The host (and its key, if typed) goes to this computer's keys file,
+  // never into the design: the server talks only to hosts saved there.
+  const key = $('pr-host-key').value.trim();
+  if (hostKind) saveHostKey(hostUrl, key);
   const kept = keptPrinters().filter((p) => p.printer.name !== printer.name);
   kept.push({ printer, nozzle_height: h });
   try {
@@ -226,7 +227,8 @@ export function fillPrinterOptions() {
 /** Saves a print host's key on the server's machine (docs/PRINTING.md). */
 async function saveHostKey(url, key) {
   try {
-    const r = await postDesign('/api/host/key', JSON.stringify({ url, key }));
+    // An empty key keeps the one saved (the page never reads it back).
+    const r = await postDesign('/api/host/key', JSON.stringify(key ? { url, key } : { url }));
     if (!r.ok) showError(`the key was not saved: ${(await r.json()).error}`);
   } catch (e) {
     showError(`the server did not answer: ${e.message || e}`);

@@ -33,15 +33,34 @@ pub(crate) struct Sent {
 }
 
 /// A link to the print host a design's printer names, with its saved key.
-fn link_for(host: &sweepclay_core::printer::PrintHost) -> Result<sweepclay_link::Link, ApiError> {
+///
+/// Only a host the user saved on this machine (the printer dialog's Save,
+/// or `sweepclay send --save-key`) is reached: a design or a request can
+/// name any address, and the server must not become a way to reach it or
+/// to hand it a key. `$SWEEPCLAY_HOST_KEY` is never read here
+/// (docs/PRINTING.md, "What the link sends where").
+fn link_for(
+    host: &sweepclay_core::printer::PrintHost,
+    key: &'static str,
+) -> Result<sweepclay_link::Link, ApiError> {
     let kind = sweepclay_link::Kind::from_name(host.kind.name()).ok_or_else(|| {
-        ApiError::new(422, "unknown print host kind").with_key("printer.host.kind")
+        ApiError::new(422, "unknown print host kind").with_key(format!("{key}.kind"))
     })?;
     let keys = sweepclay_link::keys::default_path();
-    let secret = sweepclay_link::keys::lookup(keys.as_deref(), &host.url)
-        .map_err(|e| ApiError::new(500, format!("the keys file: {e}")))?;
+    let secret = sweepclay_link::keys::saved(keys.as_deref(), &host.url)
+        .map_err(|e| ApiError::new(500, format!("the keys file: {e}")))?
+        .ok_or_else(|| {
+            ApiError::new(
+                403,
+                format!(
+                    "the print host {} is not one saved on this computer: open the printer dialog, check the address and save the printer, then send again",
+                    sweepclay_link::normalize_url(&host.url)
+                ),
+            )
+            .with_key(format!("{key}.url"))
+        })?;
     sweepclay_link::Link::new(kind, &host.url, secret)
-        .map_err(|e| ApiError::new(422, e.to_string()).with_key("printer.host.url"))
+        .map_err(|e| ApiError::new(422, e.to_string()).with_key(format!("{key}.url")))
 }
 
 /// A print host's refusal as the page shows it: 502, the host's sentence.
@@ -71,7 +90,7 @@ pub(crate) async fn send(
         Ok((text, host, d.design().name.clone()))
     })
     .await?;
-    let link = link_for(&host)?;
+    let link = link_for(&host, "printer.host")?;
     let file = link
         .upload(&name, gcode.into_bytes())
         .await
@@ -96,7 +115,7 @@ pub(crate) async fn host_status(
     let host: sweepclay_core::printer::PrintHost = serde_json::from_slice(&bytes(body)?)
         .map_err(|e| ApiError::new(400, format!("host: {e}")))?;
     host.validate("host")?;
-    link_for(&host)?
+    link_for(&host, "host")?
         .status()
         .await
         .map(Json)
@@ -107,11 +126,18 @@ pub(crate) async fn host_status(
 #[serde(deny_unknown_fields)]
 pub(crate) struct HostKey {
     url: String,
-    key: String,
+    /// The key; missing or empty keeps the one saved (the page never
+    /// reads a key back, so its field is empty when a printer is edited).
+    #[serde(default)]
+    key: Option<String>,
+    /// Forget the host and its key.
+    #[serde(default)]
+    forget: bool,
 }
 
-/// Saves a print host's key in the keys file on this machine; the page
-/// never reads it back (docs/PRINTING.md, "Keys").
+/// Saves a print host (and its key, if given) in the keys file on this
+/// machine: the hosts the server will talk to. The page never reads a key
+/// back (docs/PRINTING.md, "Keys").
 pub(crate) async fn host_key(
     body: Result<Bytes, BytesRejection>,
 ) -> Result<Json<serde_json::Value>, ApiError> {
@@ -121,10 +147,19 @@ pub(crate) async fn host_key(
         .map_err(|e| ApiError::new(422, e.to_string()).with_key("url"))?;
     let path = sweepclay_link::keys::default_path()
         .ok_or_else(|| ApiError::new(500, "no configuration directory (HOME is not set)"))?;
-    tokio::task::spawn_blocking(move || sweepclay_link::keys::save(&path, &k.url, k.key.trim()))
-        .await
-        .map_err(|e| ApiError::new(500, e.to_string()))?
-        .map_err(|e| ApiError::new(500, format!("saving the key: {e}")))?;
+    tokio::task::spawn_blocking(move || {
+        use sweepclay_link::keys::{update, Change};
+        let key = k.key.as_deref().map(str::trim).unwrap_or("");
+        let change = match (k.forget, key) {
+            (true, _) => Change::Forget,
+            (false, "") => Change::Keep,
+            (false, key) => Change::Key(key),
+        };
+        update(&path, &k.url, change)
+    })
+    .await
+    .map_err(|e| ApiError::new(500, e.to_string()))?
+    .map_err(|e| ApiError::new(500, format!("saving the key: {e}")))?;
     Ok(Json(serde_json::json!({"saved": true})))
 }
 
