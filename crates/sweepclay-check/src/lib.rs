@@ -223,6 +223,11 @@ pub const MAX_MACHINE_MM: f64 = 100_000.0;
 /// The largest bead, layer or tolerance a check accepts (mm).
 pub const MAX_BEAD_MM: f64 = 100.0;
 
+/// The widest extruder body read (radius, mm): half a metre across, past
+/// the largest clay extruder made. A body radius is a physical size; a
+/// huge one is a typo, not a printer (docs/CHECKER.md, "Collisions").
+pub const MAX_NOZZLE_RADIUS_MM: f64 = 250.0;
+
 impl CheckConfig {
     /// Checks every value: finite, positive where it must be, fractions in
     /// [0, 1], angles in (0, 90). A NaN would silently turn every test it
@@ -307,7 +312,7 @@ impl CheckConfig {
             ),
             ("e_per_mm3", self.e_per_mm3, 10_000.0),
             ("nozzle_height", self.nozzle_height, MAX_MACHINE_MM),
-            ("nozzle_radius", self.nozzle_radius, 1_000.0),
+            ("nozzle_radius", self.nozzle_radius, MAX_NOZZLE_RADIUS_MM),
             ("width_min", self.width_min, MAX_BEAD_MM),
             ("width_max", self.width_max, MAX_BEAD_MM),
             ("min_layer_mm", self.min_layer_mm, MAX_BEAD_MM),

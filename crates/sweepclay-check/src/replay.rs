@@ -4,8 +4,10 @@
 //! Klipper do), G90/G91, M82/M83, G92 (the machine's position kept apart
 //! from the file's), G20/G21, G28; M0, M1 and M600 are pauses, G4 a dwell
 //! of its length, a bare G10 a firmware retraction, M221 a flow factor;
-//! M200 D and M92 make the file one it cannot judge; unknown commands are
-//! reported, not fatal. An arc this does
+//! M200 D makes the file one it cannot judge; any other command is either
+//! on the list of those that change nothing clay sees, a pause or stop
+//! ([`PAUSES_M`], [`word_command`]), or [`Event::Unreplayed`], which the
+//! checker judges by where it stands in the file. An arc this does
 //! not replay as firmware would (another plane, no centre, a radius too
 //! short for its chord) makes the file one it cannot judge.
 
@@ -57,6 +59,94 @@ pub enum Event {
     Dwell(usize, f64),
     /// A firmware retraction (a bare `G10`, Marlin's `G10 S1`) at a line.
     Retract(usize),
+    /// A command this does not replay and that is not on the list of
+    /// those that change nothing clay sees ([`HARMLESS_M`]): fine in start
+    /// and end code, "cannot judge" inside the print (its line and name).
+    Unreplayed(usize, &'static str),
+}
+
+/// M-codes that change nothing the clay sees, anywhere in a file
+/// (docs/CHECKER.md, "Commands"): temperatures (M104, M109, M140, M190,
+/// M141, M191), fans (M106, M107), messages and reports (M105, M110, M114,
+/// M115, M117, M118, M300 a beep), progress (M73), motion limits and the
+/// speed factor (M201, M203, M204, M205, M220: time, not place or clay),
+/// waiting for moves (M400), pressure advance (M900: when, not how much),
+/// object labels (M486 with S or A only) and the mode switches replayed
+/// elsewhere.
+pub const HARMLESS_M: [f64; 22] = [
+    73.0, 104.0, 105.0, 106.0, 107.0, 109.0, 110.0, 114.0, 115.0, 117.0, 118.0, 140.0, 141.0,
+    190.0, 191.0, 201.0, 203.0, 204.0, 205.0, 220.0, 300.0, 400.0,
+];
+
+/// Pauses and stops in every dialect (docs/CHECKER.md, "Commands"): M0,
+/// M1, M25 (pause an SD print), M125 (park), M226 (wait for a pin), M600
+/// (filament change), M601 (Prusa's pause), M112 (emergency stop), M410
+/// (quick stop). Klipper's `PAUSE` and OctoPrint's `@pause` are read from
+/// their words ([`word_command`]).
+pub const PAUSES_M: [f64; 9] = [0.0, 1.0, 25.0, 125.0, 226.0, 600.0, 601.0, 112.0, 410.0];
+
+/// A line that is one of the word commands firmwares and hosts take
+/// (Klipper's extended G-code `SET_GCODE_OFFSET Z=1`, OctoPrint's
+/// `@pause`): a pause or stop, a command that changes nothing clay sees,
+/// or one not replayed. `None` for a line of G-code letters and numbers.
+pub fn word_command(raw: &[u8]) -> Option<Event> {
+    let text = std::str::from_utf8(raw).ok()?;
+    let text = text.split(';').next()?.trim();
+    let head = text.split_whitespace().next()?;
+    let host = head.starts_with('@');
+    let name = head.trim_start_matches('@');
+    let word = name.len() >= 2
+        && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
+        && name.chars().any(|c| c.is_ascii_alphabetic())
+        // G1, M104, T0, N12: letters and numbers, not a word.
+        && !(name.len() > 1
+            && name.as_bytes()[0].is_ascii_alphabetic()
+            && name[1..].chars().all(|c| c.is_ascii_digit() || c == '.' || c == '-'));
+    if !(host || word) {
+        return None;
+    }
+    let upper = name.to_ascii_uppercase();
+    let pause = [
+        "PAUSE",
+        "M0",
+        "CANCEL_PRINT",
+        "SDCARD_RESET_FILE",
+        "FIRMWARE_RESTART",
+        "RESTART",
+        "ABORT",
+    ];
+    if pause.contains(&upper.as_str()) || (host && ["ABORT", "CANCEL"].contains(&upper.as_str())) {
+        return Some(Event::Pause(0));
+    }
+    // Klipper's own commands that change nothing clay sees: messages,
+    // temperatures, fans, limits, pressure advance, object labels.
+    const HARMLESS: [&str; 14] = [
+        "RESPOND",
+        "SET_DISPLAY_TEXT",
+        "M117",
+        "SET_HEATER_TEMPERATURE",
+        "TEMPERATURE_WAIT",
+        "SET_FAN_SPEED",
+        "SET_VELOCITY_LIMIT",
+        "SET_PRESSURE_ADVANCE",
+        "SET_PRINT_STATS_INFO",
+        "EXCLUDE_OBJECT_START",
+        "EXCLUDE_OBJECT_END",
+        "EXCLUDE_OBJECT_DEFINE",
+        "SET_IDLE_TIMEOUT",
+        "UPDATE_DELAYED_GCODE",
+    ];
+    if HARMLESS.contains(&upper.as_str()) {
+        return None;
+    }
+    Some(Event::Unreplayed(
+        0,
+        if host {
+            "a host command (@…)"
+        } else {
+            "an extended command"
+        },
+    ))
 }
 
 /// Replays the lines. Returns the events; diagnostics are appended.
@@ -108,6 +198,11 @@ pub struct Replayer {
     flow: f64,
     /// Segments the arcs so far split into.
     arc_segments: usize,
+    /// The first `M92 E` (steps per mm of E): the machine's calibration,
+    /// which the printer's E per mm³ states.
+    steps_e: Option<f64>,
+    /// A later `M92 E` over the first: the clay each E now lays, relative.
+    steps_factor: f64,
 }
 
 /// Most segments a file's arcs may split into in all: 10 km of arcs in
@@ -133,6 +228,8 @@ impl Default for Replayer {
             unknown_reported: Default::default(),
             firmware: crate::Firmware::Marlin,
             plane: 17,
+            steps_e: None,
+            steps_factor: 1.0,
             segments: Vec::new(),
             cannot_judge: None,
             delta_home: None,
@@ -183,7 +280,7 @@ impl Replayer {
             self.e += de;
         }
         // `M221 S50` halves the clay of every E that follows.
-        de *= self.flow;
+        de *= self.flow * self.steps_factor;
         if let Some(f) = l.get('F') {
             self.feed = f * self.scale;
         }
@@ -338,7 +435,7 @@ impl Replayer {
             ('G', 17.0) => self.plane = 17,
             ('G', 18.0) => self.plane = 18,
             ('G', 19.0) => self.plane = 19,
-            ('M', 0.0) | ('M', 1.0) | ('M', 600.0) => return Some(Event::Pause(l.line)),
+            ('M', c) if PAUSES_M.contains(&c) => return Some(Event::Pause(l.line)),
             // A dwell: `P` milliseconds, `S` seconds (all three firmwares);
             // none, a wait for the moves to finish.
             ('G', 4.0) => {
@@ -379,11 +476,6 @@ impl Replayer {
                     );
                 }
             }
-            ('M', 92.0) if !l.params.is_empty() => self.cannot(
-                l.line,
-                "M92 changes the steps per millimetre: the moves and E after it are not the file's"
-                    .into(),
-            ),
             ('G', 20.0) => self.scale = 25.4,
             ('G', 21.0) => self.scale = 1.0,
             ('G', 28.0) => {
@@ -454,18 +546,32 @@ impl Replayer {
             }
             ('M', 82.0) => self.abs_e = true,
             ('M', 83.0) => self.abs_e = false,
-            // Known commands with no effect on the deposition.
-            ('M', c)
-                if [
-                    17.0, 18.0, 84.0, 92.0, 104.0, 105.0, 106.0, 107.0, 109.0, 110.0, 114.0, 115.0,
-                    117.0, 140.0, 190.0, 201.0, 203.0, 204.0, 205.0, 220.0, 400.0, 73.0, 107.0,
-                ]
-                .contains(&c) => {}
-            ('G', c) if [29.0, 80.0].contains(&c) => {}
-            ('T', _) => {}
+            // Commands that change nothing clay sees, anywhere.
+            ('M', c) if HARMLESS_M.contains(&c) => {}
+            ('M', 486.0) if l.params.iter().all(|(k, _)| matches!(k, 'S' | 'A')) => {}
+            // `M92` without values reports the steps; with them it is the
+            // machine's calibration ([`Event::Unreplayed`] to the checker,
+            // which judges it by where it stands).
+            ('M', 92.0) if l.params.is_empty() => {}
+            // A later `M92 E` scales E by its ratio to the first one's.
+            ('M', 92.0) if l.params.iter().all(|(k, _)| *k == 'E') => {
+                let v = l.get('E').unwrap_or(0.0);
+                match self.steps_e {
+                    Some(base) if base > 0.0 && v > 0.0 && v.is_finite() => {
+                        self.steps_factor = v / base;
+                    }
+                    _ => {
+                        self.steps_e = Some(v);
+                        return Some(Event::Unreplayed(l.line, code_name('M', 92.0)));
+                    }
+                }
+            }
             (k, c) => {
-                // One note a command, for the first 64 distinct ones.
-                if self.unknown_reported.len() < 64
+                let name = code_name(k, c);
+                // One note a command this knows nothing of, for the first
+                // 64 distinct ones (a motor switch or a probe is known).
+                if name.starts_with("an ")
+                    && self.unknown_reported.len() < 64
                     && self.unknown_reported.insert(format!("{k}{c}"))
                 {
                     diags.push(Diagnostic {
@@ -473,9 +579,27 @@ impl Replayer {
                         message: format!("unknown command {k}{c} ignored"),
                     });
                 }
+                return Some(Event::Unreplayed(l.line, name));
             }
         }
         None
+    }
+}
+
+/// A short name for a command not replayed, for the "cannot judge" line.
+fn code_name(k: char, c: f64) -> &'static str {
+    match (k, c) {
+        ('M', 92.0) => "M92 (steps per millimetre)",
+        ('M', 17.0) | ('M', 18.0) | ('M', 84.0) => "a motor switch (M17/M18/M84)",
+        ('M', 206.0) | ('M', 290.0) => "an offset of Z (M206/M290)",
+        ('G', 29.0) | ('G', 80.0) => "bed probing (G29/G80)",
+        ('G', 53.0) => "machine coordinates (G53)",
+        ('G', 38.0) => "a probing move (G38)",
+        ('G', 12.0) => "a nozzle cleaning move (G12)",
+        ('T', _) => "a tool change (T)",
+        ('G', _) => "an unknown G command",
+        ('M', _) => "an unknown M command",
+        _ => "an unknown command",
     }
 }
 

@@ -118,6 +118,128 @@ fn nozzle_below_a_printed_wall_fails() {
 }
 
 #[test]
+fn commands_inside_the_print_are_replayed_refused_or_harmless() {
+    // Each was skipped before, and the file "printable" (reliability
+    // round 4). Inside the print: a pause or stop fails as a pause; a
+    // command not replayed is "cannot judge" naming its line; the listed
+    // harmless ones change nothing. In the start or end code, none counts.
+    let g = wall(6);
+    let lines: Vec<&str> = g.out.lines().collect();
+    let mid = lines.len() / 2;
+    let with = |at: usize, cmd: &str| {
+        let mut l = lines.clone();
+        l.insert(at, cmd);
+        l.join("\n") + "\n"
+    };
+    assert!(verdict(&g.out).printable);
+    let pauses = [
+        "M0",
+        "M1",
+        "M25",
+        "M125",
+        "M226 P1 S1",
+        "M600",
+        "M601",
+        "M112",
+        "M410",
+        "PAUSE",
+        "@pause",
+        "CANCEL_PRINT",
+    ];
+    for cmd in pauses {
+        let r = verdict(&with(mid, cmd));
+        fails_for(&r, "pause", &["extrusion runs"]);
+        assert_eq!(r.findings[Finding::Pause].count, 1, "{cmd}");
+    }
+    let unreplayed = [
+        "M290 Z-5",
+        "M206 Z-20",
+        "SET_GCODE_OFFSET Z=20",
+        "G53 G1 Z0",
+        "G38.2 Z-10",
+        "G29",
+        "G12",
+        "T1",
+        "M84",
+        "M18",
+        "M92 E400",
+        "M92 X80 Y80",
+        "M999",
+        "@mymacro",
+        "M486 C",
+    ];
+    for cmd in unreplayed {
+        let r = verdict(&with(mid, cmd));
+        let c = r
+            .cannot_judge
+            .as_ref()
+            .unwrap_or_else(|| panic!("{cmd}: {}", r.render()));
+        assert_eq!(c.line, mid + 1, "{cmd}");
+        assert!(
+            c.message.contains("inside the print"),
+            "{cmd}: {}",
+            c.message
+        );
+        // Before the first bead and after the last: start and end code.
+        let start = lines
+            .iter()
+            .position(|l| l.starts_with("G0 F2400"))
+            .unwrap();
+        for at in [start, lines.len()] {
+            let r = verdict(&with(at, cmd));
+            assert!(
+                r.printable && r.cannot_judge.is_none(),
+                "{cmd} at {at}: {}",
+                r.render()
+            );
+        }
+    }
+    let harmless = [
+        "M106 S255",
+        "M107",
+        "M104 S0",
+        "M140 S0",
+        "M117 half way",
+        "M73 P50",
+        "M400",
+        "M204 S500",
+        "M220 S80",
+        "SET_FAN_SPEED FAN=f SPEED=1",
+        "RESPOND MSG=hi",
+        "M486 S1",
+        "M92",
+    ];
+    for cmd in harmless {
+        let r = verdict(&with(mid, cmd));
+        assert!(r.printable, "{cmd}: {}", r.render());
+    }
+    // A later M92 E scales E by its ratio to the first: 400 → 800 steps
+    // doubles the clay of every bead after it.
+    let twice = with(mid, "M92 E800");
+    let twice = format!("M92 E400\n{twice}");
+    let r = verdict(&twice);
+    assert!(r.cannot_judge.is_none(), "{}", r.render());
+    assert!(
+        r.volume_ml > verdict(&g.out).volume_ml * 1.3,
+        "{}",
+        r.render()
+    );
+}
+
+#[test]
+fn an_extruder_body_past_any_clay_extruder_is_refused_by_name() {
+    let huge = CheckConfig {
+        nozzle_radius: 1000.0,
+        ..CheckConfig::default()
+    };
+    assert!(huge
+        .validate()
+        .unwrap_err()
+        .to_string()
+        .contains("nozzle_radius"));
+}
+
+#[test]
 fn clay_far_outside_the_bed_is_still_seen() {
     // The collision fixture 250 mm beyond a 200 mm bed (past the indexed
     // margin): its cells are shared with the bed's border, and the

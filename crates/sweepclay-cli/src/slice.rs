@@ -285,23 +285,31 @@ pub(crate) fn slice_design(a: SliceArgs, text: String, source: String) -> Result
             );
         }
     }
-    let tmp = temp_beside(&out)?;
-    let file = tmp
-        .reopen()
-        .with_context(|| format!("opening {}", tmp.path().display()))?;
-    let checked = match plan(&job, &Cancel::new(), || {
+    // The temporary file is made when the G-code starts to stream, after
+    // the sampling and planning that take the memory: a run that dies
+    // there (killed, out of memory) leaves nothing beside the output.
+    let mut made: Option<(tempfile::NamedTempFile, std::fs::File)> = None;
+    let planned = plan(&job, &Cancel::new(), || {
         use std::io::{Seek, SeekFrom};
-        let mut f = &file;
+        if made.is_none() {
+            let tmp = temp_beside(&out).map_err(std::io::Error::other)?;
+            let file = tmp.reopen()?;
+            made = Some((tmp, file));
+        }
+        let (_, file) = made.as_ref().expect("made above");
+        let mut f = file.try_clone()?;
         f.set_len(0)?;
         f.seek(SeekFrom::Start(0))?;
         Ok(std::io::BufWriter::with_capacity(1 << 16, f))
-    }) {
+    });
+    let checked = match planned {
         Ok(p) => p.checked,
         Err(Unchecked::Design(e)) => return Err(e).with_context(|| source.clone()),
         Err(Unchecked::Io(e)) => {
-            return Err(e).with_context(|| format!("writing {}", tmp.path().display()))
+            return Err(e).with_context(|| format!("writing beside {}", out.display()))
         }
     };
+    let (tmp, _) = made.context("the plan wrote no G-code")?;
     let advice = checked.advice();
     let Checked {
         sliced,
@@ -405,13 +413,21 @@ pub(crate) fn slice_design(a: SliceArgs, text: String, source: String) -> Result
             st.volume_ml,
             st.clay_g
         );
-        for r in &st.refills {
+        const LISTED: usize = 10;
+        for r in st.refills.iter().take(LISTED) {
             say!(
                 "  refill             after {:.0} ml: layer {}, {:.1} mm up, {:.0} % of the path",
                 r.after_ml,
                 r.pass,
                 r.z_mm,
                 r.share * 100.0
+            );
+        }
+        if let (Some(c), true) = (printer.cartridge_ml, st.refills.len() > LISTED) {
+            let more = (st.volume_ml / c).ceil() - 1.0 - LISTED as f64;
+            say!(
+                "  refill             … and {more:.0} more (see --json for the first {})",
+                st.refills.len()
             );
         }
         if st.print_scale != [1.0, 1.0] {

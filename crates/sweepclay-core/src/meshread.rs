@@ -244,29 +244,36 @@ fn read_obj(bytes: &[u8]) -> Result<TriMesh> {
             }
             Some("f") => {
                 let n = m.vertices.len() as i64;
-                let idx: Vec<u32> = words
-                    .map(|w| {
-                        let i: i64 = w
-                            .split('/')
-                            .next()
-                            .unwrap_or("")
-                            .parse()
-                            .map_err(|_| bad("a face's index is not a number"))?;
-                        let i = if i < 0 { n + i } else { i - 1 };
-                        if i < 0 || i >= n {
-                            return Err(bad("a face names a vertex not yet given"));
+                let index = |w: &str| {
+                    let i: i64 = w
+                        .split('/')
+                        .next()
+                        .unwrap_or("")
+                        .parse()
+                        .map_err(|_| bad("a face's index is not a number"))?;
+                    let i = if i < 0 { n + i } else { i - 1 };
+                    if i < 0 || i >= n {
+                        return Err(bad("a face names a vertex not yet given"));
+                    }
+                    Ok(i as u32)
+                };
+                // Fanned as it is read, the cap checked before each
+                // triangle: a face of millions of indices is never held.
+                let (first, mut prev, mut count) = (words.next(), None, 0usize);
+                let first = first.map(index).transpose()?;
+                for w in words {
+                    let i = index(w)?;
+                    if let (Some(a), Some(b)) = (first, prev) {
+                        if m.triangles.len() >= MAX_TRIANGLES {
+                            return Err(bad(&format!("over the cap of {MAX_TRIANGLES} triangles")));
                         }
-                        Ok(i as u32)
-                    })
-                    .collect::<Result<_>>()?;
-                if idx.len() < 3 {
+                        m.triangles.push([a, b, i]);
+                    }
+                    prev = Some(i);
+                    count += 1;
+                }
+                if first.is_none() || count < 2 {
                     return Err(bad("a face needs three vertices"));
-                }
-                for j in 1..idx.len() - 1 {
-                    m.triangles.push([idx[0], idx[j], idx[j + 1]]);
-                }
-                if m.triangles.len() > MAX_TRIANGLES {
-                    return Err(bad(&format!("over the cap of {MAX_TRIANGLES} triangles")));
                 }
             }
             _ => {}
@@ -289,8 +296,24 @@ mod tests {
         assert_eq!(m.triangles, vec![[0, 1, 2], [0, 2, 3]]);
         let e = TriMesh::read("x.obj", b"v 0 0 0\nf 1 2 3\n").unwrap_err();
         assert!(e.to_string().contains("OBJ line 2"), "{e}");
+        let e = TriMesh::read("x.obj", b"v 0 0 0\nv 1 0 0\nf 1 2\n").unwrap_err();
+        assert!(e.to_string().contains("three vertices"), "{e}");
         let e = TriMesh::read("x.ply", b"").unwrap_err();
         assert!(e.to_string().contains("STL or OBJ"), "{e}");
+    }
+
+    #[test]
+    fn a_face_of_millions_of_indices_stops_at_the_cap_unexpanded() {
+        // Before, the face's indices were collected and fanned whole (a 95
+        // MB OBJ took 1.6 GB) before the cap was checked.
+        let mut obj = String::from("v 0 0 0\nv 1 0 0\nv 0 1 0\nf");
+        obj.reserve(2 * (MAX_TRIANGLES + 10));
+        for k in 0..MAX_TRIANGLES + 10 {
+            obj.push_str(if k % 2 == 0 { " 1" } else { " 2" });
+        }
+        obj.push('\n');
+        let e = TriMesh::read("fan.obj", obj.as_bytes()).unwrap_err();
+        assert!(e.to_string().contains("over the cap"), "{e}");
     }
 
     #[test]

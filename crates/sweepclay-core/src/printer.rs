@@ -408,31 +408,59 @@ impl Printer {
         if let Some(d) = self.bed_diameter {
             positive(&format!("{key}.bed_diameter"), d)?;
         }
-        positive(&format!("{key}.travel_feedrate"), self.travel_feedrate)?;
-        positive(&format!("{key}.clay_density_g_ml"), self.clay_density_g_ml)?;
-        positive(
-            &format!("{key}.acceleration_mm_s2"),
-            self.acceleration_mm_s2,
+        // Each rate and amount within what a clay printer can have, so no
+        // number makes a summary, a time or a list run away.
+        let k = |f: &str| format!("{key}.{f}");
+        within(
+            &k("travel_feedrate"),
+            self.travel_feedrate,
+            1.0,
+            1e6,
+            "mm/min",
         )?;
-        positive(
-            &format!("{key}.junction_deviation_mm"),
+        within(
+            &k("clay_density_g_ml"),
+            self.clay_density_g_ml,
+            0.5,
+            5.0,
+            "g/ml",
+        )?;
+        within(
+            &k("acceleration_mm_s2"),
+            self.acceleration_mm_s2,
+            1.0,
+            1e6,
+            "mm/s²",
+        )?;
+        within(
+            &k("junction_deviation_mm"),
             self.junction_deviation_mm,
+            1e-4,
+            10.0,
+            "mm",
         )?;
         for i in 0..3 {
-            positive(
-                &format!("{key}.max_speed_mm_s[{i}]"),
+            within(
+                &k(&format!("max_speed_mm_s[{i}]")),
                 self.max_speed_mm_s[i],
+                0.01,
+                1e4,
+                "mm/s",
             )?;
-            positive(
-                &format!("{key}.max_acceleration_mm_s2[{i}]"),
+            within(
+                &k(&format!("max_acceleration_mm_s2[{i}]")),
                 self.max_acceleration_mm_s2[i],
+                1.0,
+                1e6,
+                "mm/s²",
             )?;
         }
         if let Some(f) = self.max_flow_mm3_s {
-            positive(&format!("{key}.max_flow_mm3_s"), f)?;
+            within(&k("max_flow_mm3_s"), f, 0.01, 1e6, "mm³/s")?;
         }
         if let Some(c) = self.cartridge_ml {
-            positive(&format!("{key}.cartridge_ml"), c)?;
+            // From a 1 ml syringe to a 100 l tank.
+            within(&k("cartridge_ml"), c, 1.0, 100_000.0, "ml")?;
         }
         if let Some(d) = self.nozzle_diameter {
             if !(d.is_finite() && d > 0.0 && d <= 100.0) {
@@ -500,8 +528,9 @@ pub const MAX_MACHINE_MM: f64 = 100_000.0;
 /// The most E per mm³ of clay a printer may name, as `check` reads it.
 pub const MAX_E_PER_MM3: f64 = 10_000.0;
 
-/// The widest extruder body a printer may name (mm), as `check` reads it.
-pub const MAX_NOZZLE_RADIUS_MM: f64 = 1_000.0;
+/// The widest extruder body a printer may name (radius, mm), as `check`
+/// reads it: half a metre across, past the largest clay extruder made.
+pub const MAX_NOZZLE_RADIUS_MM: f64 = 250.0;
 
 /// The `printer` key: a preset name or an inline profile.
 #[derive(Clone, Debug, PartialEq)]
@@ -561,6 +590,18 @@ impl<'de> Deserialize<'de> for PrinterRef {
     }
 }
 
+/// `v` within `lo..=hi` (in `unit`), or an error naming `key`.
+fn within(key: &str, v: f64, lo: f64, hi: f64, unit: &str) -> Result<()> {
+    if v.is_finite() && (lo..=hi).contains(&v) {
+        Ok(())
+    } else {
+        Err(Error::invalid(
+            key,
+            format!("must be from {lo} to {hi} {unit} (got {v})"),
+        ))
+    }
+}
+
 fn positive(key: &str, v: f64) -> Result<()> {
     if v.is_finite() && v > 0.0 {
         Ok(())
@@ -588,7 +629,7 @@ mod tests {
         p.nozzle_radius = 2000.0;
         let e = p.validate("printer").unwrap_err().to_string();
         assert!(
-            e.starts_with("printer.nozzle_radius: must be at most 1000"),
+            e.starts_with("printer.nozzle_radius: must be at most 250"),
             "{e}"
         );
         let d = crate::Design::from_json(

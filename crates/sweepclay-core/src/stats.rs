@@ -82,6 +82,8 @@ pub struct Refill {
 /// `volume[i]` is the clay of the move ending at `points[i]` (mm³).
 pub fn refills(points: &[toolpath::PathPoint], volume: &[f64], cartridge_ml: f64) -> Vec<Refill> {
     let mut out = Vec::new();
+    // The number of cartridges is the clay over one; only the first
+    // refills are placed (a tiny cartridge must not list millions).
     if cartridge_ml.is_nan() || cartridge_ml <= 0.0 {
         return out;
     }
@@ -103,7 +105,7 @@ pub fn refills(points: &[toolpath::PathPoint], volume: &[f64], cartridge_ml: f64
             .hypot(p.pos[2] - q[2]);
         // A cartridge is empty once the clay passes it (a refill per
         // cartridge, however many a long move empties).
-        while clay > cap * (out.len() + 1) as f64 + 1e-9 {
+        while clay > cap * (out.len() + 1) as f64 + 1e-9 && out.len() < MAX_REFILLS {
             out.push(Refill {
                 after_ml: cap * (out.len() + 1) as f64 / 1000.0,
                 pass: p.pass,
@@ -345,6 +347,9 @@ pub(crate) fn planned_min(c: &Corrected, t: &Toolpath, e: &Extrusion) -> f64 {
     motion::print_time(start, moves, &motion::Limits::of(&c.surface.printer)) / 60.0
 }
 
+/// The most refills [`refills`] places.
+pub const MAX_REFILLS: usize = 100;
+
 /// The warnings of [`Stats::warnings`].
 pub(crate) fn warnings(pr: &Printer, t: &Toolpath, e: &Extrusion) -> Vec<String> {
     let mut w = Vec::new();
@@ -352,6 +357,7 @@ pub(crate) fn warnings(pr: &Printer, t: &Toolpath, e: &Extrusion) -> Vec<String>
     if let Some(c) = pr.cartridge_ml.filter(|&c| ml > c) {
         let at: Vec<String> = refills(&t.points, &e.volume, c)
             .iter()
+            .take(5)
             .map(|r| {
                 format!(
                     "layer {} at {:.1} mm ({:.0} % of the path)",
@@ -362,10 +368,11 @@ pub(crate) fn warnings(pr: &Printer, t: &Toolpath, e: &Extrusion) -> Vec<String>
             })
             .collect();
         w.push(format!(
-            "the print needs {ml:.0} ml of clay, more than printer `{}`'s cartridge holds ({c:.0} ml): {} cartridges, refilled at {}; a refill breaks the one continuous extrusion, so make it smaller or thinner, or use a larger cartridge",
+            "the print needs {ml:.0} ml of clay, more than printer `{}`'s cartridge holds ({c:.0} ml): {} cartridges, refilled at {}{}; a refill breaks the one continuous extrusion, so make it smaller or thinner, or use a larger cartridge",
             pr.name,
-            at.len() + 1,
-            at.join(", ")
+            (ml / c).ceil(),
+            at.join(", "),
+            if (ml / c).ceil() > 6.0 { ", …" } else { "" }
         ));
     }
     w

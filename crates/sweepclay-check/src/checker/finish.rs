@@ -97,11 +97,28 @@ impl Checker<'_> {
         r.diagnostics = self.diags;
         r.printer = self.cfg.printer.clone();
         r.firmware = self.cfg.firmware.name().to_string();
-        r.cannot_judge = self
-            .replayer
-            .cannot_judge
-            .take()
-            .map(|(line, message)| Diagnostic { line, message });
+        // A command the replay does not follow, between the print's first
+        // bead and its last: what the clay sees after it is unknown.
+        let print_line = self
+            .lead
+            .print_run
+            .and_then(|k| self.lead.runs.get(k))
+            .map_or(0, |run| run.line);
+        let inside = self
+            .unreplayed_inside
+            .iter()
+            .find(|(line, _)| *line > print_line)
+            .map(|&(line, name)| {
+                (
+                    line,
+                    format!("{name} inside the print: the checker does not replay it, and it may change where the nozzle goes or how much clay it lays (docs/CHECKER.md, \"Commands\"); move it to the start or end code"),
+                )
+            });
+        let first = match (self.replayer.cannot_judge.take(), inside) {
+            (Some(a), Some(b)) => Some(if a.0 <= b.0 { a } else { b }),
+            (a, b) => a.or(b),
+        };
+        r.cannot_judge = first.map(|(line, message)| Diagnostic { line, message });
         verdict(r, self.cfg);
         self.r
     }

@@ -272,7 +272,27 @@ struct Checker<'a> {
     walk: Walk,
     /// Letting old clay go ([`memory`]).
     memory: memory::Memory,
+    /// Commands not replayed since the last bead (line, name; the first
+    /// [`MAX_UNREPLAYED`]): inside the print once a bead follows them.
+    unreplayed_since: Vec<(usize, &'static str)>,
+    /// Commands not replayed with beads before and after them.
+    unreplayed_inside: Vec<(usize, &'static str)>,
 }
+
+/// Whether a line starts with a word command rather than a letter and a
+/// number: `@…`, or two letters (or a letter and `_`) at its start. Cheap:
+/// the checker asks it of every line.
+fn word_like(raw: &[u8]) -> bool {
+    let mut b = raw.iter().skip_while(|c| c.is_ascii_whitespace());
+    match (b.next(), b.next()) {
+        (Some(b'@'), _) => true,
+        (Some(a), Some(c)) => a.is_ascii_alphabetic() && (c.is_ascii_alphabetic() || *c == b'_'),
+        _ => false,
+    }
+}
+
+/// Most commands not replayed kept between two beads, and in all.
+const MAX_UNREPLAYED: usize = 64;
 
 impl<'a> Checker<'a> {
     fn new(cfg: &'a CheckConfig) -> Self {
@@ -340,6 +360,8 @@ impl<'a> Checker<'a> {
                     .tan(),
             walk: Walk::Auto,
             memory: memory::Memory::new(cfg, memory::KEPT_BEADS),
+            unreplayed_since: Vec::new(),
+            unreplayed_inside: Vec::new(),
         }
     }
 
@@ -395,7 +417,15 @@ impl<'a> Checker<'a> {
         let parsed = self
             .parser
             .parse_bytes(raw, n, &mut self.diags, &mut self.line);
-        let event = if parsed {
+        let event = if word_like(raw) {
+            // Klipper's `PAUSE`, `SET_GCODE_OFFSET Z=1`, OctoPrint's
+            // `@pause`: read as words, not letters and numbers.
+            crate::replay::word_command(raw).map(|e| match e {
+                Event::Pause(_) => Event::Pause(n),
+                Event::Unreplayed(_, name) => Event::Unreplayed(n, name),
+                e => e,
+            })
+        } else if parsed {
             self.replayer.feed(&self.line, &mut self.diags)
         } else {
             None
@@ -416,6 +446,14 @@ impl<'a> Checker<'a> {
                     self.in_run = false;
                 }
             }
+            // Before the first bead, start code; after the last, end code;
+            // between two beads, a command the replay cannot follow.
+            Some(Event::Unreplayed(line, name))
+                if self.started && self.unreplayed_since.len() < MAX_UNREPLAYED =>
+            {
+                self.unreplayed_since.push((line, name));
+            }
+            Some(Event::Unreplayed(..)) => {}
             Some(Event::Retract(line)) => {
                 self.pending.push(((Finding::Retraction), line, 0.0));
                 self.in_run = false;

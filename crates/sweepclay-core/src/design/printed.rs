@@ -150,13 +150,75 @@ impl Design {
         d
     }
 
+    /// Refuses, before anything is sampled, a control point that puts the
+    /// surface far outside the printer: a curve lies within its control
+    /// points' hull, so Ψ's points and the profiles' widest offset bound
+    /// the surface. Past the build volume by more than the volume's own
+    /// size, no design fits, and sampling one (a profile point 100 km
+    /// out) would take gigabytes before the exact check after sampling
+    /// could say so. The point is named.
+    fn reach_within(&self, this: &Design, pr: &crate::Printer) -> crate::Result<()> {
+        let profiles = [
+            ("profile_start", &this.profile_start),
+            ("profile_end", &this.end_profile()),
+        ];
+        let widest = profiles
+            .iter()
+            .flat_map(|(k, c)| {
+                c.control_points
+                    .iter()
+                    .enumerate()
+                    .map(move |(i, p)| (*k, i, p[0].abs()))
+            })
+            .fold(
+                ("profile_start", 0, 0.0f64),
+                |m, x| if x.2 > m.2 { x } else { m },
+            );
+        let t = &this.trajectory;
+        let key = if t.control_points.is_some() {
+            "control_points"
+        } else {
+            "points"
+        };
+        for (i, p) in t.given_points().iter().enumerate() {
+            for a in 0..2 {
+                let (min, size) = (pr.bed_min[a], pr.build_volume[a]);
+                let at = pr.origin[a] + p[a];
+                let (lo, hi) = (at - widest.2, at + widest.2);
+                if lo > min + 2.0 * size || hi < min - size {
+                    return Err(Error::invalid(
+                        format!("trajectory.{key}[{i}]"),
+                        format!(
+                            "the design does not fit printer `{1}`: this point puts the piece at {0} = {at:.0} mm, and the build volume spans {min:.0}..{2:.0} mm",
+                            ['x', 'y'][a],
+                            pr.name,
+                            min + size
+                        ),
+                    ));
+                }
+            }
+        }
+        let room = pr.build_volume[0].max(pr.build_volume[1]);
+        if widest.2 > room {
+            let (k, i, x) = widest;
+            return Err(Error::invalid(
+                format!("{k}.control_points[{i}]"),
+                format!(
+                    "the design does not fit printer `{}`: this point sets the wall {x:.0} mm out from its path, more than the whole build volume ({room:.0} mm)",
+                    pr.name
+                ),
+            ));
+        }
+        Ok(())
+    }
+
     /// Refuses, before anything is sampled, a design that cannot fit its
     /// printer: the surface starts and ends at Ψ's first and last points
     /// on the bed and is as tall there as the profiles, so if those leave
     /// the build volume the whole does ([`Error::DoesNotFit`], as slicing
     /// would say). A closed B-spline Ψ does not pass through its control
-    /// points, so for a closed Ψ only the height is checked here (slicing
-    /// checks the rest). [`crate::check_size`] adds the cap on work.
+    /// points, so for a closed Ψ the height and the reach of its control points are
+    /// checked here (slicing checks the rest). [`crate::check_size`] adds the cap on work.
     pub fn check_fit(&self) -> crate::Result<()> {
         let printed = self.printed();
         let this = &printed;
@@ -179,6 +241,7 @@ impl Design {
         }
         lo[2] = 0.0;
         hi[2] = top(&this.profile_start).max(top(&this.end_profile()));
+        self.reach_within(this, &pr)?;
         for a in 0..3 {
             let (min, max) = (pr.bed_min[a], pr.bed_min[a] + pr.build_volume[a]);
             if lo[a] < min - 1e-9 || hi[a] > max + 1e-9 {

@@ -173,6 +173,19 @@ pub fn fit(mesh: &TriMesh, opts: &FitOptions) -> Result<Fitted> {
         ));
     }
     let n = ((height / SECTION_MM) as usize).clamp(20, MAX_SECTIONS);
+    // Tall, narrow facets cross many heights each: fewer sections keep the
+    // cut's work (and memory) bounded by the mesh read (docs/MESHES.md,
+    // "Work and memory").
+    let n = sections::sections_within(mesh, lo[2], height, n, 20).ok_or_else(|| {
+        Error::invalid(
+            "mesh",
+            format!(
+                "has {} triangles, so many of them tall that cutting even 20 sections computes over {} segments; decimate it (Blender's Decimate, MeshLab's Quadric Edge Collapse)",
+                mesh.triangles.len(),
+                sections::MAX_SEGMENTS
+            ),
+        )
+    })?;
     let dz = height / n as f64;
     let mut cut = sections::cut(mesh, lo[2] + 0.5 * dz, dz, n, lo[2])?;
     // A rim that is not quite level (a helix's last turn, a rim's
