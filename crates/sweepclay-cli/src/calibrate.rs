@@ -60,6 +60,7 @@ pub fn run(a: CalibrateArgs) -> Result<i32> {
                 report.render().lines().next().unwrap_or("")
             );
         }
+        crate::files::not_an_input("-o", &a.output, &[std::path::Path::new(&a.printer)])?;
         write_atomic(&a.output, print.gcode.as_bytes())?;
         say(format_args!(
             "wrote      {} ({} bands, checked: printable, {:.0} ml of clay)\n",

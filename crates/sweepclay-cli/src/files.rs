@@ -54,6 +54,25 @@ pub(crate) fn output_target(path: &Path) -> Result<PathBuf> {
     }
 }
 
+/// Refuses an output (`flag` `target`) that is one of the command's
+/// input files: `calibrate --printer P.json -o P.json` wrote the print
+/// over the profile it read. Paths that do not exist are no input.
+pub(crate) fn not_an_input(flag: &str, target: &Path, inputs: &[&Path]) -> Result<()> {
+    let Ok(out) = std::fs::canonicalize(target) else {
+        return Ok(());
+    };
+    for input in inputs {
+        if std::fs::canonicalize(input).is_ok_and(|i| i == out) {
+            bail!(
+                "{flag} {}: that is an input ({}); refusing to write over it",
+                target.display(),
+                input.display()
+            );
+        }
+    }
+    Ok(())
+}
+
 /// The prefix of our temporary files: `.sweepclay-tmp-NAME.` and random
 /// letters, beside the file NAME they will replace.
 pub(crate) const TMP_PREFIX: &str = ".sweepclay-tmp-";

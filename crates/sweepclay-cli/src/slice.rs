@@ -74,6 +74,10 @@ pub(crate) struct ImportArgs {
     /// Printer preset or printer JSON file for the design.
     #[arg(long)]
     pub(crate) printer: Option<String>,
+    /// Replace the design file if it exists (it may hold edits made since
+    /// the last import).
+    #[arg(long)]
+    pub(crate) force: bool,
 }
 
 /// The most bytes of a mesh file read: a binary STL of the triangle cap.
@@ -171,9 +175,14 @@ pub(crate) fn import_cmd(a: ImportArgs) -> Result<i32> {
         .clone()
         .unwrap_or_else(|| a.mesh.with_extension("json"));
     let out = output_target(&out)?;
-    if std::fs::canonicalize(&out).ok() == std::fs::canonicalize(&a.mesh).ok() {
+    let printer_file = a.printer.as_deref().map(Path::new);
+    let inputs: Vec<&Path> = std::iter::once(a.mesh.as_path())
+        .chain(printer_file)
+        .collect();
+    not_an_input("-o", &out, &inputs)?;
+    if out.exists() && !a.force {
         bail!(
-            "-o {}: that is the mesh; refusing to write over it",
+            "{} exists (it may hold edits made since it was imported); refusing to replace it: give -o another name, or --force to replace it",
             out.display()
         );
     }

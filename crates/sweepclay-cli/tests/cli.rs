@@ -1064,6 +1064,56 @@ fn a_vessel_mesh_slices_and_imports_as_a_design() {
         d.contains("\"profile_start\"") && d.contains("\"closed\": true"),
         "{d}"
     );
+    // An import never replaces a design file (since edited) unasked.
+    std::fs::write(dir.join("cup-design.json"), "edited").unwrap();
+    sweepclay(dir)
+        .args(["import", "cup.stl", "-o", "cup-design.json"])
+        .assert()
+        .failure()
+        .stderr(predicate::str::contains("exists").and(predicate::str::contains("--force")));
+    assert_eq!(
+        std::fs::read_to_string(dir.join("cup-design.json")).unwrap(),
+        "edited"
+    );
+    sweepclay(dir)
+        .args(["import", "cup.stl", "-o", "cup-design.json", "--force"])
+        .assert()
+        .success();
+    // No command writes over the printer profile it read (both wrote it,
+    // exit 0, before).
+    let printers: serde_json::Value = serde_json::from_slice(
+        &sweepclay(dir)
+            .args(["printers", "--json"])
+            .output()
+            .unwrap()
+            .stdout,
+    )
+    .unwrap();
+    let profile = printers[0].to_string();
+    std::fs::write(dir.join("p.json"), &profile).unwrap();
+    for args in [
+        ["calibrate", "--printer", "p.json", "-o", "p.json"].as_slice(),
+        [
+            "import",
+            "cup.stl",
+            "--printer",
+            "p.json",
+            "-o",
+            "p.json",
+            "--force",
+        ]
+        .as_slice(),
+    ] {
+        sweepclay(dir)
+            .args(args)
+            .assert()
+            .failure()
+            .stderr(predicate::str::contains("that is an input"));
+        assert_eq!(
+            std::fs::read_to_string(dir.join("p.json")).unwrap(),
+            profile
+        );
+    }
     // The mesh is an input: -o onto it is refused.
     sweepclay(dir)
         .args(["slice", "cup.stl", "-o", "cup.stl"])
