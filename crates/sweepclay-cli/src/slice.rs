@@ -298,6 +298,7 @@ pub(crate) fn slice_design(a: SliceArgs, text: String, source: String) -> Result
     // the sampling and planning that take the memory: a run that dies
     // there (killed, out of memory) leaves nothing beside the output.
     let mut made: Option<(tempfile::NamedTempFile, std::fs::File)> = None;
+    let _ticker = Ticker::start(&source);
     let planned = plan(&job, &Cancel::new(), || {
         use std::io::{Seek, SeekFrom};
         if made.is_none() {
@@ -491,4 +492,41 @@ pub(crate) fn slice_design(a: SliceArgs, text: String, source: String) -> Result
     }
     persist(tmp, &out)?;
     Ok(if report.printable { 0 } else { 1 })
+}
+
+/// Says on a terminal that a long slice is still working, after 3 s and
+/// every 5 s then, with the time so far (Ctrl+C stops it and leaves no
+/// file behind); stops when dropped.
+struct Ticker(Option<(std::sync::mpsc::Sender<()>, std::thread::JoinHandle<()>)>);
+
+impl Ticker {
+    fn start(what: &str) -> Ticker {
+        use std::io::IsTerminal;
+        if !std::io::stderr().is_terminal() {
+            return Ticker(None);
+        }
+        let (tx, rx) = std::sync::mpsc::channel::<()>();
+        let what = what.to_string();
+        let t0 = std::time::Instant::now();
+        let handle = std::thread::spawn(move || {
+            let mut wait = std::time::Duration::from_secs(3);
+            while let Err(std::sync::mpsc::RecvTimeoutError::Timeout) = rx.recv_timeout(wait) {
+                eprintln!(
+                    "{what}: still slicing and checking, {:.0} s so far (Ctrl+C stops it)",
+                    t0.elapsed().as_secs_f64()
+                );
+                wait = std::time::Duration::from_secs(5);
+            }
+        });
+        Ticker(Some((tx, handle)))
+    }
+}
+
+impl Drop for Ticker {
+    fn drop(&mut self) {
+        if let Some((tx, handle)) = self.0.take() {
+            drop(tx);
+            let _ = handle.join();
+        }
+    }
 }
