@@ -21,6 +21,10 @@ pub struct CalibrateArgs {
     /// comma-separated: computes E per mm³ and saves it.
     #[arg(long, value_delimiter = ',', num_args = 1..)]
     measured: Option<Vec<f64>>,
+    /// The calibration print the walls were measured on, for the E it was
+    /// written with [default: the -o file, if it is there].
+    #[arg(long, value_name = "FILE")]
+    print: Option<PathBuf>,
     /// Where to save the calibrated profile [default: the --printer file
     /// itself; a preset needs --save].
     #[arg(long)]
@@ -83,8 +87,46 @@ pub fn run(a: CalibrateArgs) -> Result<i32> {
         ))?;
         return Ok(0);
     };
-    let fit = calibrate::fit(&print.bands, measured, printer.e_per_mm3)
-        .map_err(|e| anyhow::anyhow!("--{e}"))?;
+    // The E the print was written with travels with the print: the
+    // profile's may have changed since (a first calibration saved), and
+    // fitting against it would compound (docs/CALIBRATION.md).
+    let print_file = a
+        .print
+        .clone()
+        .or_else(|| a.output.is_file().then(|| a.output.clone()));
+    let e_written = match &print_file {
+        Some(f) => {
+            let text = crate::read_capped(f, 1 << 20)
+                .map(|b| String::from_utf8_lossy(&b).into_owned())
+                .map_err(|e| anyhow::anyhow!("--print: {e}"))?;
+            let (e, widths) = calibrate::written(&text).with_context(|| {
+                format!(
+                    "--print {}: not a calibration print sweepclay wrote",
+                    f.display()
+                )
+            })?;
+            let now: Vec<f64> = print.bands.iter().map(|b| b.width_mm).collect();
+            if widths.len() != now.len()
+                || widths.iter().zip(&now).any(|(w, n)| (w - n).abs() > 1e-3)
+            {
+                bail!(
+                    "--print {}: written with bands {widths:?} mm wide, but these settings give {now:?}: give the --layer-height, --width-min and --width-max it was written with",
+                    f.display()
+                );
+            }
+            say(format_args!(
+                "print      {} was written with E per mm³ {e}\n",
+                f.display()
+            ))?;
+            e
+        }
+        None => {
+            eprintln!("note: no calibration print to read (--print FILE): taking the E per mm³ the printer has now, {}, as the one it was written with", printer.e_per_mm3);
+            printer.e_per_mm3
+        }
+    };
+    let fit =
+        calibrate::fit(&print.bands, measured, e_written).map_err(|e| anyhow::anyhow!("--{e}"))?;
     for (i, (t, b)) in measured.iter().zip(&print.bands).enumerate() {
         say(format_args!(
             "band {}     written {:.2} mm, measured {:.2} mm: {:.4} E/mm³\n",

@@ -173,21 +173,33 @@ fn calibrate_prints_a_checked_cylinder_and_finds_the_factor_back() {
         .zip([0.04, -0.05, 0.05, -0.03])
         .map(|(w, n)| format!("{:.2}", w * 0.13 / truth + n))
         .collect();
-    sweepclay(d)
-        .args([
-            "calibrate",
-            "--printer",
-            "printer.json",
-            "--measured",
-            &measured.join(","),
-        ])
-        .assert()
-        .success()
-        .stdout(predicate::str::contains("saved      printer.json"));
-    let saved: serde_json::Value =
-        serde_json::from_str(&std::fs::read_to_string(d.join("printer.json")).unwrap()).unwrap();
-    let e = saved["e_per_mm3"].as_f64().unwrap();
+    let compute = || {
+        sweepclay(d)
+            .args([
+                "calibrate",
+                "--printer",
+                "printer.json",
+                "--print",
+                "cal.gcode",
+                "--measured",
+                &measured.join(","),
+            ])
+            .assert()
+            .success()
+            .stdout(predicate::str::contains("saved      printer.json"))
+            .stdout(predicate::str::contains("written with E per mm³ 0.13"));
+        let saved: serde_json::Value =
+            serde_json::from_str(&std::fs::read_to_string(d.join("printer.json")).unwrap())
+                .unwrap();
+        (saved["e_per_mm3"].as_f64().unwrap(), saved)
+    };
+    let (e, saved) = compute();
     assert!((e - truth).abs() / truth < 0.02, "{e} vs {truth}");
+    // The same walls again give the same E: the fit takes the E the print
+    // was written with, not the profile's new one (before: 0.118 → 0.107
+    // → 0.098, compounding).
+    let (again, _) = compute();
+    assert_eq!(again, e);
     // The rest of the profile is kept as written.
     assert_eq!(saved["start_gcode"], "G28\n");
     // Walls that disagree save nothing.

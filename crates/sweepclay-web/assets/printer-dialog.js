@@ -82,11 +82,39 @@ function dialogPrinter() {
   return printer;
 }
 
+/**
+ * Where the E per mm³ a calibration print was written with is kept, per
+ * printer name: it travels with the print, so Compute is idempotent
+ * (docs/CALIBRATION.md).
+ */
+const CAL_WRITTEN = 'sweepclay.calibration-written';
+function writtenE(name) {
+  try {
+    return JSON.parse(localStorage.getItem(CAL_WRITTEN) || '{}')[name];
+  } catch (e) {
+    return undefined;
+  }
+}
+function keepWrittenE(name, e) {
+  try {
+    const all = JSON.parse(localStorage.getItem(CAL_WRITTEN) || '{}');
+    all[name] = e;
+    localStorage.setItem(CAL_WRITTEN, JSON.stringify(all));
+  } catch (err) {
+    /* the dialog still says it */
+  }
+}
+
 /** What the calibration routes take: the dialog's printer, the design's widths. */
-function calibrationAsk(measured) {
+function calibrationAsk(measured, written) {
   const p = { ...state.meta.params, ...(state.design.params || {}) };
   const params = { layer_height: p.layer_height, width_min: p.width_min, width_max: p.width_max };
-  return JSON.stringify({ printer: dialogPrinter(), params, ...(measured ? { measured } : {}) });
+  return JSON.stringify({
+    printer: dialogPrinter(),
+    params,
+    ...(measured ? { measured } : {}),
+    ...(written ? { written_e_per_mm3: written } : {}),
+  });
 }
 
 $('pr-cal-print').addEventListener('click', async () => {
@@ -96,7 +124,9 @@ $('pr-cal-print').addEventListener('click', async () => {
     return;
   }
   download(await r.blob(), 'calibration.gcode');
-  $('pr-cal-result').textContent = `Written with E per mm³ ${$('pr-e').value}: measure before you change it.`;
+  const e = parseFloat($('pr-e').value);
+  keepWrittenE($('pr-name').value.trim(), e);
+  $('pr-cal-result').textContent = `Written with E per mm³ ${e}; Compute uses that, whatever the field says later.`;
 });
 
 $('pr-cal-fit').addEventListener('click', async () => {
@@ -105,7 +135,8 @@ $('pr-cal-fit').addEventListener('click', async () => {
     $('pr-cal-result').textContent = 'give the wall thickness of each of the four bands, in mm';
     return;
   }
-  const r = await postDesign('/api/calibrate/fit', calibrationAsk(measured));
+  const written = writtenE($('pr-name').value.trim());
+  const r = await postDesign('/api/calibrate/fit', calibrationAsk(measured, written));
   const f = await r.json();
   if (!r.ok) {
     $('pr-cal-result').textContent = f.error;
@@ -116,9 +147,9 @@ $('pr-cal-fit').addEventListener('click', async () => {
     $('pr-cal-result').textContent = `The bands disagree by ${spread} %: measure again at each band's middle (nothing changed).`;
     return;
   }
-  const was = $('pr-e').value;
   $('pr-e').value = f.e_per_mm3.toFixed(5);
-  $('pr-cal-result').textContent = `E per mm³ ${f.e_per_mm3.toFixed(5)} (was ${was}; the bands agree within ${spread} %). "Use" keeps it.`;
+  const from = written ? `the print was written with ${written}` : `no print downloaded here: taken as written with ${f.written_e_per_mm3}`;
+  $('pr-cal-result').textContent = `E per mm³ ${f.e_per_mm3.toFixed(5)} (${from}; the bands agree within ${spread} %). "Use and keep" keeps it.`;
 });
 
 $('printer-form').addEventListener('submit', (e) => {

@@ -175,6 +175,11 @@ pub(crate) struct CalibrationAsk {
     /// The walls measured at each band, lowest first (mm): for the fit.
     #[serde(default)]
     measured: Option<Vec<f64>>,
+    /// The E per mm³ the print was written with (the page keeps it from
+    /// the download): the fit uses it, never the printer's current value,
+    /// so computing twice gives the same E (docs/CALIBRATION.md).
+    #[serde(default)]
+    written_e_per_mm3: Option<f64>,
 }
 
 /// The printer and calibration print an ask names.
@@ -233,6 +238,8 @@ pub(crate) async fn calibration_print(
 #[derive(serde::Serialize)]
 pub(crate) struct Fitted {
     e_per_mm3: f64,
+    /// The E the fit took the print to be written with.
+    written_e_per_mm3: f64,
     per_band: Vec<f64>,
     spread: f64,
     /// Whether the bands agree well enough to use it.
@@ -248,8 +255,21 @@ pub(crate) async fn calibration_fit(
     let measured = ask.measured.as_deref().ok_or_else(|| {
         ApiError::new(422, "give the wall measured at each band").with_key("measured")
     })?;
-    let f = sweepclay_core::calibrate::fit(&print.bands, measured, printer.e_per_mm3)?;
+    let written =
+        match ask.written_e_per_mm3 {
+            Some(e) if e.is_finite() && e > 0.0 && e <= sweepclay_core::printer::MAX_E_PER_MM3 => e,
+            Some(e) => return Err(ApiError::new(
+                422,
+                format!(
+                    "the E per mm³ the print was written with must be a positive number (got {e})"
+                ),
+            )
+            .with_key("written_e_per_mm3")),
+            None => printer.e_per_mm3,
+        };
+    let f = sweepclay_core::calibrate::fit(&print.bands, measured, written)?;
     Ok(Json(Fitted {
+        written_e_per_mm3: written,
         trusted: f.spread <= sweepclay_core::calibrate::TRUST_SPREAD,
         e_per_mm3: f.e_per_mm3,
         per_band: f.per_band,

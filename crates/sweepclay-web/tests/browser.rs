@@ -3318,6 +3318,28 @@ async fn the_printer_dialog_calibrates_e_from_measured_walls() {
     .unwrap();
     let truth = e0 / 1.1;
     assert!((e - truth).abs() / truth < 0.02, "{e} vs {truth}: {said}");
+    // Compute again from the same walls: the same E (before, each Compute
+    // took the field's E as the one printed with: 0.416 → 0.462 → 0.513).
+    js(
+        &c,
+        "document.getElementById('pr-cal-result').textContent = ''",
+    )
+    .await;
+    click(&c, "pr-cal-fit").await;
+    wait_js(
+        &c,
+        "const t = document.getElementById('pr-cal-result').textContent; return t.startsWith('E per mm') && t",
+        "the fit again",
+    )
+    .await;
+    let again: f64 = js(
+        &c,
+        "return parseFloat(document.getElementById('pr-e').value)",
+    )
+    .await
+    .as_f64()
+    .unwrap();
+    assert_eq!(again, e, "Compute is idempotent");
     // Walls that disagree change nothing.
     set_value(&c, "pr-cal-2", "6").await;
     click(&c, "pr-cal-fit").await;
