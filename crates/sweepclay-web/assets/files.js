@@ -9,6 +9,29 @@ import { setVerdict, showError, showNote } from './status.js';
 import { download, postDesign } from './io.js';
 import { setClosed } from './shapes.js';
 import { editors } from './editors-panel.js';
+import { keptPrinters, withMyPrinter } from './printer-dialog.js';
+
+/**
+ * The printer an opened design prints on: the file's own only when it
+ * names one the user has (a preset, or a printer kept in this browser),
+ * and then the note says so; else the printer in use stays (an opened
+ * mesh names none). Returns the design and what to say, if anything.
+ */
+function onMyPrinter(d, name) {
+  const p = d.printer;
+  const pname = typeof p === 'string' ? p : p && p.name;
+  const presets = (state.meta?.presets || []).map((x) => x.name);
+  const kept = keptPrinters().find((k) => k.printer.name === pname);
+  if (typeof p === 'string' && presets.includes(p)) return [d, `${name} names the printer ${p}: now printing on it.`];
+  if (kept) {
+    d.printer = { ...kept.printer };
+    return [d, `${name} names your printer ${pname}: now printing on it.`];
+  }
+  const mine = state.design?.printer;
+  const mineName = typeof mine === 'string' ? mine : mine?.name;
+  const said = pname && pname !== mineName ? `${name} names a printer you do not have (${pname}): kept yours, ${mineName || 'generic'}.` : null;
+  return [withMyPrinter(d), said];
+}
 
 const $ = (id) => document.getElementById(id);
 
@@ -79,7 +102,9 @@ $('open-file').addEventListener('change', async () => {
     showError(`${name}: not a sweepclay design (it needs profile_start and trajectory)`);
     return;
   }
-  setDesign(d, { fit: true });
+  const [mine, said] = onMyPrinter(d, name);
+  setDesign(mine, { fit: true });
+  if (said) showNote(said);
 });
 /**
  * A vessel mesh: the server cuts it into sections and fits it by a
@@ -103,7 +128,8 @@ async function openMesh(file) {
     showError(`${file.name}: ${body.error}`);
     return;
   }
-  setDesign(body.design, { fit: true });
+  // A mesh names no printer: the one in use stays.
+  setDesign(withMyPrinter(body.design), { fit: true });
   const kind = body.kind === 'shell' ? 'a wall with its thickness, fitted at its middle' : 'a solid, fitted at its outside';
   const units = body.note ? `; ${body.note}` : '';
   // A twist and ribs found in the mesh are the design's own twist and

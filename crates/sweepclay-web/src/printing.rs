@@ -255,18 +255,19 @@ pub(crate) async fn calibration_fit(
     let measured = ask.measured.as_deref().ok_or_else(|| {
         ApiError::new(422, "give the wall measured at each band").with_key("measured")
     })?;
-    let written =
-        match ask.written_e_per_mm3 {
-            Some(e) if e.is_finite() && e > 0.0 && e <= sweepclay_core::printer::MAX_E_PER_MM3 => e,
-            Some(e) => return Err(ApiError::new(
+    let written = match ask.written_e_per_mm3 {
+        Some(e) if e.is_finite() && e > 0.0 && e <= sweepclay_core::printer::MAX_E_PER_MM3 => e,
+        Some(e) => {
+            return Err(ApiError::new(
                 422,
                 format!(
                     "the E per mm³ the print was written with must be a positive number (got {e})"
                 ),
             )
-            .with_key("written_e_per_mm3")),
-            None => printer.e_per_mm3,
-        };
+            .with_key("written_e_per_mm3"))
+        }
+        None => printer.e_per_mm3,
+    };
     let f = sweepclay_core::calibrate::fit(&print.bands, measured, written)?;
     Ok(Json(Fitted {
         written_e_per_mm3: written,

@@ -2793,6 +2793,15 @@ async fn a_mesh_opens_as_an_editable_design_and_downloads_its_gcode() {
     std::fs::write(&file, &stl).unwrap();
     c.goto(&base).await.unwrap();
     close_guide(&c).await;
+    // The potter's printer stays: opening a mesh (which names none) used
+    // to switch it to generic, centring the G-code on another bed.
+    set_value(&c, "p-printer", "cerambot-mini").await;
+    wait_js(
+        &c,
+        &format!("return {IDLE} && window.sweepclay.design.printer === 'cerambot-mini'"),
+        "the printer chosen",
+    )
+    .await;
     choose_file(&c, "open-file", &file).await;
     let note = wait_js(
         &c,
@@ -2820,6 +2829,11 @@ async fn a_mesh_opens_as_an_editable_design_and_downloads_its_gcode() {
     let (text, _) =
         download_printable(&c, &downloads, "no G-code of the mesh was downloaded").await;
     assert!(text.contains("; design: old-cup"), "{}", &text[..300]);
+    assert!(
+        text.contains("; printer: cerambot-mini"),
+        "{}",
+        &text[..300]
+    );
     // A mesh that is no sweep (twisted lobes with a spiral texture)
     // opens as the closest twisted sweep and a relief, prints as it is,
     // and the note says its twist and why it could not be made editable.
@@ -2831,6 +2845,14 @@ async fn a_mesh_opens_as_an_editable_design_and_downloads_its_gcode() {
     sweepclay_core::mesh::write_stl(&sweepclay_core::slice(&lobes).unwrap(), &mut stl).unwrap();
     let file = tmp.path().join("lobes.stl");
     std::fs::write(&file, &stl).unwrap();
+    // The lobes were drawn for the larger CERAMBOT Plus: the potter picks it.
+    set_value(&c, "p-printer", "cerambot-plus").await;
+    wait_js(
+        &c,
+        &format!("return {IDLE} && window.sweepclay.design.printer === 'cerambot-plus'"),
+        "the larger printer chosen",
+    )
+    .await;
     choose_file(&c, "open-file", &file).await;
     let note = wait_js(
         &c,
