@@ -70,12 +70,12 @@ pub enum Event {
 /// M141, M191), fans (M106, M107), messages and reports (M105, M110, M114,
 /// M115, M117, M118, M300 a beep), progress (M73), motion limits and the
 /// speed factor (M201, M203, M204, M205, M220: time, not place or clay),
-/// waiting for moves (M400), pressure advance (M900: when, not how much),
-/// object labels (M486 with S or A only) and the mode switches replayed
-/// elsewhere.
-pub const HARMLESS_M: [f64; 22] = [
+/// waiting for moves (M400) and pressure advance (Marlin's M900,
+/// RepRapFirmware's M572: when the clay comes, not how much). Object
+/// labels (M486 with S or A only) are matched apart.
+pub const HARMLESS_M: [f64; 24] = [
     73.0, 104.0, 105.0, 106.0, 107.0, 109.0, 110.0, 114.0, 115.0, 117.0, 118.0, 140.0, 141.0,
-    190.0, 191.0, 201.0, 203.0, 204.0, 205.0, 220.0, 300.0, 400.0,
+    190.0, 191.0, 201.0, 203.0, 204.0, 205.0, 220.0, 300.0, 400.0, 572.0, 900.0,
 ];
 
 /// Pauses and stops in every dialect (docs/CHECKER.md, "Commands"): M0,
@@ -87,43 +87,49 @@ pub const PAUSES_M: [f64; 9] = [0.0, 1.0, 25.0, 125.0, 226.0, 600.0, 601.0, 112.
 
 /// A line that is one of the word commands firmwares and hosts take
 /// (Klipper's extended G-code `SET_GCODE_OFFSET Z=1`, OctoPrint's
-/// `@pause`): a pause or stop, a command that changes nothing clay sees,
-/// or one not replayed. `None` for a line of G-code letters and numbers.
-pub fn word_command(raw: &[u8]) -> Option<Event> {
-    let text = std::str::from_utf8(raw).ok()?;
-    let text = text.split(';').next()?.trim();
-    let head = text.split_whitespace().next()?;
-    let host = head.starts_with('@');
-    let name = head.trim_start_matches('@');
-    let word = name.len() >= 2
-        && name.chars().all(|c| c.is_ascii_alphanumeric() || c == '_')
-        && name.chars().any(|c| c.is_ascii_alphabetic())
-        // G1, M104, T0, N12: letters and numbers, not a word.
-        && !(name.len() > 1
-            && name.as_bytes()[0].is_ascii_alphabetic()
-            && name[1..].chars().all(|c| c.is_ascii_digit() || c == '.' || c == '-'));
-    if !(host || word) {
-        return None;
-    }
-    let upper = name.to_ascii_uppercase();
+/// `@pause`), at line `n`: `None` for a line of G-code letters and numbers
+/// (to be parsed), else what the word does — a pause or stop, nothing
+/// clay sees (`Some(None)`), or a command not replayed. Cheap for G-code
+/// lines: two bytes decide, before any text is made.
+pub fn word_command(raw: &[u8], n: usize) -> Option<Option<Event>> {
+    let mut b = raw.iter().skip_while(|c| c.is_ascii_whitespace());
+    let host = match (b.next(), b.next()) {
+        (Some(b'@'), _) => true,
+        // Two letters, or a letter and `_`: `G1`, `M104`, `N12` are not.
+        (Some(a), Some(c))
+            if a.is_ascii_alphabetic() && (c.is_ascii_alphabetic() || *c == b'_') =>
+        {
+            false
+        }
+        _ => return None,
+    };
+    let text = String::from_utf8_lossy(raw);
+    let head = text
+        .split(';')
+        .next()
+        .unwrap_or("")
+        .split_whitespace()
+        .next()
+        .unwrap_or("");
+    let upper = head.trim_start_matches('@').to_ascii_uppercase();
     let pause = [
         "PAUSE",
-        "M0",
         "CANCEL_PRINT",
         "SDCARD_RESET_FILE",
         "FIRMWARE_RESTART",
         "RESTART",
         "ABORT",
     ];
-    if pause.contains(&upper.as_str()) || (host && ["ABORT", "CANCEL"].contains(&upper.as_str())) {
-        return Some(Event::Pause(0));
+    // OctoPrint's `@abort` and `@cancel` stop the job it streams.
+    let host_stop = host && upper == "CANCEL";
+    if pause.contains(&upper.as_str()) || host_stop {
+        return Some(Some(Event::Pause(n)));
     }
     // Klipper's own commands that change nothing clay sees: messages,
     // temperatures, fans, limits, pressure advance, object labels.
-    const HARMLESS: [&str; 14] = [
+    const HARMLESS: [&str; 13] = [
         "RESPOND",
         "SET_DISPLAY_TEXT",
-        "M117",
         "SET_HEATER_TEMPERATURE",
         "TEMPERATURE_WAIT",
         "SET_FAN_SPEED",
@@ -137,16 +143,14 @@ pub fn word_command(raw: &[u8]) -> Option<Event> {
         "UPDATE_DELAYED_GCODE",
     ];
     if HARMLESS.contains(&upper.as_str()) {
-        return None;
+        return Some(None);
     }
-    Some(Event::Unreplayed(
-        0,
-        if host {
-            "a host command (@…)"
-        } else {
-            "an extended command"
-        },
-    ))
+    let name = if host {
+        "a host command (@…)"
+    } else {
+        "an extended command"
+    };
+    Some(Some(Event::Unreplayed(n, name)))
 }
 
 /// Replays the lines. Returns the events; diagnostics are appended.
@@ -562,23 +566,28 @@ impl Replayer {
                     }
                     _ => {
                         self.steps_e = Some(v);
-                        return Some(Event::Unreplayed(l.line, code_name('M', 92.0)));
+                        return Some(Event::Unreplayed(l.line, "M92 (steps per millimetre)"));
                     }
                 }
             }
             (k, c) => {
-                let name = code_name(k, c);
-                // One note a command this knows nothing of, for the first
-                // 64 distinct ones (a motor switch or a probe is known).
-                if name.starts_with("an ")
-                    && self.unknown_reported.len() < 64
-                    && self.unknown_reported.insert(format!("{k}{c}"))
-                {
-                    diags.push(Diagnostic {
-                        line: l.line,
-                        message: format!("unknown command {k}{c} ignored"),
-                    });
-                }
+                let name = known_name(k, c).unwrap_or_else(|| {
+                    // One note a command this knows nothing of, for the
+                    // first 64 distinct ones.
+                    if self.unknown_reported.len() < 64
+                        && self.unknown_reported.insert(format!("{k}{c}"))
+                    {
+                        diags.push(Diagnostic {
+                            line: l.line,
+                            message: format!("unknown command {k}{c} ignored"),
+                        });
+                    }
+                    match k {
+                        'G' => "an unknown G command",
+                        'M' => "an unknown M command",
+                        _ => "an unknown command",
+                    }
+                });
                 return Some(Event::Unreplayed(l.line, name));
             }
         }
@@ -586,9 +595,10 @@ impl Replayer {
     }
 }
 
-/// A short name for a command not replayed, for the "cannot judge" line.
-fn code_name(k: char, c: f64) -> &'static str {
-    match (k, c) {
+/// The name of a known command not replayed, for the "cannot judge" line;
+/// `None` for one this knows nothing of.
+fn known_name(k: char, c: f64) -> Option<&'static str> {
+    Some(match (k, c) {
         ('M', 92.0) => "M92 (steps per millimetre)",
         ('M', 17.0) | ('M', 18.0) | ('M', 84.0) => "a motor switch (M17/M18/M84)",
         ('M', 206.0) | ('M', 290.0) => "an offset of Z (M206/M290)",
@@ -597,10 +607,8 @@ fn code_name(k: char, c: f64) -> &'static str {
         ('G', 38.0) => "a probing move (G38)",
         ('G', 12.0) => "a nozzle cleaning move (G12)",
         ('T', _) => "a tool change (T)",
-        ('G', _) => "an unknown G command",
-        ('M', _) => "an unknown M command",
-        _ => "an unknown command",
-    }
+        _ => return None,
+    })
 }
 
 #[cfg(test)]

@@ -208,6 +208,8 @@ fn commands_inside_the_print_are_replayed_refused_or_harmless() {
         "RESPOND MSG=hi",
         "M486 S1",
         "M92",
+        "M900 K0",
+        "M572 D0 S0.05",
     ];
     for cmd in harmless {
         let r = verdict(&with(mid, cmd));

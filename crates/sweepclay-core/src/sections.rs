@@ -163,20 +163,20 @@ fn level(mesh: &TriMesh, t: [u32; 3]) -> bool {
 /// A cut whose work is over [`MAX_SEGMENTS`] is refused naming the cap
 /// ([`sections_within`] chooses heights that keep under it).
 pub fn cut(mesh: &TriMesh, z0: f64, dz: f64, n: usize, bed: f64) -> Result<Vec<Section>> {
-    let w = work(mesh, z0, dz, n);
+    let v = &mesh.vertices;
+    let spans: Vec<(i64, i64)> = mesh
+        .triangles
+        .iter()
+        .map(|t| span(t.map(|i| v[i as usize][2]), z0, dz, n))
+        .collect();
+    let w: u64 = spans.iter().map(|&(a, b)| (b - a + 1).max(0) as u64).sum();
     if w > MAX_SEGMENTS {
         return Err(Error::invalid(
             "mesh",
             format!("cutting it at {n} heights would compute {w} segments, over the cap of {MAX_SEGMENTS}: its facets are very many and tall; decimate it (Blender's Decimate, MeshLab's Quadric Edge Collapse)"),
         ));
     }
-    let v = &mesh.vertices;
     // Triangles by the first height they span (a counting sort).
-    let spans: Vec<(i64, i64)> = mesh
-        .triangles
-        .iter()
-        .map(|t| span(t.map(|i| v[i as usize][2]), z0, dz, n))
-        .collect();
     let mut starts = vec![0u32; n + 1];
     for &(a, b) in &spans {
         if a <= b {

@@ -20,10 +20,10 @@ impl Checker<'_> {
         let s = self.s;
         let volume = m.de / cfg.e_per_mm3;
         self.last_bead = (self.r.moves, m.line);
-        if !self.unreplayed_since.is_empty() {
-            let room = MAX_UNREPLAYED.saturating_sub(self.unreplayed_inside.len());
-            let since = std::mem::take(&mut self.unreplayed_since);
-            self.unreplayed_inside.extend(since.into_iter().take(room));
+        if let Some(first) = self.unreplayed_since.take() {
+            if self.unreplayed_inside.len() < MAX_UNREPLAYED {
+                self.unreplayed_inside.push(first);
+            }
         }
         if self.lead.print_run.is_none() {
             if let Some(run) = self.lead.runs.last_mut() {

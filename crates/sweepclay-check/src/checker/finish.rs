@@ -114,11 +114,11 @@ impl Checker<'_> {
                     format!("{name} inside the print: the checker does not replay it, and it may change where the nozzle goes or how much clay it lays (docs/CHECKER.md, \"Commands\"); move it to the start or end code"),
                 )
             });
-        let first = match (self.replayer.cannot_judge.take(), inside) {
-            (Some(a), Some(b)) => Some(if a.0 <= b.0 { a } else { b }),
-            (a, b) => a.or(b),
-        };
-        r.cannot_judge = first.map(|(line, message)| Diagnostic { line, message });
+        r.cannot_judge = [self.replayer.cannot_judge.take(), inside]
+            .into_iter()
+            .flatten()
+            .min_by_key(|(line, _)| *line)
+            .map(|(line, message)| Diagnostic { line, message });
         verdict(r, self.cfg);
         self.r
     }

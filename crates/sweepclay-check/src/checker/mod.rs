@@ -272,26 +272,16 @@ struct Checker<'a> {
     walk: Walk,
     /// Letting old clay go ([`memory`]).
     memory: memory::Memory,
-    /// Commands not replayed since the last bead (line, name; the first
-    /// [`MAX_UNREPLAYED`]): inside the print once a bead follows them.
-    unreplayed_since: Vec<(usize, &'static str)>,
-    /// Commands not replayed with beads before and after them.
+    /// The first command not replayed since the last bead (line, name):
+    /// inside the print once a bead follows it. Only the first of a gap
+    /// counts: a gap lies wholly before the print's first bead or after.
+    unreplayed_since: Option<(usize, &'static str)>,
+    /// The first command not replayed of each gap between two beads (the
+    /// first [`MAX_UNREPLAYED`] gaps).
     unreplayed_inside: Vec<(usize, &'static str)>,
 }
 
-/// Whether a line starts with a word command rather than a letter and a
-/// number: `@…`, or two letters (or a letter and `_`) at its start. Cheap:
-/// the checker asks it of every line.
-fn word_like(raw: &[u8]) -> bool {
-    let mut b = raw.iter().skip_while(|c| c.is_ascii_whitespace());
-    match (b.next(), b.next()) {
-        (Some(b'@'), _) => true,
-        (Some(a), Some(c)) => a.is_ascii_alphabetic() && (c.is_ascii_alphabetic() || *c == b'_'),
-        _ => false,
-    }
-}
-
-/// Most commands not replayed kept between two beads, and in all.
+/// Most gaps between beads whose first command not replayed is kept.
 const MAX_UNREPLAYED: usize = 64;
 
 impl<'a> Checker<'a> {
@@ -360,7 +350,7 @@ impl<'a> Checker<'a> {
                     .tan(),
             walk: Walk::Auto,
             memory: memory::Memory::new(cfg, memory::KEPT_BEADS),
-            unreplayed_since: Vec::new(),
+            unreplayed_since: None,
             unreplayed_inside: Vec::new(),
         }
     }
@@ -414,21 +404,20 @@ impl<'a> Checker<'a> {
         }
         self.r.lines += 1;
         let n = self.r.lines;
-        let parsed = self
-            .parser
-            .parse_bytes(raw, n, &mut self.diags, &mut self.line);
-        let event = if word_like(raw) {
-            // Klipper's `PAUSE`, `SET_GCODE_OFFSET Z=1`, OctoPrint's
-            // `@pause`: read as words, not letters and numbers.
-            crate::replay::word_command(raw).map(|e| match e {
-                Event::Pause(_) => Event::Pause(n),
-                Event::Unreplayed(_, name) => Event::Unreplayed(n, name),
-                e => e,
-            })
-        } else if parsed {
-            self.replayer.feed(&self.line, &mut self.diags)
-        } else {
-            None
+        // Klipper's `PAUSE`, `SET_GCODE_OFFSET Z=1`, OctoPrint's `@pause`
+        // are read as words; every other line as letters and numbers.
+        let event = match crate::replay::word_command(raw, n) {
+            Some(word) => word,
+            None => {
+                let parsed = self
+                    .parser
+                    .parse_bytes(raw, n, &mut self.diags, &mut self.line);
+                if parsed {
+                    self.replayer.feed(&self.line, &mut self.diags)
+                } else {
+                    None
+                }
+            }
         };
         self.trim_diagnostics();
         match event {
@@ -448,10 +437,8 @@ impl<'a> Checker<'a> {
             }
             // Before the first bead, start code; after the last, end code;
             // between two beads, a command the replay cannot follow.
-            Some(Event::Unreplayed(line, name))
-                if self.started && self.unreplayed_since.len() < MAX_UNREPLAYED =>
-            {
-                self.unreplayed_since.push((line, name));
+            Some(Event::Unreplayed(line, name)) if self.started => {
+                self.unreplayed_since.get_or_insert((line, name));
             }
             Some(Event::Unreplayed(..)) => {}
             Some(Event::Retract(line)) => {
