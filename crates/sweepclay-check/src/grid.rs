@@ -21,6 +21,13 @@ pub(crate) const CELL_Z: f64 = 2.0;
 /// (docs/CHECKER.md, "Bounded cost").
 pub(crate) const MAX_CELL_RUNS: usize = 32;
 
+/// Beads one cell may hold before the check stops judging the file
+/// ("cannot judge", naming the place): a clay print lays a dozen passes
+/// of a few beads there (the corpus's files at most 33, a design sampled
+/// every 0.02 mm 709; docs/CHECKER.md, "Bounded cost").
+/// A question reads a cell's beads, so the cap bounds what each costs.
+pub(crate) const MAX_CELL_BEADS: u32 = 4096;
+
 /// Cells are indexed over the build volume with a margin of this many
 /// cells a side; clay beyond is counted in the border cells, whose lists
 /// only grow by it (every reader tests each bead's geometry).
@@ -64,6 +71,8 @@ pub(crate) struct Run {
     pub(crate) first: u32,
     pub(crate) last: u32,
     pub(crate) next: u32,
+    /// Beads laid in the cell up to this run's last, all runs counted.
+    pub(crate) total: u32,
 }
 
 impl BeadGrid {
@@ -137,11 +146,13 @@ impl BeadGrid {
         r.map(|v| (v.saturating_add(MARGIN_CELLS)).clamp(0, self.dims[a] - 1) as usize)
     }
 
+    /// Adds bead `id` to the lists of the cells it spans. Returns the
+    /// lowest corner of a cell inside the grid's border that now holds
+    /// more than [`MAX_CELL_BEADS`] beads (the first time one does).
     #[inline]
-    pub(crate) fn insert(&mut self, b: &Bead, id: u32) {
-        let Some((xs, ys, zs)) = Self::span(b) else {
-            return;
-        };
+    pub(crate) fn insert(&mut self, b: &Bead, id: u32) -> Option<[f64; 3]> {
+        let (xs, ys, zs) = Self::span(b)?;
+        let mut full = None;
         let (xs, ys, zs) = (self.clamp(0, xs), self.clamp(1, ys), self.clamp(2, zs));
         let (nx, nz) = (self.dims[0] as usize, self.dims[2] as usize);
         for y in ys[0]..ys[1] + 1 {
@@ -150,22 +161,41 @@ impl BeadGrid {
                 if column.is_empty() {
                     *column = vec![u32::MAX; nz].into_boxed_slice();
                 }
-                for head in &mut column[zs[0]..zs[1] + 1] {
-                    match self.links.get_mut(*head as usize) {
+                for (z, head) in column[zs[0]..zs[1] + 1].iter_mut().enumerate() {
+                    let total = match self.links.get_mut(*head as usize) {
                         // The path is still in the cell: its run goes on.
-                        Some(run) if run.last.checked_add(1) == Some(id) => run.last = id,
-                        _ => {
+                        Some(run) if run.last.checked_add(1) == Some(id) => {
+                            run.last = id;
+                            run.total += 1;
+                            run.total
+                        }
+                        before => {
+                            let total = before.map_or(0, |r| r.total) + 1;
                             self.links.push(Run {
                                 first: id,
                                 last: id,
                                 next: *head,
+                                total,
                             });
                             *head = self.links.len() as u32 - 1;
+                            total
                         }
+                    };
+                    let cellv = [x, y, zs[0] + z];
+                    // Border cells gather all clay beyond the grid: they
+                    // fill by what is out of bounds, not by stacking.
+                    let inside =
+                        (0..3).all(|a| cellv[a] > 0 && cellv[a] + 1 < self.dims[a] as usize);
+                    if total == MAX_CELL_BEADS + 1 && inside && full.is_none() {
+                        full = Some(cellv);
                     }
                 }
             }
         }
+        full.map(|c| {
+            let size = [CELL_XY, CELL_XY, CELL_Z];
+            [0, 1, 2].map(|a| (c[a] as f64 - f64::from(MARGIN_CELLS)) * size[a])
+        })
     }
 
     /// Settles the beads from the frontier on that are `done` (they are

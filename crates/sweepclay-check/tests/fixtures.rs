@@ -571,6 +571,38 @@ fn a_stack_rising_a_nanometre_a_move_is_judged_as_a_flat_one() {
     );
 }
 
+/// Passes stacked in one place a tenth of a micrometre apart (issue 55's
+/// fifth class: 20,000 took 4.1 s, 60,000 28 s, each question reading the
+/// whole stack) get no verdict once a cell holds more moves than a clay
+/// print lays there, naming the cell (docs/CHECKER.md, "Bounded cost"); a
+/// cell at the cap is still judged.
+#[test]
+fn a_cell_stacked_past_any_clay_print_gets_no_verdict_naming_it() {
+    use std::fmt::Write;
+    let stack = |n: usize| {
+        let mut g = String::from("G21\nG90\nM82\nG92 E0\nG1 Z1.0 F1000\nG1 X100 Y101 F1000\n");
+        let mut e = 0.0;
+        for i in 0..n {
+            let x = if i % 2 == 0 { 110 } else { 100 };
+            e += 0.039;
+            writeln!(g, "G1 X{x} Y101 Z{:.4} E{e:.4}", 1.0 + i as f64 * 1e-4).unwrap();
+        }
+        g
+    };
+    let r = check(&stack(60_000), &CheckConfig::default());
+    let d = r.cannot_judge.as_ref().expect("no verdict");
+    assert!(
+        d.message.contains("more than 4096 moves of clay within one 4 × 4 × 2 mm cell (x 100–104, y 100–104, z 0–2 mm)"),
+        "{}",
+        d.message
+    );
+    // The 4097th move into the middle cell is where it stops.
+    assert_eq!(d.line, 6 + 4097);
+    assert!(check(&stack(4000), &CheckConfig::default())
+        .cannot_judge
+        .is_none());
+}
+
 /// Letting old clay go (docs/CHECKER.md, "Bounded memory"): a tall spiral
 /// of 16,000 beads reads the same keeping one chunk of beads as keeping
 /// all; a second spiral beside it after, from the bed, too; a ring laid

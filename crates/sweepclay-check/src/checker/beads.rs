@@ -415,9 +415,7 @@ impl Checker<'_> {
         );
         bead.set_height(height);
         bead.bent = step || turn > BENT_RAD;
-        if *deep {
-            grid.insert(&bead, id);
-        }
+        let full = if *deep { grid.insert(&bead, id) } else { None };
         let low = bead.from32[2].min(bead.to32[2]);
         let heading = (xy > 1e-9 && !step).then(|| [d[0] / xy, d[1] / xy]);
         recent.push(id, heading, s, low, turn);
@@ -454,6 +452,9 @@ impl Checker<'_> {
         }
         for &(kind, v) in &held[..n_held] {
             self.record(kind, m.line, v, false);
+        }
+        if let Some(at) = full {
+            self.cell_full(m.line, at);
         }
         for (k, judged) in weak_bead.into_iter().enumerate() {
             match judged {

@@ -123,6 +123,28 @@ impl Checker<'_> {
         self.grid.forget_before(self.beads.first_kept() as u32);
     }
 
+    /// One 4 × 4 × 2 mm cell holds more beads than a question may read
+    /// ([`crate::grid::MAX_CELL_BEADS`]): no verdict from here on.
+    pub(super) fn cell_full(&mut self, line: usize, at: [f64; 3]) {
+        self.deep = false;
+        self.replayer.cannot_judge.get_or_insert((
+            line,
+            format!(
+                "more than {} moves of clay within one {} × {} × {} mm cell (x {:.0}–{:.0}, y {:.0}–{:.0}, z {:.0}–{:.0} mm): no clay print lays that many in one place (a dozen passes of a few moves), and the check reads a bounded number of them",
+                crate::grid::MAX_CELL_BEADS,
+                crate::grid::CELL_XY,
+                crate::grid::CELL_XY,
+                crate::grid::CELL_Z,
+                at[0],
+                at[0] + crate::grid::CELL_XY,
+                at[1],
+                at[1] + crate::grid::CELL_XY,
+                at[2],
+                at[2] + crate::grid::CELL_Z,
+            ),
+        ));
+    }
+
     /// A move comes back down over clay let go: no verdict from here on.
     pub(super) fn cannot_follow(&mut self, m: &Move) {
         self.deep = false;
