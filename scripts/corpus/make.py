@@ -358,184 +358,31 @@ def firmware_files(tmp, defs, vase):
     prusa_with("fault-m221", "--layer-gcode", "{if layer_num==12}M221 S10 ; flow to 10 %{endif}")
 
 
-def fullcontrol_files():
-    import fullcontrol as fc
-
-    def vase_steps(rfun, height):
-        steps = []
-        seg = 64
-        turns = int(round(height / LAYER)) - 1
-        for i in range(seg * turns + 1):
-            t = 2 * math.pi * i / seg
-            z = LAYER + LAYER * i / seg
-            steps.append(fc.Point(x=rfun(z, t) * math.cos(t), y=rfun(z, t) * math.sin(t), z=z))
-        return steps
-
-    def wall_steps():
-        # An open wall, 60 mm long, zig-zag as the paper prints it.
-        steps = []
-        for k in range(24):
-            z = LAYER * (k + 1)
-            xs = (-30, 30) if k % 2 == 0 else (30, -30)
-            for j in range(31):
-                x = xs[0] + (xs[1] - xs[0]) * j / 30
-                steps.append(fc.Point(x=x, y=6 * math.sin(x / 8), z=z))
-        return steps
-
-    def tall_steps():
-        # A helix of 5 mm layers in 3 mm beads: each turn a coil taller
-        # than it is wide on the turn below (fault-tall-layers).
-        steps = []
-        seg, pitch = 64, 5.0
-        for i in range(seg * 7 + 1):
-            t = 2 * math.pi * i / seg
-            z = 2.5 + pitch * max(0.0, (i - seg) / seg)
-            steps.append(fc.Point(x=22 * math.cos(t), y=22 * math.sin(t), z=z))
-        return steps
-
-    settings = {"extrusion_width": WIDTH, "extrusion_height": LAYER, "print_speed": 1200}
-    tall = {"extrusion_width": WIDTH, "extrusion_height": 5.0, "print_speed": 1200}
-    for name, steps, init in [("fullcontrol-vase", vase_steps(vase_r, 50), settings),
-                              ("fullcontrol-wall", wall_steps(), settings),
-                              ("fault-tall-layers", tall_steps(), tall)]:
-        text = fc.transform(steps, "gcode", fc.GcodeControls(printer_name="wasp2040clay",
-                                                               initialization_data=init),
-                            show_tips=False)
-        with open(os.path.join(OUT, name + ".gcode"), "w") as f:
-            f.write(text)
+def vase_call(stl, path, layer, width, first, *more):
+    """PrusaSlicer's spiral vase of `stl` with clay beads `width` wide on
+    `layer` layers, the first `first` high."""
+    return ["prusa-slicer", "--max-print-height", "200", "--start-gcode",
+            PRUSA_START.replace("\\n", "\n"), "--export-gcode", "--spiral-vase",
+            "--perimeters", "1", "--layer-height", str(layer), "--first-layer-height", str(first),
+            "--nozzle-diameter", str(width), "--extrusion-width", str(width),
+            "--first-layer-extrusion-width", str(width), "--filament-diameter", str(FEED_DIA),
+            "--bottom-solid-layers", "0", "--top-solid-layers", "0", "--skirts", "0",
+            "--fill-density", "0", "--center", "100,100", "--bed-shape", "0x0,200x0,200x200,0x200",
+            "--perimeter-speed", "30", "--first-layer-speed", "30", "--retract-length", "2",
+            *more, "-o", path, stl]
 
 
-def python_loop_files():
-    """Clay G-code as people script it: a spiral vase and a zig-zag wall,
-    relative E, plain string formatting."""
-    def header(lines):
-        lines += ["; a plain Python loop", "G21", "G90", "M83", "G28", "G1 Z10 F3000"]
-
-    e_mm3 = 4 / (math.pi * FEED_DIA ** 2)
-    # Spiral vase around (100, 100): flat first loop, then rising turns.
-    lines = []
-    header(lines)
-    seg = 72
-    r = 22.0
-    lines.append(f"G1 X{100 + r:.3f} Y100.000 Z{LAYER:.3f} F3000")
-    prev = (100 + r, 100.0, LAYER)
-    for i in range(1, seg * 36 + 1):
-        t = 2 * math.pi * i / seg
-        z = LAYER + max(0.0, LAYER * (i - seg) / seg)
-        p = (100 + r * math.cos(t), 100 + r * math.sin(t), z)
-        d = math.dist(p, prev)
-        lines.append(f"G1 X{p[0]:.3f} Y{p[1]:.3f} Z{p[2]:.3f} E{d * WIDTH * LAYER * e_mm3:.5f} F1500")
-        prev = p
-    lines += ["G1 E-1.5 F1200 ; end retraction", "G1 Z80 F3000", "G28 X Y", "M84"]
-    with open(os.path.join(OUT, "python-vase.gcode"), "w") as f:
-        f.write("\n".join(lines) + "\n")
-    # Zig-zag wall along y = 100 from x = 60 to 140, 2 mm beads.
-    lines = []
-    header(lines)
-    lines.append(f"G1 X60.000 Y100.000 Z{LAYER:.3f} F3000")
-    for k in range(30):
-        z = LAYER * (k + 1)
-        if k > 0:
-            # Step up at the turn: the clay of the end of the new layer.
-            lines.append(f"G1 Z{z:.3f} E{0.5 * WIDTH * LAYER * WIDTH * e_mm3:.5f} F600")
-        a, b = (60.0, 140.0) if k % 2 == 0 else (140.0, 60.0)
-        for j in range(1, 41):
-            x = a + (b - a) * j / 40
-            lines.append(f"G1 X{x:.3f} Y100.000 E{2.0 * WIDTH * LAYER * e_mm3:.5f} F1500")
-    lines += ["G1 E-1.5 F1200 ; end retraction", "G1 Z80 F3000", "M84"]
-    with open(os.path.join(OUT, "python-wall.gcode"), "w") as f:
-        f.write("\n".join(lines) + "\n")
-
-
-def edits():
-    """Hand-made faults, one each, in copies of valid files."""
-    def load(name):
-        with open(os.path.join(OUT, name + ".gcode")) as f:
-            return f.read().split("\n")
-
-    def save(name, lines):
-        with open(os.path.join(OUT, "fault-" + name + ".gcode"), "w") as f:
-            f.write("\n".join(lines))
-
-    def z_of(line):
-        for w in line.split(";")[0].split():
-            if w.startswith("Z"):
-                return float(w[1:])
-        return None
-
-    def mid_index(lines, z):
-        """The first extruding G1 line at or above height z."""
-        cur = 0.0
-        for i, l in enumerate(lines):
-            zz = z_of(l)
-            if zz is not None:
-                cur = zz
-            if cur >= z and l.startswith("G1") and " E" in l and " X" in l:
-                return i
-        raise ValueError(z)
-
-    # A travel in the middle: lift, move away and back, lower (Prusa vase).
-    p = load("prusa-vase")
-    i = mid_index(p, 25.0)
-    p[i:i] = ["G1 Z35 F3000 ; travel away", "G1 X150 Y150", "G1 X100 Y100", "G1 Z25.0"]
-    save("travel", p)
-    # Relative E switched on half way through an absolute-E file (Prusa
-    # vase): each running total is read as one move's clay.
-    p = load("prusa-vase")
-    i = mid_index(p, 25.0)
-    p[i:i] = ["M83 ; relative extrusion from here"]
-    save("m83", p)
-    # A pause in the middle (Cura vase).
-    c = load("cura-vase")
-    i = mid_index(c, 20.0)
-    c[i:i] = ["M0 ; pause for a photo"]
-    save("pause", c)
-    # A retraction in the print (python vase, relative E).
-    v = load("python-vase")
-    i = mid_index(v, 15.0)
-    v[i:i] = ["G1 E-2.0 F1200 ; retract", "G1 E2.0 F1200 ; unretract"]
-    save("retraction", v)
-    # A bead from Z=0: the python wall's first pass dragged on the bed.
-    w = load("python-wall")
-    w = [l.replace(f"Z{LAYER:.3f} F3000", "Z0.000 F3000") if l.startswith("G1 X60") else l for l in w]
-    save("bed-drag", w)
-    # An overhang: the python wall's upper half shifted 4 mm sideways.
-    w = load("python-wall")
-    out = []
-    for l in w:
-        zz = z_of(l)
-        out.append(l)
-    shifted = []
-    cur = 0.0
-    for l in w:
-        zz = z_of(l)
-        if zz is not None:
-            cur = zz
-        if cur > 20 and l.startswith("G1 X"):
-            l = l.replace("Y100.000", "Y104.000")
-        shifted.append(l)
-    save("overhang", shifted)
-    # A pass printed twice: after the python wall's 10th pass, back over it
-    # and forth again at its height (then on as before).
-    w = load("python-wall")
-    e_mm3 = 4 / (math.pi * FEED_DIA ** 2)
-    steps = [i for i, l in enumerate(w) if l.startswith("G1 Z")]
-    end = steps[9] + 41  # the step up to pass 10 and its 40 beads
-    z = 10 * LAYER
-    again = []
-    for a, b in [(60.0, 140.0), (140.0, 60.0)]:
-        for j in range(1, 41):
-            x = a + (b - a) * j / 40
-            again.append(f"G1 X{x:.3f} Y100.000 Z{z:.3f} E{2.0 * WIDTH * LAYER * e_mm3:.5f} F1500")
-    w[end:end] = again
-    save("twice", w)
-    # Clay piled at the turns: each of the python wall's 1.25 mm steps up
-    # extrudes the clay of 4 mm of full bead (a cuboid as the paper's
-    # tall ends got), not the rounded end of the new layer.
-    w = load("python-wall")
-    pile = f"E{4.0 * WIDTH * LAYER * e_mm3:.5f}"
-    w = [re.sub(r"E[0-9.]+", pile, l) if l.startswith("G1 Z") and " E" in l else l for l in w]
-    save("turn-pile", w)
+def round5_files(tmp, vase):
+    """Issue 55: PrusaSlicer's vase of a plain cylinder whose first layer
+    is 3.0 mm, the tallest first layer the checker takes (class 1: its
+    ramp starts 0.005 mm above that loop, where the loop ends); the bulging
+    vase in 3.7 mm beads on 1.5 mm layers with `M221 S25` from layer 12
+    (class 4: a 0.92 mm coil, narrower than it is tall)."""
+    cyl = os.path.join(tmp, "cylinder.stl")
+    write_stl(cyl, lambda z, t: 30.0, 45, 30, 128)
+    run(vase_call(cyl, os.path.join(OUT, "prusa-first3.gcode"), 1.5, 4.0, 3.0))
+    run(vase_call(vase, os.path.join(OUT, "fault-m221-25.gcode"), 1.5, 3.7, 1.5,
+                  "--layer-gcode", "{if layer_num==12}M221 S25 ; flow to 25 %{endif}"))
 
 
 def main():
@@ -553,6 +400,7 @@ def main():
         lean_files(tmp, defs)
         cone_files(tmp, defs)
         firmware_files(tmp, defs, vase)
+        round5_files(tmp, vase)
         prusa("prusa-slicer", vase, os.path.join(OUT, "prusa-vase.gcode"), tmp)
         prusa("prusa-slicer", ripple, os.path.join(OUT, "prusa-ripple.gcode"), tmp)
         prusa("slic3r", vase, os.path.join(OUT, "slic3r-vase.gcode"), tmp)

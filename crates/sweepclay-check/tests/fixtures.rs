@@ -1252,3 +1252,101 @@ fn dwells_firmware_retraction_and_flow_overrides_are_read_as_firmware_does() {
         assert!(!r.printable, "{line}");
     }
 }
+
+/// What a vase's spiral does at its start and at each turn
+/// ([`ramp_vase`]).
+#[derive(Clone, Copy)]
+struct Vase {
+    /// The first turn's clay against what its gap holds (1: as slicers
+    /// write it).
+    ramp_clay: f64,
+    /// At each turn's start: a move this long (mm) at this share of a
+    /// bead's clay, or with none (0).
+    dip: Option<(f64, f64)>,
+}
+
+/// A loop of 4 mm beads on the bed at Z 1.5 (moves 3.1 mm long), then ten turns of a spiral
+/// of 1.5 mm layers whose first turn climbs from the loop's top with its
+/// clay following the gap under it, as PrusaSlicer and Cura write vases
+/// (docs/CHECKER.md, "Ramps").
+fn ramp_vase(v: Vase) -> String {
+    use std::fmt::Write;
+    let (layer, w, r, n, e_per) = (1.5, 4.0, 30.0, 60, CheckConfig::default().e_per_mm3);
+    let mut g = format!(
+        "G21\nG90\nM82\nG92 E0\nG1 X{:.3} Y100 Z{layer:.3} F3000\n",
+        100.0 + r
+    );
+    let seg = std::f64::consts::TAU * r / n as f64;
+    let at = |a: f64| (100.0 + r * a.cos(), 100.0 + r * a.sin());
+    let mut e = 0.0;
+    for i in 1..=n {
+        let (x, y) = at(std::f64::consts::TAU * i as f64 / n as f64);
+        e += seg * layer * w * e_per;
+        writeln!(g, "G1 X{x:.3} Y{y:.3} E{e:.5} F1200").unwrap();
+    }
+    for t in 0..10 {
+        for i in 1..=n {
+            let a = std::f64::consts::TAU * i as f64 / n as f64;
+            let z = layer * (1.0 + t as f64 + i as f64 / n as f64);
+            let (gap, scale) = if t == 0 {
+                (layer * (i as f64 - 0.5) / n as f64, v.ramp_clay)
+            } else {
+                (layer, 1.0)
+            };
+            let mut len = seg;
+            if let (1, Some((dip, share))) = (i, v.dip.filter(|_| t > 0)) {
+                // The dip: the first `dip` mm of the turn's first move.
+                let (x0, y0) = at(std::f64::consts::TAU * (i - 1) as f64 / n as f64);
+                let f = dip / seg;
+                let (x, y) = (x0 + f * (at(a).0 - x0), y0 + f * (at(a).1 - y0));
+                e += dip * gap * w * e_per * share;
+                writeln!(g, "G1 X{x:.4} Y{y:.4} Z{z:.3} E{e:.5}").unwrap();
+                len = seg - dip;
+            }
+            let (x, y) = at(a);
+            e += len * gap * w * e_per * scale;
+            writeln!(g, "G1 X{x:.3} Y{y:.3} Z{z:.3} E{e:.5}").unwrap();
+        }
+    }
+    g
+}
+
+const SLICED: Vase = Vase {
+    ramp_clay: 1.0,
+    dip: None,
+};
+
+/// A ramp whose clay follows the gap under it lays what that gap holds:
+/// it is no under-extrusion (issue 55, class 1: its first moves failed as
+/// "under-extruded"); one laying 5 % of it over the turn is.
+#[test]
+fn a_ramp_laying_the_clay_of_its_gap_is_no_under_extrusion() {
+    let r = verdict(&ramp_vase(SLICED));
+    assert!(r.printable, "{}", r.render());
+    let starved = verdict(&ramp_vase(Vase {
+        ramp_clay: 0.05,
+        ..SLICED
+    }));
+    assert!(!starved.printable, "{}", starved.render());
+}
+
+/// Flow is judged over a bead's length (issue 55, class 2): a 0.3 mm move
+/// at 19 % at each turn prints, as does a 1 mm move with no clay (a ramp
+/// start rounded to `E0.000`) inside the run; a 2.5 mm move at 5 % is a
+/// flow drop, and a 3.1 mm move with no clay (over `width_min`) a travel.
+#[test]
+fn a_move_shorter_than_a_bead_is_no_flow_change() {
+    let with = |dip: f64, share: f64| {
+        verdict(&ramp_vase(Vase {
+            dip: Some((dip, share)),
+            ..SLICED
+        }))
+    };
+    let r = with(0.3, 0.19);
+    assert!(r.printable, "{}", r.render());
+    let r = with(1.0, 0.0);
+    assert!(r.printable, "{}", r.render());
+    assert_eq!(r.extrusion_runs, 1);
+    fails_for(&with(2.5, 0.05), "under-extruded", &[]);
+    fails_for(&with(3.1, 0.0), "travel", &["extrusion runs"]);
+}

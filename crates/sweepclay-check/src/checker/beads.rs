@@ -60,6 +60,7 @@ impl Checker<'_> {
             support_settled,
             recent,
             prev_support,
+            bed_loop_top,
             walk,
             steepest,
             overhang_near,
@@ -93,6 +94,10 @@ impl Checker<'_> {
         let id = beads.len() as u32;
         let mut width = cfg.width_min;
         let mut height = 0.0;
+        // The width its clay makes in the gap it fills, where that differs
+        // from `width` (a ramp over the loop below, a film): what the
+        // under-extrusion rule reads (docs/CHECKER.md, "Ramps").
+        let mut flow_width = f64::NAN;
         let horizon = s_start - 2.0 * cfg.width_max;
         settle(
             beads,
@@ -147,7 +152,11 @@ impl Checker<'_> {
             // for the rest (reversals, drops) each such bead is asked.
             // The shortcuts: along the pass below (`prev_support`), or on
             // the bare bed (a first layer: nothing below to follow).
-            let near_bed = mid[2] <= cfg.first_layer_max_mm;
+            // A ramp starting from a first layer laid at the tallest one
+            // (Z 3.000) lies on that loop's clay, the bed under it, until
+            // it has risen a thinnest layer over it.
+            let near_bed = mid[2] <= cfg.first_layer_max_mm
+                || bed_loop_top.is_some_and(|z| mid[2] < z + cfg.min_layer_mm);
             // The largest gap this bead's clay can stand in: as tall as
             // it would then be wide, with the widths' tolerance.
             let gap_limit = (section * (1.0 + WIDTH_TOLERANCE))
@@ -229,6 +238,14 @@ impl Checker<'_> {
                     // be on the thinnest layer, at most the widest bead (a
                     // move carrying next to no clay reads as under-extruded).
                     width = (volume / (len * cfg.min_layer_mm)).min(cfg.width_max);
+                    // A ramp climbing from the clay under it: its clay
+                    // follows the gap it fills, its first millimetres a few
+                    // percent of a bead because that is all the gap holds.
+                    // A flat move (a floor's join across the rings) has
+                    // no gap growing under it to read.
+                    if m.to[2] > m.from[2] && gap > 0.0 {
+                        flow_width = volume / (len * gap);
+                    }
                 }
             }
             rest = Some(match support {
@@ -237,6 +254,11 @@ impl Checker<'_> {
                 None if near_bed => Rest::Bed,
                 None => Rest::Air,
             });
+            *bed_loop_top = match rest {
+                Some(Rest::Bed) if mid[2] <= cfg.first_layer_max_mm => Some(m.from[2].max(m.to[2])),
+                Some(Rest::Bed) => *bed_loop_top,
+                _ => None,
+            };
             let (dz, overlap, offset, below_h) = match support {
                 _ if on_clay => (f64::NAN, f64::NAN, 0.0, 0.0),
                 Some(c) => {
@@ -476,13 +498,39 @@ impl Checker<'_> {
         // Less than a quarter of the narrowest bead's clay on a move that
         // is no climbing step: an under-extruded bead, unless nothing but
         // more of them follows (the final taper).
+        let width = if flow_width.is_finite() {
+            flow_width
+        } else {
+            width
+        };
         if !step && width.is_finite() {
-            if width < crate::report::UNDER_EXTRUDED * cfg.width_min {
+            let least = crate::report::UNDER_EXTRUDED * cfg.width_min;
+            if width < least {
                 self.under.push((m.line, width, len));
-            } else if !self.under.is_empty() {
-                for (line, w, _) in std::mem::take(&mut self.under) {
-                    self.record(Finding::UnderExtruded, line, w, false);
+            } else {
+                if !self.under.is_empty() {
+                    // Flow is judged over a bead's length: a dip shorter
+                    // than half `width_min` (a slicer's 0.3 mm layer-change
+                    // move at 19 %), with the full beads beside it, over
+                    // `width_min` of path; a longer one (a floor's 2.55 mm
+                    // join at 5 %) is a flow drop (docs/CHECKER.md, "Short
+                    // moves").
+                    let dip: f64 = self.under.iter().map(|u| u.2).sum();
+                    let clay: f64 = self.under.iter().map(|u| u.1 * u.2).sum();
+                    let side = if self.full_width.is_finite() {
+                        width.max(self.full_width)
+                    } else {
+                        width
+                    };
+                    let averaged = (clay + side * (cfg.width_min - dip)) / cfg.width_min;
+                    let under = std::mem::take(&mut self.under);
+                    if dip >= 0.5 * cfg.width_min || averaged < least {
+                        for (line, w, _) in under {
+                            self.record(Finding::UnderExtruded, line, w, false);
+                        }
+                    }
                 }
+                self.full_width = width;
             }
         }
         if self.lead.print_run.is_some() {

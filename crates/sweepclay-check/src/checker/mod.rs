@@ -235,6 +235,11 @@ struct Checker<'a> {
     /// length): a failure once a bead follows them, the final taper if
     /// none does and they are no longer than two widest beads.
     under: Vec<(usize, f64, f64)>,
+    /// The width of the last bead laid at full flow (not under-extruded).
+    full_width: f64,
+    /// Path without clay since the last bead (mm): shorter than a bead
+    /// inside a run, it joins the run (docs/CHECKER.md, "Short moves").
+    dry_len: f64,
     /// The feedrate of the last move (mm/min): how long a dwell is
     /// against the bead it holds up.
     last_feed: f64,
@@ -264,6 +269,10 @@ struct Checker<'a> {
     recent: Recent,
     /// The bead the last bead rests on.
     prev_support: Option<u32>,
+    /// The top of the first layer the last bead rested on the bed at, if
+    /// it did: a ramp climbing from that loop lies on the bed until it
+    /// has risen a thinnest layer (docs/CHECKER.md, "Ramps").
+    bed_loop_top: Option<f64>,
     /// Offset / layer height of the steepest overhang so far, and a ratio
     /// just under the overhang limit's.
     steepest: f64,
@@ -325,6 +334,8 @@ impl<'a> Checker<'a> {
             prev_overlap: 0.0,
             weak: Default::default(),
             under: Vec::new(),
+            full_width: f64::NAN,
+            dry_len: 0.0,
             last_feed: 0.0,
             typical_gap: 0.0,
             beads: Beads::default(),
@@ -343,6 +354,7 @@ impl<'a> Checker<'a> {
             support_settled: 0,
             recent: Recent::default(),
             prev_support: None,
+            bed_loop_top: None,
             steepest: f64::NEG_INFINITY,
             overhang_near: 0.999
                 * (cfg.max_overhang_deg + cfg.overhang_tolerance_deg)
@@ -422,8 +434,8 @@ impl<'a> Checker<'a> {
         self.trim_diagnostics();
         match event {
             Some(Event::Pause(line)) => {
+                self.break_run(line);
                 self.pending.push(((Finding::Pause), line, 0.0));
-                self.in_run = false;
             }
             // A dwell is a pause when clay pools in it: longer than laying
             // a narrowest bead's length of clay takes at the feed in force
@@ -431,8 +443,8 @@ impl<'a> Checker<'a> {
             Some(Event::Dwell(line, seconds)) => {
                 let feed_mm_s = (self.last_feed / 60.0).max(1.0);
                 if seconds > self.cfg.width_min / feed_mm_s {
+                    self.break_run(line);
                     self.pending.push(((Finding::Pause), line, seconds));
-                    self.in_run = false;
                 }
             }
             // Before the first bead, start code; after the last, end code;
@@ -442,8 +454,8 @@ impl<'a> Checker<'a> {
             }
             Some(Event::Unreplayed(..)) => {}
             Some(Event::Retract(line)) => {
+                self.break_run(line);
                 self.pending.push(((Finding::Retraction), line, 0.0));
-                self.in_run = false;
             }
             Some(Event::Move(m)) => {
                 self.framed(m);
@@ -502,6 +514,15 @@ impl<'a> Checker<'a> {
         });
     }
 
+    /// Ends the extrusion run: the dry moves it had taken in (shorter
+    /// than a bead so far) were a travel after all.
+    fn break_run(&mut self, line: usize) {
+        if self.in_run && self.started && self.dry_len > 0.0 {
+            self.pending.push((Finding::TravelMove, line, self.dry_len));
+        }
+        self.in_run = false;
+    }
+
     fn step(&mut self, m: &Move) {
         let cfg = self.cfg;
         let len = m.length();
@@ -512,12 +533,12 @@ impl<'a> Checker<'a> {
         // Continuity.
         self.r.moves += 1;
         if m.de < -EPS_E {
+            self.break_run(m.line);
             self.pending.push(((Finding::Retraction), m.line, -m.de));
-            self.in_run = false;
         } else if is_extruding && len == 0.0 {
+            self.break_run(m.line);
             self.pending
                 .push(((Finding::ExtrusionWithoutMotion), m.line, m.de));
-            self.in_run = false;
         } else if bead {
             self.started = true;
             self.r.extruding_moves += 1;
@@ -530,11 +551,19 @@ impl<'a> Checker<'a> {
                 self.new_run(m);
             }
             self.in_run = true;
+            self.dry_len = 0.0;
         } else if len > 0.0 {
-            if self.started {
-                self.pending.push(((Finding::TravelMove), m.line, len));
+            // A move without clay shorter than a bead inside a run (a
+            // slicer's ramp start rounded to E0.000) joins it: no clay
+            // extruder stops and starts within a bead's length.
+            let joins = self.in_run && self.dry_len + len < cfg.width_min;
+            if !joins {
+                self.break_run(m.line);
+                if self.started {
+                    self.pending.push(((Finding::TravelMove), m.line, len));
+                }
             }
-            self.in_run = false;
+            self.dry_len += len;
         }
         // Bounds (the machine cannot go there, start code or not).
         let mut out =
