@@ -1,8 +1,9 @@
-//! Collisions with the extruder (docs/CHECKER.md, "Checks"): along a move,
-//! every r/2 mm of path, the carriage against the highest clay and the
-//! nozzle cylinder (radius r, up to H above the tip) against the settled
-//! clay near it. Clay laid in the last r + w_max of path is the bead just
-//! laid, not an obstacle.
+//! Collisions with the extruder (docs/CHECKER.md, "Collisions"): along a
+//! move, every `w_min`/2 mm of path, the carriage against the highest clay and
+//! the nozzle against the settled clay near it. The nozzle is a cone from
+//! the tip (`w_min`/2 round) widening at 45° up to the body's radius r,
+//! to H above the tip. Only the clay the tip is laying (the last `w_max`
+//! of path) is exempt, whatever r.
 
 use crate::bead::Beads;
 use crate::grid::BeadGrid;
@@ -11,7 +12,7 @@ use crate::report::Finding;
 use crate::CheckConfig;
 
 /// Probes move `m` (`len` long, from path distance `s_start` to `s_end`)
-/// at points every r/2 mm of path (at most 200 a move), settling the
+/// at points every `w_min`/2 mm of path (at most 200 a move), settling the
 /// beads the nozzle has left behind as it goes; `hit` gets each
 /// collision ([`Finding::CarriageCollision`] or
 /// [`Finding::NozzleCollision`]) with how high the clay reaches above
@@ -25,9 +26,13 @@ pub(crate) fn probe(
     (m, len, s_start, s_end): (&Move, f64, f64, f64),
     mut hit: impl FnMut(Finding, f64),
 ) {
-    let recent_nozzle = cfg.nozzle_radius + cfg.width_max;
-    let reach = cfg.nozzle_radius + cfg.width_max / 2.0;
-    let every = (cfg.nozzle_radius / 2.0).max(0.5);
+    let recent_nozzle = cfg.width_max;
+    // The nozzle's widest, at H above the tip.
+    let widest = nozzle_radius_at(cfg, cfg.nozzle_height);
+    let reach = widest + cfg.width_max / 2.0;
+    // Probes as close as the tip is wide, whatever the body: the same
+    // places are asked of every body, so a bigger one finds no less.
+    let every = (0.5 * cfg.width_min).max(0.5);
     // Path distances are ≥ 0, where truncation is the floor (and no
     // library call).
     let floor = |v: f64| (v as i64) as f64;
@@ -58,7 +63,7 @@ pub(crate) fn probe(
                 return;
             }
             let (d, z, _) = b.closest(p);
-            if z > zlo && d < cfg.nozzle_radius + b.width() / 2.0 {
+            if z > zlo && d < nozzle_radius_at(cfg, z - p[2]) + b.width() / 2.0 {
                 worst = worst.max(z - p[2]);
             }
         });
@@ -66,4 +71,13 @@ pub(crate) fn probe(
             hit(Finding::NozzleCollision, worst);
         }
     }
+}
+
+/// The nozzle's radius `h` mm above its tip: `w_min`/2 at the tip (the
+/// bore's rim), widening by a millimetre a millimetre (45°, wider than
+/// any clay nozzle's taper: Luer and WASP tips widen 0.2–0.4 mm a
+/// millimetre), at most the body's radius.
+#[inline]
+pub(crate) fn nozzle_radius_at(cfg: &CheckConfig, h: f64) -> f64 {
+    (0.5 * cfg.width_min + h.max(0.0)).min(cfg.nozzle_radius)
 }

@@ -241,6 +241,36 @@ fn an_extruder_body_past_any_clay_extruder_is_refused_by_name() {
         .contains("nozzle_radius"));
 }
 
+/// Only the clay the tip is laying is exempt, whatever the body's radius
+/// (docs/CHECKER.md, "Collisions"): a 10 mm wall ten layers tall, then a
+/// bead on the bed 5 mm beside it. The wall's 100 mm of path lay within
+/// the last r + w_max of a 200 mm body's path, so that body passed what a
+/// 20 mm body failed; now every body fails, a bigger one no less.
+#[test]
+fn a_bigger_extruder_body_sees_no_fewer_collisions() {
+    let mut g = wall_from(50.0, 60.0, 10);
+    g.line("G0 Z20");
+    g.line("G0 X45 Y55");
+    g.line("G0 Z1.25");
+    g.at = [45.0, 55.0, LAYER];
+    g.run([65.0, 55.0, LAYER], W, LAYER);
+    let mut before = 0;
+    for radius in [5.0, 20.0, 60.0, 200.0] {
+        let cfg = CheckConfig {
+            nozzle_radius: radius,
+            ..CheckConfig::default()
+        };
+        let r = check(&g.out, &cfg);
+        fails_for(&r, "nozzle collision", &["travel", "extrusion runs"]);
+        let n = r.findings[Finding::NozzleCollision].count;
+        assert!(
+            n >= before,
+            "r {radius}: {n} collisions, {before} with a smaller body"
+        );
+        before = n;
+    }
+}
+
 #[test]
 fn clay_far_outside_the_bed_is_still_seen() {
     // The collision fixture 250 mm beyond a 200 mm bed (past the indexed

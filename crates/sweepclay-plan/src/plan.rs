@@ -478,23 +478,26 @@ mod tests {
 
     #[test]
     fn a_twist_the_shape_cannot_take_is_refused_with_the_most_it_takes() {
-        // A small oval pot (random vessel 167 of seed 1) turned −80°: the
-        // twist's estimates let it through, but its G-code's body meets
-        // clay whatever the loop tightens. The refusal says how much twist
-        // this shape takes, and that much prints.
+        // A small oval pot (random vessel 167 of seed 1) turned −100°: the
+        // twist's estimates let it through (they allow 109°), but its
+        // G-code overhangs and meets clay whatever the loop tightens. The
+        // refusal says how much twist this shape takes, and that much
+        // prints. (At −80° it failed for the nozzle while the checker took
+        // the body's full radius down to the tip; with the nozzle's cone it
+        // prints: docs/CHECKER.md, "Collisions".)
         let mut d = Design::from_json(
             r#"{"sweepclay": 1, "profile_start": {"control_points": [[0, 0], [1.228, 8.835], [0, 17.670]]},
             "profile_end": {"control_points": [[0, 0], [-6.480, 14.505], [0, 29.009]]},
             "trajectory": {"control_points": [[28.455, -2.410], [19.385, 10.959], [-2.512, 16.497], [-24.408, 10.959],
               [-33.478, -2.410], [-24.408, -15.779], [-2.512, -21.317], [19.385, -15.779]], "closed": true, "offset": "normal"},
-            "params": {"floor_layers": 2}, "twist_deg": -80,
+            "params": {"floor_layers": 2}, "twist_deg": -100,
             "printer": {"name": "wide", "build_volume": [300, 300, 250], "origin": [150, 150]}}"#,
         )
         .unwrap();
         let c = checked(&d, 0.5);
         assert!(!c.report.printable);
         let most = c.most_twist.expect("the untwisted pot prints");
-        assert!((0.0..80.0).contains(&most), "{most}");
+        assert!((0.0..100.0).contains(&most), "{most}");
         assert!(
             c.advice()
                 .iter()
