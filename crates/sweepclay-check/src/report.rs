@@ -173,7 +173,7 @@ impl Finding {
             Finding::CarriageCollision => "carriage collision(s) with printed clay",
             Finding::Unsupported => "bead(s) with no clay below",
             Finding::LayerGap => {
-                "bead(s) resting on clay farther below than they are wide (clay two layers down is no support)"
+                "bead(s) resting on clay farther below than they are wide (a coil narrower than its layer does not stand; clay two layers down is no support)"
             }
             Finding::DoubleDeposition => "stretch(es) of beads laid on clay at their own height",
             Finding::UnderMinOverlap => "bead(s) overlapping the bead below by less than half",

@@ -555,6 +555,30 @@ pub(crate) fn clay_within_gap(beads: &Beads, grid: &BeadGrid, q: &Query, gap: f6
     found
 }
 
+/// Whether earlier clay lies beside the new bead at its own height (within
+/// a thinnest layer, `width_max` in plan), not counting the run's fresh
+/// clay of the last 2 `width_max` of path: a thin bead between such
+/// neighbours (a floor's narrowed tail) stands between them; a thin coil
+/// with nothing beside it does not (docs/CHECKER.md, "Layer gaps").
+pub(crate) fn flanked(beads: &Beads, grid: &BeadGrid, q: &Query) -> bool {
+    let (mid, cfg) = (q.mid, q.cfg);
+    let (lo, hi) = (mid[2] - cfg.min_layer_mm, mid[2] + cfg.min_layer_mm);
+    let mut found = false;
+    grid.in_box(mid, cfg.width_max, lo, hi, |run| {
+        found = found
+            || (run.first..=run.last).any(|j| {
+                let b = &beads[j as usize];
+                if b.step || q.s_start - b.s_end <= 2.0 * cfg.width_max || is_smear(b.width(), cfg)
+                {
+                    return false;
+                }
+                let (d, z, _) = b.closest(mid);
+                z > lo && z < hi && d <= cfg.width_max
+            });
+    });
+    found
+}
+
 /// Whether a bead lies at the new bead's own height under its middle
 /// ([`Class::Double`]): asked of the beads themselves where a cell too
 /// coarse to tell holds clay that high near it (beside the rings of a

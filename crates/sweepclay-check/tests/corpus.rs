@@ -193,14 +193,11 @@ fn each_hand_made_fault_fails_for_its_fault() {
             ][..],
         ),
         // `M221 S25` on 3.7 mm beads and 1.5 mm layers: a 0.92 mm coil,
-        // narrower than it is tall. It fails for the turns above it,
-        // which overlap it by less than half; the coil itself still passes
-        // as a thin bead (issue 55, class 4: docs/CHECKER.md, "Layer
-        // gaps", says why that rule waits).
+        // narrower than it is tall, does not stand (issue 55, class 4).
         (
             "fault-m221-25.gcode",
-            "overlapping the bead below",
-            &["under-extruded"][..],
+            "farther below than they are wide",
+            &["overlapping the bead below", "overhang", "under-extruded"][..],
         ),
     ] {
         println!("{file}");

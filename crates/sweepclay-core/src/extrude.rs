@@ -106,6 +106,46 @@ fn across(path: &Toolpath, i: usize, q: [f64; 3]) -> f64 {
     ((t[0] * d[1] - t[1] * d[0]) / l).abs()
 }
 
+/// For a twisted vessel, whether point `i` lies behind the start of the
+/// wall's first turn though its point below `b` is on that turn: a
+/// column turns with height, so the point below a second-turn point lies
+/// along the wall from it (4.7 mm at r 30 mm for two turns over 100 mm),
+/// and where it lies ahead of the first turn's start, nothing but the
+/// floor is under the point (the round vase twisted −720° laid three
+/// beads 1.5 mm wide over a 2.5 mm gap there). Always false otherwise.
+fn twisted_wall_start(path: &Toolpath) -> impl Fn(usize, usize) -> bool + '_ {
+    use crate::toolpath::PointKind;
+    let pts = &path.points;
+    let start = path
+        .vessel
+        .as_ref()
+        .filter(|_| path.twisted)
+        .and_then(|_| pts.iter().position(|p| p.kind != PointKind::Floor));
+    // Path length in plan from the wall's start to each of its points.
+    let mut s = vec![0.0; pts.len()];
+    if let Some(w) = start {
+        for k in w + 1..pts.len() {
+            let (a, b) = (pts[k - 1].pos, pts[k].pos);
+            s[k] = s[k - 1] + (b[0] - a[0]).hypot(b[1] - a[1]);
+        }
+    }
+    move |i, b| {
+        let Some(w) = start else { return false };
+        if b < w || b + 1 >= pts.len() {
+            return false;
+        }
+        let (p, q) = (pts[i].pos, pts[b].pos);
+        let (lo, hi) = (pts[b.saturating_sub(1).max(w)].pos, pts[b + 1].pos);
+        let t = [hi[0] - lo[0], hi[1] - lo[1]];
+        let l = t[0].hypot(t[1]);
+        if l < 1e-9 {
+            return false;
+        }
+        let along = ((p[0] - q[0]) * t[0] + (p[1] - q[1]) * t[1]) / l;
+        s[b] + along < 0.0
+    }
+}
+
 /// Computes widths and volumes. `origin` is where the path's origin lands
 /// on the bed (the printer's): steps are told from beads on the
 /// coordinates the G-code will carry, as the checker reads them.
@@ -117,8 +157,15 @@ pub fn plan_extrusion(path: &Toolpath, params: &Params, origin: [f64; 2]) -> Ext
     let floor_top = path.vessel.as_ref().map_or(0.0, |v| v.floor_top_mm);
     let mut layer_height = Vec::with_capacity(n);
     let mut offset = Vec::with_capacity(n);
+    let before_wall = twisted_wall_start(path);
     for (i, p) in path.points.iter().enumerate() {
         match path.below[i] {
+            Some(b) if before_wall(i, b as usize) => {
+                // Over the floor, where the wall's first turn has not
+                // yet begun (docs/ALGORITHMS.md §8, "Twist").
+                layer_height.push(p.pos[2] - floor_top);
+                offset.push(0.0);
+            }
             Some(b) => {
                 let q = path.points[b as usize].pos;
                 layer_height.push(p.pos[2] - q[2]);

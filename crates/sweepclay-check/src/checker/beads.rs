@@ -270,14 +270,19 @@ impl Checker<'_> {
                     // bead of its own; a bead climbing
                     // a thinnest layer or more climbs from the clay it
                     // was just laid on (a finishing pass, a sloping edge).
-                    // A thin bead (a floor's narrowed tail between its
-                    // neighbours) fails only over a gap well beyond the
-                    // layers laid so far: clay two layers down.
+                    // A thin bead between neighbours at its height (a
+                    // floor's narrowed tail) fails only over a gap well
+                    // beyond the layers laid so far: clay two layers down;
+                    // a thin coil with none beside it fails over any gap
+                    // taller than it is wide.
                     if rise < cfg.min_layer_mm {
                         let thin = width < cfg.width_min * (1.0 - WIDTH_TOLERANCE);
                         let deep = *typical_gap == 0.0 || dz > DEEP_GAP * *typical_gap;
                         let over = dz > gap_limit
-                            && (!thin || deep)
+                            // A smear is the under-extrusion rule's, not a
+                            // bead that stands or falls.
+                            && !crate::support::is_smear(width, cfg)
+                            && (!thin || deep || !crate::support::flanked(beads, grid, &q))
                             && !crate::support::clay_within_gap(beads, grid, &q, gap_limit);
                         if !over {
                             *typical_gap = if *typical_gap == 0.0 {
