@@ -831,3 +831,42 @@ async fn silent_connections_give_their_places_back_in_seconds() {
         t.elapsed()
     );
 }
+
+/// Issue 58: long work is answered at the limit the server states. The
+/// twisted lobes sampled every 0.02 mm (1.4 million samples, about 15 s)
+/// against a 1 s limit: 503 naming the limit within a few seconds. The
+/// work itself stops at its next stage boundary (the self-intersection
+/// search, 11 of its 15 s, has none) and gives its worker back: the next
+/// slice is answered (docs/MODELER.md, "Limits").
+#[tokio::test]
+async fn work_past_the_time_limit_stops_there_and_says_so() {
+    let base = server(Limits {
+        request_timeout: std::time::Duration::from_secs(1),
+        workers: 1,
+        ..Limits::default()
+    })
+    .await;
+    let mut d: Value = serde_json::from_str(examples::example("twisted-lobes").unwrap()).unwrap();
+    d["params"] = serde_json::json!({ "spacing": 0.02 });
+    let started = std::time::Instant::now();
+    let r = post(&format!("{base}/api/slice"), d.to_string()).await;
+    assert_eq!(r.status(), 503);
+    let v: Value = r.json().await.unwrap();
+    assert_eq!(
+        v["error"], "the work took longer than this server's limit of 1 s",
+        "{v}"
+    );
+    assert!(started.elapsed() < std::time::Duration::from_secs(5));
+    // The one worker was given back once the work stopped.
+    let t1 = examples::example("t1").unwrap();
+    let mut answered = false;
+    for _ in 0..60 {
+        let r = post(&format!("{base}/api/slice"), t1.to_string()).await;
+        if r.status() == 200 {
+            answered = true;
+            break;
+        }
+        tokio::time::sleep(std::time::Duration::from_millis(500)).await;
+    }
+    assert!(answered, "the worker stayed taken");
+}
