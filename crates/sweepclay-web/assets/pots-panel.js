@@ -116,6 +116,18 @@ function potEdit(i, what, inp) {
   if (v == null) return;
   const d = state.design;
   const pts = potRows(d);
+  // Far past the printer is a slip of the keyboard, refused here before
+  // anything is drawn or sampled: a row 1e6 mm up crashed the tab.
+  const printer = currentPrinter(d);
+  if (printer) {
+    const bv = printer.build_volume;
+    const most = what === 'z' ? 4 * bv[2] : 4 * Math.max(bv[0], bv[1]);
+    if (v > most) {
+      const says = what === 'z' ? `the ${fmtMm(bv[2])} mm the ${printer.name} prints in height` : `the ${fmtMm(Math.max(bv[0], bv[1]))} mm the ${printer.name}'s bed spans`;
+      potError(inp, `${what === 'z' ? 'height' : 'width'} ${fmtMm(v)} mm: at most ${fmtMm(most)} mm here, four times ${says}`);
+      return;
+    }
+  }
   if (what === 'z') {
     // Any height above the base takes its place among the rows (they
     // stay sorted, each keeping its width); it may not sit on another.

@@ -3442,6 +3442,64 @@ async fn a_refusal_shows_on_the_phones_shape_tab() {
     no_page_errors_and_close(c).await;
 }
 
+/// Issue 59, point 4: a row height of 1e6 or 1e9 crashed the tab, 100000
+/// moved the row to the bottom and blamed the point spacing, a width of
+/// 1e9 was refused far from the field in control-point words. Each is now
+/// refused beside the table in words, before anything is drawn or
+/// sampled, and the design keeps its rows.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn typos_in_the_pot_rows_are_refused_beside_them() {
+    let Some(Session {
+        driver: _driver,
+        c,
+        base,
+        ..
+    }) = Session::start().await
+    else {
+        return;
+    };
+    open_first_slice(&c, &base).await;
+    click(&c, "new-pot").await;
+    wait_js(
+        &c,
+        &format!("return {IDLE} && !window.sweepclay.design.profile_end"),
+        "a new pot",
+    )
+    .await;
+    let before = js(
+        &c,
+        "return JSON.stringify(window.sweepclay.design.profile_start.control_points)",
+    )
+    .await;
+    for (id, typed, says) in [
+        ("pot-z1", "1e6", "height 1000000 mm: at most"),
+        ("pot-z1", "1e9", "height 1000000000 mm: at most"),
+        ("pot-z1", "100000", "height 100000 mm: at most"),
+        ("pot-w1", "1e9", "width 1000000000 mm: at most"),
+        ("pot-w0", "1e9", "width 1000000000 mm: at most"),
+    ] {
+        set_value(&c, id, typed).await;
+        let said = wait_js(
+            &c,
+            &format!(
+                "const e = document.getElementById('pot-error').textContent; return document.getElementById('{id}').classList.contains('bad') && e.length > 0 && e"
+            ),
+            &format!("{id} = {typed} refused"),
+        )
+        .await;
+        let said = said.as_str().unwrap();
+        assert!(said.starts_with(says), "{id} = {typed}: {said}");
+        assert!(said.contains("four times"), "{said}");
+        let now = js(
+            &c,
+            "return JSON.stringify(window.sweepclay.design.profile_start.control_points)",
+        )
+        .await;
+        assert_eq!(now, before, "{id} = {typed} changed the design");
+    }
+    no_page_errors_and_close(c).await;
+}
+
 /// The path's width across (its x-extent, mm) at each of `zs` in a
 /// G-code text: the moves within 0.7 mm of that height.
 fn widths_at(gcode: &str, zs: &[f64]) -> Vec<f64> {
