@@ -215,8 +215,8 @@ pub fn fit(bands: &[Band], measured_mm: &[f64], e_written: f64) -> Result<Fit> {
     for (i, (&t, b)) in measured_mm.iter().zip(bands).enumerate() {
         if !(t.is_finite() && t > 0.2 * b.width_mm && t < 5.0 * b.width_mm) {
             return Err(Error::invalid(
-                format!("measured[{i}]"),
-                format!("{t} mm is not a wall thickness for a band written {:.2} mm thick (band {} from the bottom); measure the wall, not the diameter", b.width_mm, i + 1),
+                format!("band {} from the bottom", i + 1),
+                format!("{t} mm is not a wall thickness for a band written {:.2} mm thick; measure the wall, not the diameter", b.width_mm),
             ));
         }
     }
@@ -300,7 +300,10 @@ mod tests {
         let e = fit(&p.bands, &[3.0, 4.0, 60.0, 6.0], 0.13)
             .unwrap_err()
             .to_string();
-        assert!(e.contains("measured[2]") && e.contains("diameter"), "{e}");
+        assert!(
+            e.contains("band 3 from the bottom") && e.contains("diameter"),
+            "{e}"
+        );
     }
 
     #[test]

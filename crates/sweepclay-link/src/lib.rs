@@ -91,7 +91,7 @@ pub enum LinkError {
         why: String,
     },
     /// The key or password was refused.
-    #[error("{host} refused the {what}: copy it again from {host}'s settings (`sweepclay send --save-key`, or the printer dialog)")]
+    #[error("{host} refused the {what}: copy it again from {host}'s settings and save it with sweepclay send --save-key")]
     WrongKey {
         /// The host's name in messages.
         host: &'static str,

@@ -14,3 +14,9 @@ export function parseDecimal(text) {
 /** A length as the page shows it: at most two decimals, no trailing zeros. */
 export const fmtMm = (v) => String(Number(v.toFixed(2)));
 
+
+/**
+ * An extrusion calibration (E per mm³) as the page shows it: five
+ * significant digits, no trailing zeros (0.41575168807678786 → 0.41575).
+ */
+export const fmtE = (v) => String(Number(Number(v).toPrecision(5)));

@@ -35,7 +35,7 @@ export function buildParams() {
   editPrinter.type = 'button';
   editPrinter.id = 'printer-edit';
   editPrinter.textContent = 'Edit printer…';
-  editPrinter.title = 'Set up your own printer: build volume, bed_min, origin, E per mm³, nozzle body, start and end code';
+  editPrinter.title = 'Set up your own printer: build volume, where the bed and the pot sit, E per mm³, nozzle body, start and end code';
   editPrinter.addEventListener('click', openPrinter);
   form.appendChild(editPrinter);
   for (const [key, label, unit, step, help, factor] of PARAMS) {

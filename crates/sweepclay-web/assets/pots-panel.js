@@ -251,7 +251,7 @@ $('pot-height').addEventListener('change', () => {
   const pts = state.design.profile_start.control_points;
   const top = pts[pts.length - 1][1];
   if (!(h >= MIN_DZ * (pts.length - 1))) {
-    potError(inp, `height ${fmtMm(h)} mm: too low for ${pts.length} heights`);
+    potError(inp, `height ${fmtMm(h)} mm: too low for its ${pts.length} rows, which stand at least ${fmtMm(MIN_DZ)} mm apart (at least ${fmtMm(MIN_DZ * (pts.length - 1))} mm)`);
     return;
   }
   // Taller than the printer is shown, the part outside in violet; far

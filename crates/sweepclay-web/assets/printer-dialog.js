@@ -4,7 +4,7 @@
 // the calibration print and its fit; the printer a design names.
 
 import { download, postDesign } from './io.js';
-import { fmtMm, parseDecimal } from './numbers.js';
+import { fmtE, fmtMm, parseDecimal } from './numbers.js';
 import { setVerdict, showError } from './status.js';
 import { clone, edit, setDesign, state } from './store.js';
 
@@ -38,7 +38,7 @@ export function openPrinter() {
     for (let k = 0; k < n; k++) $(`${id}${k}`).value = (base[key] || [0, 0, 0])[k];
   }
   $('pr-dia').value = base.bed_diameter || '';
-  $('pr-e').value = base.e_per_mm3;
+  $('pr-e').value = fmtE(base.e_per_mm3);
   $('pr-r').value = base.nozzle_radius;
   $('pr-h').value = { ...state.meta.params, ...(d.params || {}) }.nozzle_height;
   $('pr-rel').checked = !!base.relative_e;
@@ -126,7 +126,7 @@ $('pr-cal-print').addEventListener('click', async () => {
   download(await r.blob(), 'calibration.gcode');
   const e = parseFloat($('pr-e').value);
   keepWrittenE($('pr-name').value.trim(), e);
-  $('pr-cal-result').textContent = `Written with E per mm³ ${e}; Compute uses that, whatever the field says later.`;
+  $('pr-cal-result').textContent = `Written with E per mm³ ${fmtE(e)}; Compute uses that, whatever the field says later.`;
 });
 
 $('pr-cal-fit').addEventListener('click', async () => {
@@ -147,9 +147,9 @@ $('pr-cal-fit').addEventListener('click', async () => {
     $('pr-cal-result').textContent = `The bands disagree by ${spread} %: measure again at each band's middle (nothing changed).`;
     return;
   }
-  $('pr-e').value = f.e_per_mm3.toFixed(5);
-  const from = written ? `the print was written with ${written}` : `no print downloaded here: taken as written with ${f.written_e_per_mm3}`;
-  $('pr-cal-result').textContent = `E per mm³ ${f.e_per_mm3.toFixed(5)} (${from}; the bands agree within ${spread} %). "Use and keep" keeps it.`;
+  $('pr-e').value = fmtE(f.e_per_mm3);
+  const from = written ? `the print was written with ${written}` : `no print downloaded here: taken as written with ${fmtE(f.written_e_per_mm3)}`;
+  $('pr-cal-result').textContent = `E per mm³ ${fmtE(f.e_per_mm3)} (${from}; the bands agree within ${spread} %). "Use and keep" keeps it.`;
 });
 
 $('printer-form').addEventListener('submit', (e) => {
@@ -180,7 +180,7 @@ $('printer-form').addEventListener('submit', (e) => {
   const bad = [
     [!printer.name, 'give the printer a name'],
     [!printer.build_volume.every((v) => v > 0), 'the build volume must be positive on every axis'],
-    [![...printer.bed_min, ...printer.origin].every(Number.isFinite), 'bed_min and the origin must be numbers'],
+    [![...printer.bed_min, ...printer.origin].every(Number.isFinite), 'the box\'s lowest corner and where the pot\'s centre lands must be numbers'],
     [dia && !(printer.bed_diameter > 0), 'the bed diameter must be a positive number of mm, or empty for a rectangular bed'],
     [!(printer.e_per_mm3 > 0), 'E per mm³ must be positive'],
     [!(printer.nozzle_radius >= 0), 'the nozzle body radius must be a number of mm'],

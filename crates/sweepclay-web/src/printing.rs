@@ -65,6 +65,13 @@ fn link_for(
 
 /// A print host's refusal as the page shows it: 502, the host's sentence.
 fn host_error(e: sweepclay_link::LinkError) -> ApiError {
+    // The page says what to do on the page, not on a command line.
+    if let sweepclay_link::LinkError::WrongKey { host, what } = e {
+        return ApiError::new(
+            502,
+            format!("{host} refused the {what}: copy it again from {host}'s settings into \"key\" in Edit printer…, and save"),
+        );
+    }
     ApiError::new(502, e.to_string())
 }
 

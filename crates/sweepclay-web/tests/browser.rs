@@ -3362,6 +3362,24 @@ async fn the_printer_dialog_calibrates_e_from_measured_walls() {
     .as_f64()
     .unwrap();
     assert_eq!(again, e, "Compute is idempotent");
+    // In words a potter reads: E to five digits, not 0.41575168807678786.
+    let shown = js(&c, "return document.getElementById('pr-e').value").await;
+    let digits = shown.as_str().unwrap().trim_start_matches("0.").len();
+    assert!(digits <= 5, "{shown}");
+    assert!(said.as_str().unwrap().len() < 160, "{said}");
+    // A diameter typed for a wall names the band, not `measured[0]`.
+    set_value(&c, "pr-cal-1", "80").await;
+    click(&c, "pr-cal-fit").await;
+    let bad = wait_js(
+        &c,
+        "const t = document.getElementById('pr-cal-result').textContent; return t.includes('not a wall thickness') && t",
+        "the band refused",
+    )
+    .await;
+    let bad = bad.as_str().unwrap();
+    assert!(bad.starts_with("band 1 from the bottom: 80 mm"), "{bad}");
+    assert!(!bad.contains('['), "{bad}");
+    set_value(&c, "pr-cal-1", "3,30").await;
     // Walls that disagree change nothing.
     set_value(&c, "pr-cal-2", "6").await;
     click(&c, "pr-cal-fit").await;

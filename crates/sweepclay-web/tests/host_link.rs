@@ -32,6 +32,8 @@ enum Answer {
     Redirect(String),
     /// 200 with a body that never ends.
     Endless,
+    /// 403, as OctoPrint answers a wrong key.
+    Refuse,
 }
 
 async fn stand_in(answer: Answer) -> (String, Log) {
@@ -57,6 +59,7 @@ async fn stand_in(answer: Answer) -> (String, Log) {
                         .header("location", format!("{to}/api/job?apikey=x"))
                         .body(Body::empty())
                         .unwrap(),
+                    Answer::Refuse => StatusCode::FORBIDDEN.into_response(),
                     Answer::Endless => {
                         let chunk = axum::body::Bytes::from(vec![b' '; 64 << 10]);
                         let s = futures_stream(chunk);
@@ -212,4 +215,14 @@ async fn the_server_talks_only_to_saved_hosts_and_keys_stay_with_theirs() {
             0
         );
     }
+    // Issue 59, point 5: a wrong key is said in the page's words, with no
+    // command line and no backticks.
+    let (refusing, _) = stand_in(Answer::Refuse).await;
+    save(&base, json!({"url": refusing, "key": "wrong"})).await;
+    let (code, v) = status(&base, &refusing).await;
+    assert_eq!(code, 502, "{v}");
+    let said = v["error"].as_str().unwrap();
+    assert!(said.starts_with("OctoPrint refused the API key"), "{said}");
+    assert!(said.contains("Edit printer"), "{said}");
+    assert!(!said.contains('`') && !said.contains("--"), "{said}");
 }
