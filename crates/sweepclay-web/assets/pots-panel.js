@@ -107,6 +107,8 @@ function potNumber(inp, what) {
 function potError(inp, msg) {
   $('pot-error').textContent = msg;
   inp.classList.add('bad');
+  // On a phone the keyboard may cover it: bring the words into view.
+  $('pot-error').scrollIntoView({ block: 'nearest' });
 }
 
 /** Row `i`'s height or width typed in, within the profile's rules. */

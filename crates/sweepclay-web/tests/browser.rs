@@ -1372,6 +1372,99 @@ async fn finger_drag(c: &Client, from: (f64, f64), by: (f64, f64), steps: usize)
 /// checkbox counts by its label.
 const SMALL_CONTROLS: &str = "return [...document.querySelectorAll('button, select, input, textarea')].filter((e) => e.offsetParent !== null && !e.closest('dialog:not([open])')).map((e) => { const t = e.type === 'checkbox' ? e.closest('label') || e : e; const r = t.getBoundingClientRect(); return [e.id || e.textContent.trim() || e.type, Math.round(r.width), Math.round(r.height)]; }).filter(([, w, h]) => w < 44 || h < 44)";
 
+/// Issue 59, point 6: on a phone the printer dialog's "Calibrate" summary
+/// (18 px) and key field (21 px) were under a fingertip; with the
+/// keyboard up (the page 508 px tall) the header and tabs took 200 px and
+/// a row's error landed under the keyboard. Now every control of the
+/// dialog is 44 px, and while a field has the focus the header and tabs
+/// step aside and the row's error is on screen.
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn the_printer_dialog_and_a_rows_error_fit_a_phone() {
+    let Some(Session {
+        driver: _driver,
+        c,
+        base,
+        ..
+    }) = Session::start().await
+    else {
+        return;
+    };
+    c.set_window_size(390, 844).await.unwrap();
+    open_first_slice(&c, &base).await;
+    c.execute(
+        "document.querySelector('#tabs button[data-tab=side]').click()",
+        vec![],
+    )
+    .await
+    .unwrap();
+    tap_id(&c, "printer-edit").await;
+    wait_js(
+        &c,
+        "return document.getElementById('printer-dialog').open",
+        "the printer dialog",
+    )
+    .await;
+    js(
+        &c,
+        "document.getElementById('pr-cal').open = true; return 0",
+    )
+    .await;
+    tokio::time::sleep(Duration::from_millis(200)).await;
+    let small = js(
+        &c,
+        "return [...document.querySelectorAll('#printer-dialog summary, #printer-dialog button, #printer-dialog select, #printer-dialog input:not([type=checkbox]), #printer-dialog textarea')].filter((e) => e.offsetParent !== null).map((e) => { const r = e.getBoundingClientRect(); return [e.id || e.textContent.trim().slice(0, 20) || e.type, Math.round(r.width), Math.round(r.height)]; }).filter(([, w, h]) => w < 44 || h < 44)",
+    )
+    .await;
+    assert_eq!(small, json!([]), "the printer dialog: controls under 44 px");
+    js(
+        &c,
+        "document.getElementById('printer-dialog').close(); return 0",
+    )
+    .await;
+    // The keyboard up: 508 px of page. A height on the base, refused.
+    c.set_window_size(390, 508).await.unwrap();
+    c.execute(
+        "document.querySelector('#tabs button[data-tab=editors]').click()",
+        vec![],
+    )
+    .await
+    .unwrap();
+    tap_id(&c, "new-pot").await;
+    wait_js(
+        &c,
+        &format!("return {IDLE} && !window.sweepclay.design.profile_end"),
+        "a new pot",
+    )
+    .await;
+    tap_id(&c, "pot-z2").await;
+    let e = c.find(fantoccini::Locator::Id("pot-z2")).await.unwrap();
+    js(&c, "document.getElementById('pot-z2').select(); return 0").await;
+    e.send_keys("0,3").await.unwrap();
+    // The change fires while the field keeps the focus (Enter).
+    js(
+        &c,
+        "document.getElementById('pot-z2').dispatchEvent(new Event('change')); return 0",
+    )
+    .await;
+    let at = wait_js(
+        &c,
+        "const e = document.getElementById('pot-error'); const r = e.getBoundingClientRect(); return e.textContent.length > 0 && [r.top, r.bottom, window.innerHeight, document.getElementById('header-extras').getBoundingClientRect().height, document.activeElement.id]",
+        "the error",
+    )
+    .await;
+    let (top, bottom, height) = (
+        at[0].as_f64().unwrap(),
+        at[1].as_f64().unwrap(),
+        at[2].as_f64().unwrap(),
+    );
+    assert!(top >= 0.0 && bottom <= height, "the error off screen: {at}");
+    assert_eq!(at[3], json!(0), "the header stays while typing: {at}");
+    if let Ok(path) = std::env::var("SWEEPCLAY_KEYBOARD_SCREENSHOT") {
+        std::fs::write(&path, c.screenshot().await.unwrap()).unwrap();
+    }
+    no_page_errors_and_close(c).await;
+}
+
 /// Issue 29's walk: on a 390 × 844 phone, by touch only and by controls a
 /// fingertip hits, from "New pot" through the widths at heights to a
 /// downloaded G-code that the independent checker passes; and the phone's
