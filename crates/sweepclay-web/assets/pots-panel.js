@@ -45,9 +45,12 @@ function fillPot() {
   const pts = potRows(d);
   const w0 = baseWidth(d);
   const p = { ...state.meta.params, ...(d.params || {}) };
+  // Widths as callipers read them: the outside, a bead wider than the
+  // centreline the design keeps (docs/FORMATS.md, "Widths at heights").
+  const bead = p.width_min;
   // Rebuilt only when it shows something else: a drag repaints no table.
   fillRim(d);
-  const look = JSON.stringify([pts, w0, p.layer_height]);
+  const look = JSON.stringify([pts, w0, p.layer_height, bead]);
   if (look === state.potLook) return;
   state.potLook = look;
   const body = $('pot-rows').tBodies[0];
@@ -69,7 +72,7 @@ function fillPot() {
       return inp;
     };
     const zi = cell(`pot-z${i}`, z, i === 0 ? 'the base stands on the bed' : 'height of this point above the bed (mm)', i === 0);
-    const wi = cell(`pot-w${i}`, w0 + 2 * (x - pts[0][0]), i === 0 ? 'the width of the base across (mm): the path seen from above scales with it' : 'the width across at this height (mm)');
+    const wi = cell(`pot-w${i}`, w0 + 2 * (x - pts[0][0]) + bead, i === 0 ? 'the width of the foot outside, as callipers read it (mm): the path seen from above scales with it' : 'the width outside at this height, as callipers read it (mm)');
     zi.addEventListener('change', () => potEdit(i, 'z', zi));
     wi.addEventListener('change', () => potEdit(i, 'w', wi));
     const td = document.createElement('td');
@@ -149,16 +152,18 @@ function potEdit(i, what, inp) {
     }, true);
     return;
   }
-  if (!(v > 0)) {
-    potError(inp, `width ${fmtMm(v)} mm: must be more than 0`);
+  // Typed outside; the design keeps the centreline, a bead in.
+  const bead = { ...state.meta.params, ...(d.params || {}) }.width_min;
+  if (!(v > 2 * bead)) {
+    potError(inp, `width ${fmtMm(v)} mm: must be more than two beads (${fmtMm(2 * bead)} mm): the widths are outside, as callipers read them`);
     return;
   }
   const w0 = baseWidth(d);
   if (i === 0) {
     // The base's width scales the path about o; the heights' widths keep
     // their distance from the base's.
-    const k = v / w0;
-    const others = pts.map(([x]) => w0 + 2 * (x - pts[0][0]));
+    const k = (v - bead) / w0;
+    const others = pts.map(([x]) => w0 + 2 * (x - pts[0][0]) + bead);
     edit((dd) => {
       const t = dd.trajectory;
       const key = t.points ? 'points' : 'control_points';
@@ -171,7 +176,7 @@ function potEdit(i, what, inp) {
   }
   edit((dd) => {
     const rows = potRows(dd);
-    rows[i][0] = pts[0][0] + (v - w0) / 2;
+    rows[i][0] = pts[0][0] + (v - bead - w0) / 2;
     setPotRows(dd, rows);
   }, true);
 }

@@ -3611,29 +3611,32 @@ async fn typos_in_the_pot_rows_are_refused_beside_them() {
     no_page_errors_and_close(c).await;
 }
 
-/// The path's width across (its x-extent, mm) at each of `zs` in a
-/// G-code text: the moves within 0.7 mm of that height.
+/// The print's width outside along x (mm) at each of `zs` in a G-code
+/// text: over the moves within 0.7 mm of that height, the farthest bead
+/// edges, each bead as wide as the `;WIDTH:` comment before it says.
 fn widths_at(gcode: &str, zs: &[f64]) -> Vec<f64> {
-    let (mut x, mut y, mut z) = (0.0f64, 0.0f64, 0.0f64);
+    let (mut x, mut z, mut w) = (0.0f64, 0.0f64, 0.0f64);
     let mut span = vec![(f64::MAX, f64::MIN); zs.len()];
     for line in gcode.lines() {
+        if let Some(v) = line.strip_prefix(";WIDTH:") {
+            w = v.trim().parse().unwrap_or(w);
+            continue;
+        }
         let code = line.split(';').next().unwrap_or("");
         if !code.starts_with("G1 ") {
             continue;
         }
-        for w in code.split_whitespace().skip(1) {
-            let v = w[1..].parse::<f64>().unwrap_or(f64::NAN);
-            match &w[..1] {
+        for word in code.split_whitespace().skip(1) {
+            let v = word[1..].parse::<f64>().unwrap_or(f64::NAN);
+            match &word[..1] {
                 "X" => x = v,
-                "Y" => y = v,
                 "Z" => z = v,
                 _ => {}
             }
         }
-        let _ = y;
         for (k, &at) in zs.iter().enumerate() {
             if (z - at).abs() <= 0.7 {
-                span[k] = (span[k].0.min(x), span[k].1.max(x));
+                span[k] = (span[k].0.min(x - w / 2.0), span[k].1.max(x + w / 2.0));
             }
         }
     }
@@ -3733,16 +3736,19 @@ async fn a_pot_typed_80_130_70_80_prints_those_widths() {
         std::fs::write(&path, d.as_str().unwrap()).unwrap();
     }
     let (gcode, _) = download_printable(&c, &downloads, "no G-code of the pot").await;
-    // The printed path is as wide as typed (its first turn just above the
-    // foot, its last just under the lip), within 2 mm.
+    // The print is as wide outside as typed, as callipers read it (its
+    // first turn just above the foot, its last just under the lip).
     let p = js(&c, "return { ...window.sweepclay.meta.params, ...(window.sweepclay.design.params || {}) }.layer_height").await;
     let h = p.as_f64().unwrap();
+    // The foot is read on the floor, which still runs about a bead
+    // outside the wall's first turn (issue 57, point 1: 82.0 mm for 80).
     let at = [h, 45.0, 95.0, 120.0 - h / 2.0];
     let got = widths_at(&gcode, &at);
     for (w, (want, z)) in got.iter().zip([80.0, 130.0, 70.0, 80.0].iter().zip(at)) {
+        let within = if z == h { 2.5 } else { 0.5 };
         assert!(
-            (w - want).abs() <= 2.0,
-            "at z {z}: {w:.1} mm printed, {want} mm typed; all {got:?}"
+            (w - want).abs() <= within,
+            "at z {z}: {w:.1} mm printed outside, {want} mm typed; all {got:?}"
         );
     }
     no_page_errors_and_close(c).await;
