@@ -109,6 +109,9 @@ pub(crate) fn mesh_design(
     if let Some(n) = m.units_note {
         eprintln!("note: {shown}: {n}");
     }
+    if let Some(n) = &m.fitted.absorbed {
+        eprintln!("note: {shown}: {n}");
+    }
     let f = m.fitted;
     // A twist and ribs found in the mesh are the design's own twist and
     // texture (docs/MESHES.md).

@@ -480,3 +480,49 @@ fn a_wall_turned_steeply_by_a_twist_is_not_taken_for_a_cap() {
     assert!(f.deviation_mm <= 0.3, "{}", f.deviation_mm);
     assert!(f.design.twist_deg != 0.0);
 }
+
+/// A closed box from `lo` to `hi`, to add to a mesh as a separate body.
+fn add_box(mesh: &mut TriMesh, lo: [f64; 3], hi: [f64; 3]) {
+    let base = mesh.vertices.len() as u32;
+    for k in 0..8 {
+        mesh.vertices.push([
+            if k & 1 == 0 { lo[0] } else { hi[0] },
+            if k & 2 == 0 { lo[1] } else { hi[1] },
+            if k & 4 == 0 { lo[2] } else { hi[2] },
+        ]);
+    }
+    // Two triangles a face, outward.
+    for [a, b, c, d] in [
+        [0, 2, 3, 1],
+        [4, 5, 7, 6],
+        [0, 1, 5, 4],
+        [2, 6, 7, 3],
+        [0, 4, 6, 2],
+        [1, 3, 7, 5],
+    ] {
+        mesh.triangles.push([base + a, base + b, base + c]);
+        mesh.triangles.push([base + a, base + c, base + d]);
+    }
+}
+
+/// Issue 56, point 2: a detail smaller than a bead is no second part.
+/// Four 1 mm islands beside a cylinder's wall were "splits into 5 parts
+/// (a handle, a knob or two bodies)"; they are taken into the wall and
+/// said so, with where. A knob 4 × 5 mm in section is still a second
+/// part, refused by name.
+#[test]
+fn details_under_a_bead_are_taken_in_and_a_knob_is_still_refused() {
+    let mut pot = solid(|_, _| 30.0, 60.0, 96, 24);
+    for (x, y) in [(31.0, 0.0), (-32.0, 0.0), (0.0, 31.5), (0.0, -31.0)] {
+        add_box(&mut pot, [x, y, 40.0], [x + 1.0, y + 1.0, 41.0]);
+    }
+    let f = fit(&pot, &FitOptions::default()).expect("the islands taken in");
+    let said = f.absorbed.expect("the islands said");
+    assert!(said.contains("too small for a bead"), "{said}");
+    assert!(said.contains("between z = 40"), "{said}");
+    assert!(f.deviation_mm < 0.3, "{}", f.deviation_mm);
+    let mut knob = solid(|_, _| 30.0, 60.0, 96, 24);
+    add_box(&mut knob, [32.0, -2.0, 30.0], [36.0, 3.0, 40.0]);
+    let e = fit(&knob, &FitOptions::default()).unwrap_err().to_string();
+    assert!(e.contains("splits into 2 parts"), "{e}");
+}

@@ -80,6 +80,9 @@ pub struct Fitted {
     /// from it (mm) and where it lies. `None` for a design that is the
     /// sweep alone.
     pub sweep: Option<(f64, [f64; 3])>,
+    /// Details too small for a bead that the fit took into the wall,
+    /// said in words (docs/MESHES.md, "Details under a bead").
+    pub absorbed: Option<String>,
 }
 
 /// A mesh file read and fitted: what `slice pot.stl`, `import` and the
@@ -161,9 +164,72 @@ const RAYS: usize = 360;
 /// points (the rest of the detail is below the tolerance).
 const MAX_CURVE_POINTS: usize = 160;
 
+/// A loop of a section smaller than this (mm², a 3 mm bead's square) that
+/// is not the section's largest is a detail no bead prints: a 0.6 mm cone
+/// on the inner floor, a 1 mm island on a shoulder.
+pub const DETAIL_AREA_MM2: f64 = 9.0;
+
 /// Fits `mesh` (millimetres, any position) by a design within
 /// `opts.tolerance_mm`.
 pub fn fit(mesh: &TriMesh, opts: &FitOptions) -> Result<Fitted> {
+    let mut absorbed = None;
+    fit_with(mesh, opts, &mut absorbed).map(|f| Fitted { absorbed, ..f })
+}
+
+/// Takes the loops of `cut` smaller than [`DETAIL_AREA_MM2`] (never a
+/// section's largest) out of their sections, and says how many, the
+/// largest and where, and between which heights.
+fn absorb_details(cut: &mut [sections::Section]) -> Option<String> {
+    let (mut n, mut zs, mut largest) = (0usize, (f64::MAX, f64::MIN), (0.0f64, [0.0; 3]));
+    for s in cut.iter_mut() {
+        let areas: Vec<f64> = s
+            .loops
+            .iter()
+            .map(|l| 0.5 * signed_area2(l).abs())
+            .collect();
+        let Some(big) = areas
+            .iter()
+            .cloned()
+            .fold(None, |m: Option<f64>, a| Some(m.map_or(a, |m| m.max(a))))
+        else {
+            continue;
+        };
+        let mut k = 0;
+        let mut keep = |i: usize| {
+            let a = areas[i];
+            let small = a < DETAIL_AREA_MM2 && a < big;
+            if small {
+                n += 1;
+                zs = (zs.0.min(s.z), zs.1.max(s.z));
+                if a >= largest.0 {
+                    let c = centroid(&s.loops[i]);
+                    largest = (a, [c[0], c[1], s.z]);
+                }
+            }
+            !small
+        };
+        let kept: Vec<bool> = (0..areas.len()).map(&mut keep).collect();
+        s.loops.retain(|_| {
+            k += 1;
+            kept[k - 1]
+        });
+        let mut k = 0;
+        s.up.retain(|_| {
+            k += 1;
+            kept[k - 1]
+        });
+    }
+    (n > 0).then(|| {
+        let (a, at) = largest;
+        format!(
+            "took {n} detail(s) too small for a bead into the wall (under {DETAIL_AREA_MM2} mm² in section, between z = {:.1} and {:.1} mm; the largest {a:.1} mm² at ({:.1}, {:.1}, {:.1}) mm): they do not print",
+            zs.0, zs.1, at[0], at[1], at[2]
+        )
+    })
+}
+
+/// [`fit`], saying in `absorbed` what details it took into the wall.
+fn fit_with(mesh: &TriMesh, opts: &FitOptions, absorbed: &mut Option<String>) -> Result<Fitted> {
     let (lo, hi) = mesh.bounds();
     let height = hi[2] - lo[2];
     if !(5.0..=2000.0).contains(&height) {
@@ -188,6 +254,7 @@ pub fn fit(mesh: &TriMesh, opts: &FitOptions) -> Result<Fitted> {
     })?;
     let dz = height / n as f64;
     let mut cut = sections::cut(mesh, lo[2] + 0.5 * dz, dz, n, lo[2])?;
+    *absorbed = absorb_details(&mut cut);
     // A rim that is not quite level (a helix's last turn, a rim's
     // rounding) leaves sections near the top that do not go round: the
     // rim is where the last whole section is, if that is within 3 mm of
@@ -347,6 +414,7 @@ pub fn fit(mesh: &TriMesh, opts: &FitOptions) -> Result<Fitted> {
         (deviation, at) = worst;
     }
     Ok(Fitted {
+        absorbed: None,
         design,
         deviation_mm: deviation,
         at: b.turned(at, height),

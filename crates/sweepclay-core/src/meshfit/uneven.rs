@@ -313,6 +313,7 @@ pub(super) fn fit_uneven(
         };
     }
     Ok(Fitted {
+        absorbed: None,
         design,
         deviation_mm: deviation,
         at,

@@ -251,7 +251,11 @@ pub fn import_mesh(name: &str, bytes: &[u8], up: usize) -> Result<MeshImport, Ap
         at: f.at,
         kind: f.kind,
         triangles: m.triangles,
-        note: m.units_note,
+        // The units assumed and the details taken in, one sentence each.
+        note: match (m.units_note, f.absorbed) {
+            (Some(u), Some(a)) => Some(format!("{u}; {a}")),
+            (u, a) => u.or(a),
+        },
         sweep: f
             .sweep
             .map(|(deviation_mm, at)| SweepMiss { deviation_mm, at }),
