@@ -381,8 +381,11 @@ export class View3D {
       clearance: `body clearance ${b.clearance[i].toFixed(1)} mm`,
     }[k];
     let advice = '';
-    // Advice only where the room is short (under a quarter).
-    if (m[k] < 0.25) {
+    // Advice only where the room is short (under a quarter), and only
+    // where following it changes the verdict: a print that passes needs
+    // none (a straight cylinder's foot was told to pull its wall in).
+    const fails = this.data.verdict && this.data.verdict.printable === false;
+    if (m[k] < 0.25 && fails) {
       if (k === 'overhang' || k === 'overlap') {
         const by = this.pullIn(i);
         advice = by ? `: pull the wall in by about ${by} mm near z ${z} mm` : `: lean the wall less near z ${z} mm`;

@@ -1737,6 +1737,24 @@ async fn tabs_views_and_printers_keep_the_truth() {
         !legend.contains("layer 0.0"),
         "the spiral's start marked: {legend}"
     );
+    // A print that passes gets no advice: following it would change
+    // nothing (issue 57, point 1: a straight cylinder was told to pull
+    // its wall in by 0.5 mm at its foot).
+    for example in ["vase", "cylinder"] {
+        c.goto(&format!("{base}/?example={example}")).await.unwrap();
+        wait_js(&c, PRINTABLE, example).await;
+        let legend = wait_js(
+            &c,
+            &format!("return {IDLE} && document.getElementById('legend').textContent.includes('least room') ? document.getElementById('legend').textContent : null"),
+            "the legend",
+        )
+        .await;
+        let legend = legend.as_str().unwrap();
+        assert!(
+            !legend.contains("pull the wall") && !legend.contains("lean the wall"),
+            "{example}: advice on a print that passes: {legend}"
+        );
+    }
 
     // Tab A edits; tab B opens the last saved design and changes it.
     c.goto(&format!("{base}/?example=t1")).await.unwrap();
