@@ -154,6 +154,29 @@ pub enum LinkError {
     },
 }
 
+/// What to do with the print under way.
+#[derive(Clone, Copy, Debug, PartialEq, Eq, serde::Deserialize, Serialize)]
+#[serde(rename_all = "lowercase")]
+pub enum JobAction {
+    /// Stop where it is, to go on later.
+    Pause,
+    /// Go on after a pause.
+    Resume,
+    /// Stop for good.
+    Cancel,
+}
+
+impl JobAction {
+    /// The word for messages.
+    pub fn name(self) -> &'static str {
+        match self {
+            JobAction::Pause => "pause",
+            JobAction::Resume => "resume",
+            JobAction::Cancel => "cancel",
+        }
+    }
+}
+
 /// What the host says the printer is doing.
 #[derive(Clone, Debug, PartialEq, Serialize)]
 pub struct Status {
@@ -299,6 +322,17 @@ impl Link {
             Kind::OctoPrint => octoprint::start(self, file).await,
             Kind::Moonraker => moonraker::start(self, file).await,
             Kind::RepRap => reprap::start(self, file).await,
+        }
+    }
+
+    /// Pauses, resumes or cancels the print under way (docs/PRINTING.md,
+    /// "Pause, resume, cancel"). Refused with the host's words where
+    /// there is none to act on.
+    pub async fn job(&self, action: JobAction) -> Result<(), LinkError> {
+        match self.kind {
+            Kind::OctoPrint => octoprint::job(self, action).await,
+            Kind::Moonraker => moonraker::job(self, action).await,
+            Kind::RepRap => reprap::job(self, action).await,
         }
     }
 

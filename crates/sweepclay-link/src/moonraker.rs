@@ -87,6 +87,17 @@ pub(crate) async fn start(link: &Link, file: &str) -> Result<(), LinkError> {
     Ok(())
 }
 
+pub(crate) async fn job(link: &Link, action: crate::JobAction) -> Result<(), LinkError> {
+    let path = format!("printer/print/{}", action.name());
+    let resp = link
+        .send(with_key(link, link.http.post(link.at(&path))), SHORT)
+        .await?;
+    if !resp.status().is_success() {
+        return Err(failure(link, resp).await);
+    }
+    Ok(())
+}
+
 pub(crate) async fn status(link: &Link) -> Result<Status, LinkError> {
     // Without Klipper the printer objects do not exist (404): ask
     // Moonraker first whether Klipper is there.

@@ -53,6 +53,7 @@ async fn failure(link: &Link, resp: reqwest::Response, doing: Doing) -> LinkErro
 enum Doing {
     Upload,
     Start,
+    Job,
 }
 
 pub(crate) async fn upload(link: &Link, name: &str, gcode: Vec<u8>) -> Result<String, LinkError> {
@@ -81,6 +82,21 @@ pub(crate) async fn start(link: &Link, file: &str) -> Result<(), LinkError> {
     let resp = link.send(req, SHORT).await?;
     if !resp.status().is_success() {
         return Err(failure(link, resp, Doing::Start).await);
+    }
+    Ok(())
+}
+
+pub(crate) async fn job(link: &Link, action: crate::JobAction) -> Result<(), LinkError> {
+    use crate::JobAction::*;
+    let body = match action {
+        Pause => serde_json::json!({"command": "pause", "action": "pause"}),
+        Resume => serde_json::json!({"command": "pause", "action": "resume"}),
+        Cancel => serde_json::json!({"command": "cancel"}),
+    };
+    let req = with_key(link, link.http.post(link.at("api/job"))).json(&body);
+    let resp = link.send(req, SHORT).await?;
+    if !resp.status().is_success() {
+        return Err(failure(link, resp, Doing::Job).await);
     }
     Ok(())
 }

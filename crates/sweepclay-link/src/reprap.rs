@@ -222,6 +222,30 @@ pub(crate) async fn start(link: &Link, file: &str) -> Result<(), LinkError> {
     .await
 }
 
+pub(crate) async fn job(link: &Link, action: crate::JobAction) -> Result<(), LinkError> {
+    use crate::JobAction::*;
+    // RepRapFirmware: M25 pauses, M24 resumes, M0 after a pause cancels.
+    let codes: &[&str] = match action {
+        Pause => &["M25"],
+        Resume => &["M24"],
+        Cancel => &["M25", "M0"],
+    };
+    in_session(link, async |s| {
+        for code in codes {
+            let req = link
+                .http
+                .get(link.at("rr_gcode"))
+                .query(&[("gcode", *code)]);
+            let v = answer(link, link.send(with_session(req, s), SHORT).await?).await?;
+            if v.get("buff").is_none() {
+                return Err(link.bad("rr_gcode's answer has no `buff`".into()));
+            }
+        }
+        Ok(())
+    })
+    .await
+}
+
 pub(crate) async fn status(link: &Link) -> Result<Status, LinkError> {
     in_session(link, async |s| state(link, s).await).await
 }

@@ -3,7 +3,7 @@
 
 mod hosts;
 
-use sweepclay_link::{Kind, Link, LinkError};
+use sweepclay_link::{JobAction, Kind, Link, LinkError};
 
 /// A short clay-like file: a square spiral of 300 moves.
 fn small_gcode() -> String {
@@ -83,6 +83,51 @@ async fn octoprint_takes_the_file_prints_it_and_names_each_failure() {
     assert!(std::panic::catch_unwind(|| hosts::assert_received_in_order(&server, &more)).is_err());
 }
 
+/// The state OctoPrint reports, once it is one of `want` (within 60 s).
+async fn wait_state(link: &Link, want: &[&str]) -> String {
+    for _ in 0..300 {
+        let s = link.status().await.unwrap();
+        if want.contains(&s.state.as_str()) {
+            return s.state;
+        }
+        tokio::time::sleep(std::time::Duration::from_millis(200)).await;
+    }
+    panic!("OctoPrint never reached {want:?}");
+}
+
+/// Issue 59, point 3: a print sent can be paused, resumed and cancelled,
+/// on the real OctoPrint's virtual printer; with nothing printing, each
+/// is refused in the host's words.
+#[tokio::test(flavor = "multi_thread")]
+async fn octoprint_pauses_resumes_and_cancels_a_print() {
+    let dir = tempfile::tempdir().unwrap();
+    let Some(server) = hosts::octoprint(&dir.path().join("octoprint")) else {
+        return;
+    };
+    let link = Link::new(Kind::OctoPrint, &server.url, Some(server.key.clone())).unwrap();
+    let e = link.job(JobAction::Pause).await.unwrap_err();
+    assert!(e.to_string().contains("OctoPrint"), "{e}");
+    // Long enough to act on: ten times the small file.
+    let g = small_gcode().repeat(10);
+    let stored = link.upload("long", g.into_bytes()).await.unwrap();
+    link.start(&stored).await.unwrap();
+    wait_state(&link, &["Printing"]).await;
+    link.job(JobAction::Pause).await.unwrap();
+    wait_state(&link, &["Paused"]).await;
+    let s = link.status().await.unwrap();
+    assert!(s.printing, "paused is still a print under way: {s:?}");
+    link.job(JobAction::Resume).await.unwrap();
+    wait_state(&link, &["Printing"]).await;
+    link.job(JobAction::Cancel).await.unwrap();
+    wait_state(&link, &["Operational"]).await;
+    let s = link.status().await.unwrap();
+    assert!(!s.printing, "{s:?}");
+    assert!(
+        s.progress.is_none_or(|p| p < 1.0),
+        "cancelled, not done: {s:?}"
+    );
+}
+
 #[tokio::test(flavor = "multi_thread")]
 async fn nothing_listening_is_unreachable_in_a_sentence() {
     let port = hosts::free_port();
@@ -116,4 +161,12 @@ async fn moonraker_takes_and_lists_the_file_and_says_klipper_is_missing() {
     let e = link.start(&stored).await.unwrap_err();
     assert!(matches!(e, LinkError::NotConnected { .. }), "{e}");
     assert!(e.to_string().contains("not connected"), "{e}");
+    // Nor can a print be paused or cancelled without Klipper.
+    for action in [JobAction::Pause, JobAction::Resume, JobAction::Cancel] {
+        let e = link.job(action).await.unwrap_err();
+        assert!(
+            matches!(e, LinkError::NotConnected { .. }),
+            "{action:?}: {e}"
+        );
+    }
 }

@@ -223,6 +223,37 @@ async fn a_duet_gets_the_file_in_gcodes_starts_it_with_m32_and_reports_progress(
         .contains(&"rr_upload name=0:/gcodes/pot.gcode".to_string()));
 }
 
+/// Issue 59, point 3: a Duet's print is paused with M25, resumed with
+/// M24 and cancelled with M25 then M0, each in a session it closes.
+#[tokio::test]
+async fn a_duet_pauses_resumes_and_cancels_with_m25_m24_m0() {
+    let (url, board) = board("clay").await;
+    let link = Link::new(Kind::RepRap, &url, Some("clay".into())).unwrap();
+    for action in [
+        sweepclay_link::JobAction::Pause,
+        sweepclay_link::JobAction::Resume,
+        sweepclay_link::JobAction::Cancel,
+    ] {
+        link.job(action).await.unwrap();
+    }
+    let b = board.lock().unwrap();
+    let sent: Vec<&String> = b.log.iter().filter(|l| l.starts_with("rr_gcode")).collect();
+    assert_eq!(
+        sent,
+        [
+            "rr_gcode M25",
+            "rr_gcode M24",
+            "rr_gcode M25",
+            "rr_gcode M0"
+        ]
+    );
+    assert!(
+        b.sessions.is_empty(),
+        "sessions left open: {:?}",
+        b.sessions
+    );
+}
+
 #[tokio::test]
 async fn a_wrong_password_and_a_full_card_are_plain_messages() {
     let (url, state) = board("clay").await;
