@@ -380,6 +380,21 @@ async function sendToPrinter(button) {
     openPrinter();
     return;
   }
+  // Ask first, with what the print takes (docs/PRINTING.md).
+  const st = state.view?.data?.stats;
+  $('send-what').textContent = `${state.design.name || 'This design'} to ${printer.host.kind} at ${printer.host.url}` +
+    (st ? `: about ${Math.round(st.time_min)} min and ${st.volume_ml.toFixed(0)} ml of clay.` : '.') +
+    ' It starts as soon as it arrives.';
+  const d = $('send-confirm');
+  const go = await new Promise((done) => {
+    d.addEventListener('close', () => done(d.returnValue === 'go'), { once: true });
+    d.returnValue = '';
+    d.showModal();
+  });
+  if (!go) {
+    sendStatus('not sent');
+    return;
+  }
   button.disabled = true;
   sendStatus('slicing, checking and sending…');
   try {
@@ -410,11 +425,14 @@ async function followPrint(host, file, polls) {
       sendStatus(s.error, true);
       return;
     }
+    showJob(s);
     const pct = s.progress == null ? '' : ` ${Math.floor(s.progress * 100)} %`;
-    if (s.printing) sendStatus(`Printing ${file}${pct} (${s.state})`);
+    if (s.printing) sendStatus(`${/paus/i.test(s.state) ? 'Paused' : 'Printing'} ${file}${pct} (${s.state})`);
     else if (polls > 2) {
-      sendStatus(`${file}: ${s.state}${pct}`);
+      // The job ended: done, or stopped before its end.
+      sendStatus(s.progress === 1 ? `${file}: done` : `${file}: stopped (${s.state}${pct})`);
       state.sending = null;
+      showJob(null);
       return;
     }
   } catch (e) {
@@ -425,6 +443,35 @@ async function followPrint(host, file, polls) {
 }
 
 $('send-printer').addEventListener('click', (e) => sendToPrinter(e.currentTarget));
+
+/** The pause, resume and cancel buttons, for the print a status shows. */
+function showJob(s) {
+  $('send-job').hidden = !s || !s.printing;
+  if (!s) return;
+  // Pausing or resuming: neither until the printer has done it.
+  const paused = /^paused$/i.test(s.state);
+  const moving = /ing$/i.test(s.state) && !/^printing$/i.test(s.state);
+  $('job-pause').hidden = paused || moving;
+  $('job-resume').hidden = !paused;
+}
+
+/** Pauses, resumes or cancels the print being followed. */
+async function job(action) {
+  const printer = currentPrinter(state.design);
+  if (!printer?.host) return;
+  if (action === 'cancel' && !window.confirm('Cancel the print for good?')) return;
+  const r = await postDesign('/api/host/job', JSON.stringify({ host: printer.host, action }));
+  const s = await r.json();
+  if (!r.ok) {
+    sendStatus(s.error, true);
+    return;
+  }
+  showJob(s);
+  sendStatus(`${action === 'pause' ? 'Pausing' : action === 'resume' ? 'Resuming' : 'Cancelling'}… (${s.state})`);
+}
+$('job-pause').addEventListener('click', () => job('pause'));
+$('job-resume').addEventListener('click', () => job('resume'));
+$('job-cancel').addEventListener('click', () => job('cancel'));
 
 // On a phone the header's extras open under "More" and close once used.
 $('more').addEventListener('click', () => {

@@ -207,6 +207,7 @@ pub fn router(limits: Limits) -> Router {
         .route("/api/transform", post(transform))
         .route("/api/send", post(printing::send))
         .route("/api/host/status", post(printing::host_status))
+        .route("/api/host/job", post(printing::host_job))
         .route("/api/host/key", post(printing::host_key))
         .route("/api/calibrate", post(printing::calibration_print))
         .route("/api/calibrate/fit", post(printing::calibration_fit))

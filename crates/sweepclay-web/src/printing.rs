@@ -129,6 +129,29 @@ pub(crate) async fn host_status(
         .map_err(host_error)
 }
 
+/// What to do with the print under way, and on which host.
+#[derive(Deserialize)]
+#[serde(deny_unknown_fields)]
+pub(crate) struct HostJob {
+    /// The printer's `host` object.
+    host: sweepclay_core::printer::PrintHost,
+    /// "pause", "resume" or "cancel".
+    action: sweepclay_link::JobAction,
+}
+
+/// Pauses, resumes or cancels the print on a saved host, then says what
+/// the printer is doing (docs/PRINTING.md, "Pause, resume, cancel").
+pub(crate) async fn host_job(
+    body: Result<Bytes, BytesRejection>,
+) -> Result<Json<sweepclay_link::Status>, ApiError> {
+    let j: HostJob = serde_json::from_slice(&bytes(body)?)
+        .map_err(|e| ApiError::new(400, format!("job: {e}")))?;
+    j.host.validate("host")?;
+    let link = link_for(&j.host, "host")?;
+    link.job(j.action).await.map_err(host_error)?;
+    link.status().await.map(Json).map_err(host_error)
+}
+
 #[derive(Deserialize)]
 #[serde(deny_unknown_fields)]
 pub(crate) struct HostKey {

@@ -3348,10 +3348,43 @@ async fn a_pot_is_sent_from_the_page_to_octoprint_and_printed() {
         tokio::time::sleep(Duration::from_millis(100)).await;
     }
 
+    // It asks first, saying what the print takes; "Not now" sends nothing.
     click(&c, "send-printer").await;
-    // The page follows the print to its end.
+    let asked = wait_js(
+        &c,
+        "const d = document.getElementById('send-confirm'); return d.open && document.getElementById('send-what').textContent",
+        "the question before printing",
+    )
+    .await;
+    let asked = asked.as_str().unwrap();
+    assert!(
+        asked.contains("min and") && asked.contains("ml of clay"),
+        "{asked}"
+    );
+    js(
+        &c,
+        "document.getElementById('send-confirm').close('cancel'); return 0",
+    )
+    .await;
+    wait_js(
+        &c,
+        "return document.getElementById('send-status').textContent === 'not sent'",
+        "not sent",
+    )
+    .await;
+    click(&c, "send-printer").await;
+    wait_js(
+        &c,
+        "return document.getElementById('send-confirm').open",
+        "the question again",
+    )
+    .await;
+    click(&c, "send-go").await;
+    // The page follows the print to its end; it is paused and resumed
+    // on the way (issue 59, point 3).
     let deadline = Instant::now() + Duration::from_secs(240);
     let mut shot = false;
+    let mut paused = false;
     loop {
         let s = js(
             &c,
@@ -3366,12 +3399,24 @@ async fn a_pot_is_sent_from_the_page_to_octoprint_and_printed() {
                 std::fs::write(&path, c.screenshot().await.unwrap()).unwrap();
             }
         }
-        if s == "pot.gcode: Operational 100 %" {
+        if s.starts_with("Printing") && !paused {
+            paused = true;
+            click(&c, "job-pause").await;
+            wait_js(
+                &c,
+                "return document.getElementById('send-status').textContent.endsWith('(Paused)') && !document.getElementById('job-resume').hidden",
+                "the print paused",
+            )
+            .await;
+            click(&c, "job-resume").await;
+        }
+        if s == "pot.gcode: done" {
             break;
         }
         assert!(Instant::now() < deadline, "the print did not end: {s}");
         tokio::time::sleep(Duration::from_millis(500)).await;
     }
+    assert!(paused, "never seen printing");
     // What OctoPrint received is the checked file, every line of it.
     let sent = std::fs::read_to_string(octo.dir.join("uploads").join("pot.gcode")).unwrap();
     let report = sweepclay_check::check(
