@@ -1,7 +1,8 @@
 //! A vessel's rim shaped round the loop (not in the paper; docs/FORMATS.md,
-//! "rim"; docs/ALGORITHMS.md §8): the design's one profile stretched in
-//! height toward a taller rim — on one side (a slanted cut), in waves, or
-//! over one raised arc (a pitcher's back, a spout). A potter shapes the
+//! "rim"; docs/ALGORITHMS.md §8): the design's one profile carried on
+//! above its top toward a taller rim — on one side (a slanted cut), in
+//! waves, or over one raised arc (a pitcher's back, a spout); the body
+//! below the profile's top keeps its shape. A potter shapes the
 //! rim by how high it rises and toward where, not by a second profile and
 //! an interpolation; the sampling reads it as the profile stretched to
 //! `rise` mm more and, for each column, how far toward that it is by the

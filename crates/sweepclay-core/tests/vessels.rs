@@ -600,3 +600,56 @@ fn a_first_turn_that_cannot_start_names_the_most_the_rim_may_rise() {
         .unwrap_or_else(|e| e.to_string());
     assert!(!again.contains("wherever it starts"), "{again}");
 }
+
+/// Issue 57, point 2: raising the rim adds height at the rim, a
+/// continuation of the body's top; it does not stretch the body. The belly
+/// vase (rows 70 / 115 / 60 / 72 mm outside at 0 / 45 / 105 / 140 mm)
+/// raised 30 mm at the back: below its top the wall is as wide at the back
+/// as at the front, within half a millimetre, at every height; stretched,
+/// the back stood several millimetres off the front at the neck.
+#[test]
+fn a_raised_rim_keeps_the_body_it_rises_from() {
+    let mut v: serde_json::Value =
+        serde_json::from_str(include_str!("../../../examples/belly-vase.json")).unwrap();
+    v["rim"] = serde_json::json!({"shape": "raised", "rise": 30, "toward_deg": 90});
+    let d = Design::from_json(&v.to_string()).unwrap();
+    let s = slice(&d).unwrap_or_else(|e| panic!("{e}"));
+    let r = common::check_full(&s);
+    assert!(r.printable, "{}", r.render());
+    // The wall's distance from o at the back (+y) and the front (−y),
+    // over the path's points within half a millimetre of each height.
+    let pts: Vec<[f64; 3]> = s
+        .toolpath
+        .points
+        .iter()
+        .filter(|p| p.kind != sweepclay_core::toolpath::PointKind::Floor)
+        .map(|p| p.pos)
+        .collect();
+    // The toolpath is in the design's frame: o at the origin.
+    let centre = |_z: f64| [0.0, 0.0];
+    let at = |z: f64, back: bool| {
+        let o = centre(z);
+        let sel: Vec<f64> = pts
+            .iter()
+            .filter(|p| (p[2] - z).abs() < 0.7)
+            .filter(|p| {
+                let a = (p[1] - o[1]).atan2(p[0] - o[0]).to_degrees();
+                if back {
+                    (a - 90.0).abs() < 4.0
+                } else {
+                    (a + 90.0).abs() < 4.0
+                }
+            })
+            .map(|p| (p[0] - o[0]).hypot(p[1] - o[1]))
+            .collect();
+        assert!(!sel.is_empty(), "no wall at z {z}");
+        sel.iter().sum::<f64>() / sel.len() as f64
+    };
+    for z in [20.0, 45.0, 80.0, 105.0, 130.0] {
+        let (b, f) = (at(z, true), at(z, false));
+        assert!(
+            (b - f).abs() < 0.5,
+            "at z {z}: back {b:.2} mm, front {f:.2} mm from o"
+        );
+    }
+}

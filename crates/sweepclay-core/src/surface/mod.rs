@@ -155,13 +155,35 @@ pub struct Surface {
     /// A mesh's relief over the profiles' blend, as printed
     /// ([`crate::relief`]); part of the drawn form.
     pub relief: Option<crate::relief::Relief>,
+    /// A shaped rim (the design's `rim`): every column is the one profile
+    /// up to its top, and where the rim rises higher the wall continues
+    /// from there ([`continued`]); the body is never stretched.
+    pub rim_continues: bool,
+}
+
+/// The one profile's offset at height `z` (mm) for a shaped rim: the
+/// profile itself up to its top, and above it the profile's top carried
+/// on along its last 2 % (docs/FORMATS.md, "rim"). A pitcher raised 30 mm
+/// at the back keeps the widths typed below its top all round; stretched,
+/// it stood 48.8 mm from the centre at z 100 where 40 was typed.
+pub fn continued(start: &Profile, z: f64) -> f64 {
+    let h = start.height;
+    if z <= h {
+        return start.offset((z / h).max(0.0));
+    }
+    let d = 0.02;
+    let slope = (start.offset(1.0) - start.offset(1.0 - d)) / (h * d);
+    start.offset(1.0) + slope * (z - h)
 }
 
 impl Surface {
     /// ξ_i(t) of the design (before corrections), scaled by `compression`.
     pub fn design_offset(&self, col: &Column, z: f64, compression: f64) -> f64 {
-        let t = (z / col.height).min(1.0);
         let relief = self.relief.as_ref().map_or(0.0, |r| r.at(col.u, z));
+        if self.rim_continues {
+            return compression * (continued(&self.start, z.min(col.height)) + relief);
+        }
+        let t = (z / col.height).min(1.0);
         compression
             * ((1.0 - col.lambda) * self.start.offset(t) + col.lambda * self.end.offset(t) + relief)
     }
@@ -469,6 +491,7 @@ fn sample_plain(design: &Design) -> Result<Surface> {
         texture: Vec::new(),
         texture_label: (String::new(), 0.0),
         relief: design.relief.clone(),
+        rim_continues: design.rim.is_some(),
     };
     let mut samples = Vec::new();
     let mut columns = std::mem::take(&mut surface.columns);

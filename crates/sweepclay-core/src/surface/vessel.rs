@@ -103,6 +103,9 @@ pub(super) fn sample_vessel(
     let reach = printer.nozzle_radius + params.width_max / 2.0 + displacement_reach(design);
     let exempt = printer.nozzle_radius + params.width_max;
     let offset = |c: &Column| {
+        if design.rim.is_some() {
+            return super::continued(&start, c.height);
+        }
         let t = 1.0;
         (1.0 - c.lambda) * start.offset(t) + c.lambda * end.offset(t)
     };
@@ -262,6 +265,7 @@ fn vessel_samples(
         texture: Vec::new(),
         texture_label: (String::new(), 0.0),
         relief: design.relief.clone(),
+        rim_continues: design.rim.is_some(),
     };
     // Each arc column's place in the arc.
     let mut in_arc = vec![usize::MAX; n];
