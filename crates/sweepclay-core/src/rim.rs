@@ -4,9 +4,10 @@
 //! waves, or over one raised arc (a pitcher's back, a spout); the body
 //! below the profile's top keeps its shape. A potter shapes the
 //! rim by how high it rises and toward where, not by a second profile and
-//! an interpolation; the sampling reads it as the profile stretched to
-//! `rise` mm more and, for each column, how far toward that it is by the
-//! column's angle about o.
+//! an interpolation; the sampling reads, for each column, how far toward
+//! the highest rim it is by the column's angle about o, and lays the
+//! profile up to its top and its continuation above it
+//! (`surface::continued`).
 
 use crate::error::{Error, Result};
 use serde::{Deserialize, Serialize};
@@ -137,10 +138,11 @@ impl RimSpec {
         }
     }
 
-    /// The control points of the profile where the rim is highest: the
-    /// profile's `points` (`[x, z]`) stretched in height by its top's
-    /// (h + rise) / h, so the wall keeps its shape at the same share of
-    /// its height.
+    /// The control points of a profile as tall as the rim where it is
+    /// highest: the profile's `points` (`[x, z]`) stretched in height by
+    /// its top's (h + rise) / h. It gives the columns their heights; their
+    /// shape is the one profile carried on above its top
+    /// (`surface::continued`).
     pub fn stretched(&self, points: &[[f64; 2]]) -> Vec<[f64; 2]> {
         let top = points.iter().map(|p| p[1]).fold(0.0, f64::max);
         let k = if top > 0.0 {

@@ -263,7 +263,8 @@ impl Design {
 
     /// C_t: `profile_end`, or `profile_start` where the design gives one
     /// profile (the same section all round the loop or along the wall),
-    /// stretched to the taller rim where the design shapes its `rim`.
+    /// stretched to the taller rim where the design shapes its `rim` (for
+    /// the columns' heights; their shape is `surface::continued`).
     pub fn end_profile(&self) -> std::borrow::Cow<'_, CurveSpec> {
         match (&self.profile_end, &self.rim) {
             (Some(end), _) => std::borrow::Cow::Borrowed(end),
