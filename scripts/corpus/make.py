@@ -338,19 +338,8 @@ def firmware_files(tmp, defs, vase):
     run(cmd)
 
     def prusa_with(name, *more):
-        path = os.path.join(OUT, name + ".gcode")
-        prusa("prusa-slicer", vase, path, tmp)
-        # The same call with the extra options (prusa() keeps its own).
-        cmd = ["prusa-slicer", "--max-print-height", "200", "--start-gcode",
-               PRUSA_START.replace("\\n", "\n"), "--export-gcode", "--spiral-vase",
-               "--perimeters", "1", "--layer-height", str(LAYER), "--first-layer-height", str(LAYER),
-               "--nozzle-diameter", str(WIDTH), "--extrusion-width", str(WIDTH),
-               "--first-layer-extrusion-width", str(WIDTH), "--filament-diameter", str(FEED_DIA),
-               "--bottom-solid-layers", "0", "--top-solid-layers", "0", "--skirts", "0",
-               "--fill-density", "0", "--center", "100,100", "--bed-shape", "0x0,200x0,200x200,0x200",
-               "--perimeter-speed", "30", "--first-layer-speed", "30", "--retract-length", "2",
-               *more, "-o", path, vase]
-        run(cmd)
+        # PrusaSlicer's vase with the extra options.
+        run(vase_call(vase, os.path.join(OUT, name + ".gcode"), LAYER, WIDTH, LAYER, *more))
 
     prusa_with("prusa-fwretract", "--use-firmware-retraction")
     prusa_with("prusa-g4p0", "--layer-gcode", "G4 P0 ; planner sync")
