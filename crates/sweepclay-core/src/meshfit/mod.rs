@@ -194,7 +194,6 @@ fn absorb_details(cut: &mut [sections::Section]) -> Option<String> {
         else {
             continue;
         };
-        let mut k = 0;
         let mut keep = |i: usize| {
             let a = areas[i];
             let small = a < DETAIL_AREA_MM2 && a < big;
@@ -209,15 +208,10 @@ fn absorb_details(cut: &mut [sections::Section]) -> Option<String> {
             !small
         };
         let kept: Vec<bool> = (0..areas.len()).map(&mut keep).collect();
-        s.loops.retain(|_| {
-            k += 1;
-            kept[k - 1]
-        });
-        let mut k = 0;
-        s.up.retain(|_| {
-            k += 1;
-            kept[k - 1]
-        });
+        let mut flags = kept.iter();
+        s.loops.retain(|_| *flags.next().unwrap_or(&true));
+        let mut flags = kept.iter();
+        s.up.retain(|_| *flags.next().unwrap_or(&true));
     }
     (n > 0).then(|| {
         let (a, at) = largest;
