@@ -337,6 +337,21 @@ def firmware_files(tmp, defs, vase):
     cmd += ["-l", vase, "-o", out]
     run(cmd)
 
+    # Debian's Cura definition of the Structur3D Discov3ry, a paste
+    # extruder on an Ultimaker 2+: its own start code sets the paste's
+    # steps (`M92 E2589`), its end code sets them back for plastic
+    # (`M92 E282`), as a paste printer's file does (issue 55, class 3).
+    out = os.path.join(OUT, "cura-discov3ry.gcode")
+    cmd = ["CuraEngine", "slice", "-j",
+           os.path.join(defs, "structur3d_discov3ry1_complete_um2plus.def.json")]
+    for s in clay:
+        cmd += ["-s", s]
+    cmd += ["-e0"]
+    for s in clay:
+        cmd += ["-s", s]
+    cmd += ["-l", vase, "-o", out]
+    run(cmd)
+
     def prusa_with(name, *more):
         # PrusaSlicer's vase with the extra options.
         run(vase_call(vase, os.path.join(OUT, name + ".gcode"), LAYER, WIDTH, LAYER, *more))

@@ -11,6 +11,10 @@
 //! not replay as firmware would (another plane, no centre, a radius too
 //! short for its chord) makes the file one it cannot judge.
 
+/// The name of `M92 E` (steps per millimetre of E) as an
+/// [`Event::Unreplayed`]: the checker says so in the start code.
+pub(crate) const M92_E: &str = "M92 E (steps per millimetre of E)";
+
 use crate::parse::{Diagnostic, Line};
 
 /// One linear move.
@@ -566,7 +570,7 @@ impl Replayer {
                     }
                     _ => {
                         self.steps_e = Some(v);
-                        return Some(Event::Unreplayed(l.line, "M92 (steps per millimetre)"));
+                        return Some(Event::Unreplayed(l.line, M92_E));
                     }
                 }
             }

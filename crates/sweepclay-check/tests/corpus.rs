@@ -76,7 +76,7 @@ fn snapshot(file: &str, r: &Report) {
     );
 }
 
-const VALID: [&str; 22] = [
+const VALID: [&str; 23] = [
     // Leaning vase starts: a 35° bowl, 4.5 mm lines on 1.8 mm layers,
     // whose first turn rises from the flat first loop at full flow.
     "cura-bowl.gcode",
@@ -115,6 +115,11 @@ const VALID: [&str; 22] = [
     // ramp starts 0.005 mm above that loop where the loop ends, on the
     // loop's clay and the bed (issue 55, class 1; docs/CHECKER.md, "Ramps").
     "prusa-first3.gcode",
+    // Debian's Cura definition of the Structur3D Discov3ry paste extruder:
+    // its start code sets the paste's E steps (`M92 E2589`), the machine's
+    // calibration, and its end code sets them back (`M92 E282`) after the
+    // last bead (issue 55, class 3; docs/CHECKER.md, "Commands").
+    "cura-discov3ry.gcode",
 ];
 
 #[test]

@@ -192,6 +192,13 @@ fn commands_inside_the_print_are_replayed_refused_or_harmless() {
                 "{cmd} at {at}: {}",
                 r.render()
             );
+            // The E steps before the first bead are said, as the machine's
+            // calibration the printer's E per mm³ already states.
+            let said = r
+                .start_code
+                .as_ref()
+                .is_some_and(|s| s.items.iter().any(|i| i.contains("E steps set")));
+            assert_eq!(said, cmd == "M92 E400" && at == start, "{cmd} at {at}");
         }
     }
     let harmless = [

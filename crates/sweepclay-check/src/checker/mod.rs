@@ -452,6 +452,16 @@ impl<'a> Checker<'a> {
             Some(Event::Unreplayed(line, name)) if self.started => {
                 self.unreplayed_since.get_or_insert((line, name));
             }
+            // `M92 E` before any bead: the machine's E calibration, which
+            // the printer's E per mm³ states; said in the start code
+            // (docs/CHECKER.md, "Commands").
+            Some(Event::Unreplayed(line, crate::replay::M92_E)) => {
+                self.lead.start.cover(line);
+                self.lead.start.note(format!(
+                    "E steps set (`M92`, line {line}): the machine's calibration, read as the printer's {} E per mm³",
+                    self.cfg.e_per_mm3
+                ));
+            }
             Some(Event::Unreplayed(..)) => {}
             Some(Event::Retract(line)) => {
                 self.break_run(line);
