@@ -113,6 +113,22 @@ def main():
     inner = trimesh.creation.cylinder(radius=32.0, height=70.0, sections=64)
     inner.apply_translation((0, 0, 40.0))
     forms["cup-shell"] = outer.difference(inner)
+    # Walls thicker than a bead, as potters model them (issue 56, point
+    # 1): a cylinder 10 mm thick on an 8 mm floor; a wide bowl flaring
+    # from 40 to 70 mm radius over 45 mm, 6 mm thick on a 6 mm floor.
+    outer = trimesh.creation.cylinder(radius=40.0, height=70.0, sections=96)
+    outer.apply_translation((0, 0, 35.0))
+    inner = trimesh.creation.cylinder(radius=30.0, height=70.0, sections=96)
+    inner.apply_translation((0, 0, 43.0))
+    forms["thick-cylinder"] = outer.difference(inner)
+    bowl = revolved([(40.0, 0.0), (70.0, 45.0)], 96)
+    hollow = revolved([(34.0 + 30.0 * 6.0 / 45.0, 6.0), (64.0 + 30.0 * 6.0 / 45.0, 51.0)], 96)
+    forms["wide-bowl"] = bowl.difference(hollow)
+    # An eight-point star, its points 45 mm out and its notches 35, swept
+    # straight up 60 mm: a solid whose spikes are sharp.
+    star = Polygon([((45.0 if k % 2 == 0 else 35.0) * np.cos(np.pi * k / 8),
+                     (45.0 if k % 2 == 0 else 35.0) * np.sin(np.pi * k / 8)) for k in range(16)])
+    forms["star"] = trimesh.creation.extrude_polygon(star, 60.0)
     for name, m in forms.items():
         if not m.is_watertight:
             sys.exit(f"{name}: trimesh wrote a mesh that is not watertight")

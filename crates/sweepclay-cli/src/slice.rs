@@ -112,6 +112,9 @@ pub(crate) fn mesh_design(
     if let Some(n) = &m.fitted.absorbed {
         eprintln!("note: {shown}: {n}");
     }
+    if let Some(n) = &m.fitted.inside {
+        eprintln!("note: {shown}: {n}");
+    }
     let f = m.fitted;
     // A twist and ribs found in the mesh are the design's own twist and
     // texture (docs/MESHES.md).
@@ -131,7 +134,7 @@ pub(crate) fn mesh_design(
         say!(
             "{shown}: {} triangles, a {}; no sweep of one loop within {tolerance} mm (the closest, {}{twist}, differs by {dev:.2} mm at ({:.1}, {:.1}, {:.1}) mm): printed as the mesh is, that sweep and a relief of {} heights × {} places over it, within {:.2} mm of its {} sections; its foot's centre moved to o (editing its curves reshapes the sweep under the relief; --sweep-only refuses such a mesh)",
             m.triangles,
-            if f.kind == "shell" { "wall with its thickness (fitted at its middle)" } else { "solid (fitted at its outside)" },
+            if f.kind == "shell" { "wall with its thickness (its outside kept)" } else { "solid (its outside kept)" },
             if f.design.profile_end.is_some() { "two profiles blended round one loop" } else { "one profile round one loop" },
             at[0],
             at[1],
@@ -146,7 +149,7 @@ pub(crate) fn mesh_design(
     say!(
         "{shown}: {} triangles, a {}; fitted by a design (one loop, {}{twist}) within {:.2} mm of its {} sections (largest at ({:.1}, {:.1}, {:.1}) mm); its foot's centre moved to o",
         m.triangles,
-        if f.kind == "shell" { "wall with its thickness (fitted at its middle)" } else { "solid (fitted at its outside)" },
+        if f.kind == "shell" { "wall with its thickness (its outside kept)" } else { "solid (its outside kept)" },
         if f.design.profile_end.is_some() { "two profiles blended round it" } else { "one profile" },
         f.deviation_mm,
         f.sections,

@@ -337,7 +337,7 @@ fn offset_spiral(outer: &[[f64; 2]], beads: FloorBeads) -> Option<Measured> {
 /// The contours of a counter-clockwise closed contour offset inward by
 /// `d` (outward where negative): none when nothing is left, several
 /// where it splits.
-fn offset(contour: &[[f64; 2]], d: f64) -> Vec<Vec<[f64; 2]>> {
+pub(crate) fn offset(contour: &[[f64; 2]], d: f64) -> Vec<Vec<[f64; 2]>> {
     use i_overlay::mesh::outline::offset::OutlineOffset;
     use i_overlay::mesh::style::{LineJoin, OutlineStyle};
     // Round where the outline grows (its convex corners), bevelled where

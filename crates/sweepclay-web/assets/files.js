@@ -130,7 +130,7 @@ async function openMesh(file) {
   }
   // A mesh names no printer: the one in use stays.
   setDesign(withMyPrinter(body.design), { fit: true });
-  const kind = body.kind === 'shell' ? 'a wall with its thickness, fitted at its middle' : 'a solid, fitted at its outside';
+  const kind = body.kind === 'shell' ? 'a wall with its thickness, its outside kept' : 'a solid, its outside kept';
   const units = body.note ? `; ${body.note}` : '';
   // A twist and ribs found in the mesh are the design's own twist and
   // texture (docs/MESHES.md, "Twist", "Ribs").

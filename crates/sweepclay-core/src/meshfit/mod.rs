@@ -11,9 +11,11 @@
 //! splits (a handle, two bodies), a wall a ray meets twice, a mesh with a
 //! hole, or a fit beyond the tolerance is refused by name.
 //!
-//! A solid (one loop a section) is fitted at its outside; a shell (two
+//! The pot is its outside: a solid (one loop a section) and a shell (two
 //! nested loops: a wall with its thickness, as sweepclay's own STL export
-//! writes) at the middle of its wall. Cost: linear in the triangles
+//! writes) are both fitted half a bead inside their outside, so the
+//! printed bead's outer edge lies on it; a wall thicker than the bead
+//! keeps its outside and says how far its inside moved. Cost: linear in the triangles
 //! (cutting) plus sections × rays × loop points (about 0.1 s for a pot).
 
 use crate::bspline::BSpline;
@@ -47,6 +49,11 @@ pub struct FitOptions {
     /// sweep as the design's relief (printed as the mesh is) rather than
     /// refuse it.
     pub relief: bool,
+    /// The bead the pot will be printed with (mm, the design's
+    /// `width_min`): the wall's centre line is fitted half of it inside
+    /// the mesh's outside, so the printed bead's outer edge is the
+    /// mesh's outside (docs/MESHES.md, "The outside is the pot").
+    pub bead_mm: f64,
 }
 
 impl Default for FitOptions {
@@ -55,6 +62,7 @@ impl Default for FitOptions {
             tolerance_mm: 0.3,
             name: String::new(),
             relief: true,
+            bead_mm: crate::design::Params::default().width_min,
         }
     }
 }
@@ -68,7 +76,8 @@ pub struct Fitted {
     pub deviation_mm: f64,
     /// Where it lies, in the design's frame (mm).
     pub at: [f64; 3],
-    /// Solid (fitted at its outside) or shell (at its wall's middle).
+    /// Solid or shell (a wall with its thickness): either way fitted half
+    /// a bead inside its outside.
     pub kind: &'static str,
     /// How many sections were compared.
     pub sections: usize,
@@ -83,6 +92,10 @@ pub struct Fitted {
     /// Details too small for a bead that the fit took into the wall,
     /// said in words (docs/MESHES.md, "Details under a bead").
     pub absorbed: Option<String>,
+    /// Where the wall is thicker than a bead: its outside kept and how
+    /// far its inside moved out, said in words (docs/MESHES.md, "The
+    /// outside is the pot").
+    pub inside: Option<String>,
 }
 
 /// A mesh file read and fitted: what `slice pot.stl`, `import` and the
@@ -174,6 +187,70 @@ pub const DETAIL_AREA_MM2: f64 = 9.0;
 pub fn fit(mesh: &TriMesh, opts: &FitOptions) -> Result<Fitted> {
     let mut absorbed = None;
     fit_with(mesh, opts, &mut absorbed).map(|f| Fitted { absorbed, ..f })
+}
+
+/// The walls wider than a bead by more than this (mm) are said to have
+/// their inside moved: under it the bead is the wall, as near as a
+/// slicer's rounding.
+pub(super) const THICKER_MM: f64 = 0.5;
+
+/// Makes each section's wall the centre line of the bead that prints it:
+/// its outside (the largest loop) moved in by half a bead, so the bead's
+/// outer edge lies on the mesh's outside, whatever the wall's thickness.
+/// A shell's inside loop goes; the most its inside moves out (a wall
+/// thicker than a bead, by more than [`THICKER_MM`]) is said. A section
+/// narrower than a bead inside its outside is refused by name.
+fn keep_outside(cut: &mut [sections::Section], bead: f64) -> Result<Option<String>> {
+    let mut moved: Option<(f64, f64)> = None;
+    for s in cut.iter_mut() {
+        let areas: Vec<f64> = s.loops.iter().map(|l| signed_area2(l).abs()).collect();
+        let Some(o) = (0..areas.len()).max_by(|&a, &b| areas[a].total_cmp(&areas[b])) else {
+            continue;
+        };
+        let mut outer = s.loops[o].clone();
+        if signed_area2(&outer) < 0.0 {
+            outer.reverse();
+        }
+        if s.loops.len() == 2 {
+            // The wall's mean thickness: the ring's area over its mean
+            // length (exact for concentric circles).
+            let length = |l: &[[f64; 2]]| -> f64 {
+                (0..l.len())
+                    .map(|i| {
+                        let (a, b) = (l[i], l[(i + 1) % l.len()]);
+                        (b[0] - a[0]).hypot(b[1] - a[1])
+                    })
+                    .sum()
+            };
+            let mean = 0.5 * (length(&s.loops[0]) + length(&s.loops[1]));
+            let t = 0.5 * (areas[o] - areas[1 - o]) / mean.max(1e-9);
+            if t - bead > THICKER_MM && moved.is_none_or(|m| t - bead > m.0) {
+                moved = Some((t - bead, s.z));
+            }
+        }
+        let mut parts = crate::floor::offset(&outer, 0.5 * bead);
+        parts.sort_by(|a, b| signed_area2(b).abs().total_cmp(&signed_area2(a).abs()));
+        let Some(mut wall) = parts.into_iter().next() else {
+            return Err(Error::invalid(
+                "mesh",
+                format!(
+                    "is narrower than a bead ({bead} mm) at z = {:.1} mm: a bead inside its outside leaves nothing to print there",
+                    s.z
+                ),
+            ));
+        };
+        if signed_area2(&wall) < 0.0 {
+            wall.reverse();
+        }
+        s.up = vec![vec![false; wall.len()]];
+        s.loops = vec![wall];
+    }
+    Ok(moved.map(|(m, z)| {
+        format!(
+            "the wall is up to {:.1} mm thicker than a bead ({bead} mm, at z = {z:.1} mm): its outside is kept and its inside moves out by that much",
+            m
+        )
+    }))
 }
 
 /// Takes the loops of `cut` smaller than [`DETAIL_AREA_MM2`] (never a
@@ -340,6 +417,10 @@ fn fit_with(mesh: &TriMesh, opts: &FitOptions, absorbed: &mut Option<String>) ->
             }
         }
     }
+    // The pot is its outside: the bead's outer edge on it.
+    let inside = keep_outside(&mut cut, opts.bead_mm)?;
+    let kind = if shell { "shell" } else { "solid" };
+    let shell = false;
     let (c, psi) = foot_frame(&cut);
     let loops: Vec<Vec<Vec<[f64; 2]>>> = cut.iter().map(|s| about(s, c)).collect();
     let zs: Vec<f64> = cut.iter().map(|s| s.z).collect();
@@ -375,7 +456,12 @@ fn fit_with(mesh: &TriMesh, opts: &FitOptions, absorbed: &mut Option<String>) ->
     // in it takes next to nothing off).
     if b.deviation > tol || b.two {
         if let Some(t) = ribs::textured(&b, &zs, height, tol) {
-            let within = t.deviation <= tol && (b.deviation > tol || !t.two);
+            // Two profiles with ribs beat two without when no farther:
+            // a printed outside's bead widths vary a little round the
+            // loop, which the two profiles take up, and the ribs are then
+            // the texture they are (docs/MESHES.md, "Ribs").
+            let within = t.deviation <= tol
+                && (b.deviation > tol || !t.two || (b.two && t.deviation <= b.deviation));
             if within || (b.deviation > tol && t.deviation < 0.75 * b.deviation) {
                 b = t;
             }
@@ -409,10 +495,11 @@ fn fit_with(mesh: &TriMesh, opts: &FitOptions, absorbed: &mut Option<String>) ->
     }
     Ok(Fitted {
         absorbed: None,
+        inside,
         design,
         deviation_mm: deviation,
         at: b.turned(at, height),
-        kind: if shell { "shell" } else { "solid" },
+        kind,
         sections: cut.len(),
         moved: [-c[0], -c[1], -lo[2]],
         sweep,
@@ -435,7 +522,8 @@ struct Sections<'a> {
     zs: &'a [f64],
     /// Their loops (one, or two nested for a shell).
     loops: &'a [Vec<Vec<[f64; 2]>>],
-    /// Two nested loops a section: fitted at the wall's middle.
+    /// Two nested loops a section (the inside loop read for the wall's
+    /// thickness only).
     shell: bool,
     /// The mesh's height (mm).
     height: f64,

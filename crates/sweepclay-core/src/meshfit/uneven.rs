@@ -8,8 +8,9 @@ use super::*;
 /// A shell (or, `solid`, a solid) whose rim rises round the loop
 /// (docs/MESHES.md, "Uneven rims"): sections up to `whole` go round,
 /// those above are the wall's higher parts. Along each radial ray the
-/// wall's middle (a solid's outside, where it is not the cap across its
-/// top) is found in every section it reaches and the ray's rim height
+/// bead's centre line, half a bead inside the wall's outside (where it
+/// is not the cap across a solid's top), is found in every section it
+/// reaches and the ray's rim height
 /// H_j where it stops;
 /// the design's two profiles of heights Z_s = min H and Z_t = max H are
 /// blended by λ_j = (H_j − Z_s) / (Z_t − Z_s), at the same fraction of
@@ -28,13 +29,17 @@ pub(super) fn fit_uneven(
     let (c, psi0) = foot_frame(cut);
     let jj = psi0.len();
     let zs: Vec<f64> = cut.iter().map(|s| s.z).collect();
-    // The wall's middle along each ray in each section it reaches.
+    // Half a bead inside the outside along each ray in each section it
+    // reaches.
     let mut d: Vec<Vec<Option<f64>>> = Vec::with_capacity(cut.len());
-    let mut half = vec![None::<f64>; jj];
+    // The bead's centre line half a bead inside the outside, along the
+    // ray (docs/MESHES.md, "The outside is the pot"); the thickest wall.
+    let half_bead = 0.5 * opts.bead_mm;
+    let mut thick = 0.0f64;
     for (k, sec) in cut.iter().enumerate() {
         let loops = about(sec, c);
         let mut row = Vec::with_capacity(jj);
-        for (j, p) in psi0.iter().enumerate() {
+        for p in &psi0 {
             let r = p[0].hypot(p[1]).max(1e-9);
             let dir = [p[0] / r, p[1] / r];
             if solid {
@@ -52,7 +57,7 @@ pub(super) fn fit_uneven(
                     })
                     .max_by(|a, b| a.0.total_cmp(&b.0));
                 row.push(match far {
-                    Some((t, false)) => Some(t - r),
+                    Some((t, false)) => Some(t - half_bead - r),
                     // The cap, where it reaches lower than the section
                     // that starts it all round (a faceted dome's).
                     Some((_, true)) => None,
@@ -75,12 +80,12 @@ pub(super) fn fit_uneven(
             row.push(match ts.len() {
                 2 => {
                     if k < whole {
-                        half[j] = Some(0.5 * (ts[1] - ts[0]));
+                        thick = thick.max(ts[1] - ts[0]);
                     }
-                    Some(0.5 * (ts[0] + ts[1]) - r)
+                    Some(ts[1] - half_bead - r)
                 }
                 // A shell's floor slab: its outside only.
-                1 if k < whole => Some(ts[0] - r),
+                1 if k < whole => Some(ts[0] - half_bead - r),
                 0 if k >= whole => None,
                 n if k < whole => {
                     return Err(Error::invalid(
@@ -94,17 +99,7 @@ pub(super) fn fit_uneven(
         }
         d.push(row);
     }
-    // The slab's middle: half the wall's thickness in from its outside.
-    for (k, row) in d.iter_mut().enumerate().take(whole) {
-        if cut[k].loops.len() == 1 {
-            for (v, h) in row.iter_mut().zip(&half) {
-                if let (Some(v), Some(h)) = (v.as_mut(), h) {
-                    *v -= h;
-                }
-            }
-        }
-    }
-    // Ψ is the wall's middle at the lowest section; D is from it.
+    // Ψ is the bead's centre line at the lowest section; D is from it.
     let base: Vec<f64> = d[0].iter().map(|v| v.unwrap_or(0.0)).collect();
     let psi: Vec<[f64; 2]> = (0..jj)
         .map(|j| {
@@ -314,6 +309,13 @@ pub(super) fn fit_uneven(
     }
     Ok(Fitted {
         absorbed: None,
+        inside: (thick - opts.bead_mm > THICKER_MM).then(|| {
+            format!(
+                "the wall is up to {:.1} mm thicker than a bead ({} mm): its outside is kept and its inside moves out by that much",
+                thick - opts.bead_mm,
+                opts.bead_mm
+            )
+        }),
         design,
         deviation_mm: deviation,
         at,

@@ -214,7 +214,8 @@ pub struct MeshImport {
     pub deviation_mm: f64,
     /// Where it lies (mm, the design's frame).
     pub at: [f64; 3],
-    /// `solid` (fitted at its outside) or `shell` (at its wall's middle).
+    /// `solid` or `shell` (a wall with its thickness); either way the
+    /// printed bead's outer edge is the mesh's outside.
     pub kind: &'static str,
     /// Triangles read.
     pub triangles: usize,
@@ -252,9 +253,12 @@ pub fn import_mesh(name: &str, bytes: &[u8], up: usize) -> Result<MeshImport, Ap
         kind: f.kind,
         triangles: m.triangles,
         // The units assumed and the details taken in, one sentence each.
-        note: match (m.units_note, f.absorbed) {
-            (Some(u), Some(a)) => Some(format!("{u}; {a}")),
-            (u, a) => u.or(a),
+        note: {
+            let notes: Vec<String> = [m.units_note, f.absorbed, f.inside]
+                .into_iter()
+                .flatten()
+                .collect();
+            (!notes.is_empty()).then(|| notes.join("; "))
         },
         sweep: f
             .sweep
