@@ -124,6 +124,15 @@ def main():
     bowl = revolved([(40.0, 0.0), (70.0, 45.0)], 96)
     hollow = revolved([(34.0 + 30.0 * 6.0 / 45.0, 6.0), (64.0 + 30.0 * 6.0 / 45.0, 51.0)], 96)
     forms["wide-bowl"] = bowl.difference(hollow)
+    # A pot on a ring foot (issue 56, point 3): a cylinder 80 mm across,
+    # its wall 5 mm thick on a 6 mm floor, standing on a ring 10 mm wide
+    # round a recess 4 mm deep under its floor.
+    pot = trimesh.creation.cylinder(radius=40.0, height=70.0, sections=96)
+    pot.apply_translation((0, 0, 35.0))
+    cavity = trimesh.creation.cylinder(radius=35.0, height=70.0, sections=96)
+    cavity.apply_translation((0, 0, 45.0))
+    recess = trimesh.creation.cylinder(radius=30.0, height=8.0, sections=96)
+    forms["ring-foot"] = pot.difference(cavity).difference(recess)
     # An eight-point star, its points 45 mm out and its notches 35, swept
     # straight up 60 mm: a solid whose spikes are sharp.
     star = Polygon([((45.0 if k % 2 == 0 else 35.0) * np.cos(np.pi * k / 8),

@@ -639,4 +639,16 @@ fn the_printed_bead_keeps_the_meshs_outside() {
     let f = trimesh_form("thick-cylinder").unwrap();
     let said = f.inside.unwrap();
     assert!(said.contains("up to 7.0 mm thicker"), "{said}");
+    // A pot on a ring foot 10 mm wide round a 4 mm recess (issue 56,
+    // point 3): its outside kept down to the bed, the recess said to be
+    // filled, and the ring not taken for a wall 7 mm thicker than a bead
+    // (its wall above is 5 mm: 2.0 mm more).
+    let f = trimesh_form("ring-foot").unwrap();
+    assert!(off_half_a_bead_inside("ring-foot", &f) < 0.6);
+    let said = f.inside.unwrap();
+    assert!(
+        said.contains("the recess under its floor (inside its ring foot, up to z = 4.")
+            && said.contains("up to 2.0 mm thicker"),
+        "{said}"
+    );
 }

@@ -201,8 +201,15 @@ pub(super) const THICKER_MM: f64 = 0.5;
 /// thicker than a bead, by more than [`THICKER_MM`]) is said. A section
 /// narrower than a bead inside its outside is refused by name.
 fn keep_outside(cut: &mut [sections::Section], bead: f64) -> Result<Option<String>> {
+    // A ring at the foot under a section of one loop (a floor slab): a
+    // ring foot round a recess, which the floor, laid on the bed, fills.
+    let slab = cut.iter().position(|s| s.loops.len() == 1);
+    let recess = match slab {
+        Some(k) if k > 0 && cut[0].loops.len() == 2 => Some((k, cut[k].z)),
+        _ => None,
+    };
     let mut moved: Option<(f64, f64)> = None;
-    for s in cut.iter_mut() {
+    for (k, s) in cut.iter_mut().enumerate() {
         let areas: Vec<f64> = s.loops.iter().map(|l| signed_area2(l).abs()).collect();
         let Some(o) = (0..areas.len()).max_by(|&a, &b| areas[a].total_cmp(&areas[b])) else {
             continue;
@@ -211,7 +218,7 @@ fn keep_outside(cut: &mut [sections::Section], bead: f64) -> Result<Option<Strin
         if signed_area2(&outer) < 0.0 {
             outer.reverse();
         }
-        if s.loops.len() == 2 {
+        if s.loops.len() == 2 && recess.is_none_or(|(top, _)| k >= top) {
             // The wall's mean thickness: the ring's area over its mean
             // length (exact for concentric circles).
             let length = |l: &[[f64; 2]]| -> f64 {
@@ -245,12 +252,20 @@ fn keep_outside(cut: &mut [sections::Section], bead: f64) -> Result<Option<Strin
         s.up = vec![vec![false; wall.len()]];
         s.loops = vec![wall];
     }
-    Ok(moved.map(|(m, z)| {
-        format!(
-            "the wall is up to {:.1} mm thicker than a bead ({bead} mm, at z = {z:.1} mm): its outside is kept and its inside moves out by that much",
-            m
-        )
-    }))
+    let notes: Vec<String> = recess
+        .map(|(_, z)| {
+            format!(
+                "the recess under its floor (inside its ring foot, up to z = {z:.1} mm) is filled: the floor is laid on the bed out to the foot's outside"
+            )
+        })
+        .into_iter()
+        .chain(moved.map(|(m, z)| {
+            format!(
+                "the wall is up to {m:.1} mm thicker than a bead ({bead} mm, at z = {z:.1} mm): its outside is kept and its inside moves out by that much"
+            )
+        }))
+        .collect();
+    Ok((!notes.is_empty()).then(|| notes.join("; ")))
 }
 
 /// Takes the loops of `cut` smaller than [`DETAIL_AREA_MM2`] (never a
