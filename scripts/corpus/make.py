@@ -315,6 +315,21 @@ EAZAO_START = ("G21 \nG90 ;absolute positioning\nM82 ;set extruder to absolute m
 EAZAO_END = "G92 Z0 E0\nG1 F1500 E-2\nG1 F1500 Z10\nG28 X0;move X Y to min endstops\nM82\nM84 ;steppers off\n"
 
 
+def cura_machine(defs, definition, stl, name, machine=()):
+    """CuraEngine with a printer's own definition (its start and end
+    code) and the clay settings, `machine` overriding its machine
+    settings, slicing `stl` into the corpus's `name`.gcode."""
+    clay = cura_settings()
+    cmd = ["CuraEngine", "slice", "-j", os.path.join(defs, definition + ".def.json")]
+    for s in clay + list(machine):
+        cmd += ["-s", s]
+    cmd += ["-e0"]
+    for s in clay:
+        cmd += ["-s", s]
+    cmd += ["-l", stl, "-o", os.path.join(OUT, name + ".gcode")]
+    run(cmd)
+
+
 def firmware_files(tmp, defs, vase):
     """Files whose firmware commands the checker must read as firmware
     does (docs/CHECKER.md, "Firmwares"), made by the slicers themselves:
@@ -323,34 +338,14 @@ def firmware_files(tmp, defs, vase):
     retraction (`G10`/`G11`); PrusaSlicer's layer-change G-code writing
     `G4 P0` (a planner sync) at every layer, then `G4 S5` (a 5 s pause) at
     one layer, then `M221 S10` (10 % flow) from one layer on."""
-    out = os.path.join(OUT, "cura-eazao.gcode")
-    clay = cura_settings()
-    cmd = ["CuraEngine", "slice", "-j", os.path.join(defs, "eazao_zero.def.json")]
-    extra = [f"machine_start_gcode={EAZAO_START}", f"machine_end_gcode={EAZAO_END}",
-             "machine_width=150", "machine_depth=150", "machine_height=240"]
-    for group in (clay + extra,):
-        for s in group:
-            cmd += ["-s", s]
-    cmd += ["-e0"]
-    for s in clay:
-        cmd += ["-s", s]
-    cmd += ["-l", vase, "-o", out]
-    run(cmd)
-
+    cura_machine(defs, "eazao_zero", vase, "cura-eazao",
+                 [f"machine_start_gcode={EAZAO_START}", f"machine_end_gcode={EAZAO_END}",
+                  "machine_width=150", "machine_depth=150", "machine_height=240"])
     # Debian's Cura definition of the Structur3D Discov3ry, a paste
     # extruder on an Ultimaker 2+: its own start code sets the paste's
     # steps (`M92 E2589`), its end code sets them back for plastic
     # (`M92 E282`), as a paste printer's file does (issue 55, class 3).
-    out = os.path.join(OUT, "cura-discov3ry.gcode")
-    cmd = ["CuraEngine", "slice", "-j",
-           os.path.join(defs, "structur3d_discov3ry1_complete_um2plus.def.json")]
-    for s in clay:
-        cmd += ["-s", s]
-    cmd += ["-e0"]
-    for s in clay:
-        cmd += ["-s", s]
-    cmd += ["-l", vase, "-o", out]
-    run(cmd)
+    cura_machine(defs, "structur3d_discov3ry1_complete_um2plus", vase, "cura-discov3ry")
 
     def prusa_with(name, *more):
         # PrusaSlicer's vase with the extra options.

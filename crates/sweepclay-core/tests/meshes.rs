@@ -189,16 +189,7 @@ fn a_twisted_square_prints_as_it_is_with_a_relief_or_is_refused_sweep_only() {
                     [r * a.cos(), r * a.sin()]
                 })
                 .collect();
-            let inside = (0..960)
-                .map(|k| {
-                    let (p, q) = (outline[k], outline[(k + 1) % 960]);
-                    let (ex, ey) = (q[0] - p[0], q[1] - p[1]);
-                    let t =
-                        (((x - p[0]) * ex + (y - p[1]) * ey) / (ex * ex + ey * ey)).clamp(0.0, 1.0);
-                    (x - p[0] - t * ex).hypot(y - p[1] - t * ey)
-                })
-                .fold(f64::INFINITY, f64::min);
-            worst = worst.max((inside - half).abs());
+            worst = worst.max((to_ring([x, y], &outline) - half).abs());
         }
     }
     assert!(
@@ -568,6 +559,17 @@ fn details_under_a_bead_are_taken_in_and_a_knob_is_still_refused() {
     assert!(e.contains("splits into 2 parts"), "{e}");
 }
 
+/// How far point `p` lies from the closed loop `ring`, in plan (mm).
+fn to_ring(p: [f64; 2], ring: &[[f64; 2]]) -> f64 {
+    use sweepclay_core::plane::closest_on_segment;
+    (0..ring.len())
+        .map(|k| {
+            let c = closest_on_segment(p, ring[k], ring[(k + 1) % ring.len()]);
+            (p[0] - c[0]).hypot(p[1] - c[1])
+        })
+        .fold(f64::INFINITY, f64::min)
+}
+
 /// The most a design's sampled surface lies off half a bead inside the
 /// outside of `name`'s mesh (mm), measured in plan at every fourth
 /// sample above the foot's ring and below the 3 mm lip, the design
@@ -598,17 +600,7 @@ fn off_half_a_bead_inside(name: &str, f: &sweepclay_core::meshfit::Fitted) -> f6
                     area(a).total_cmp(&area(b))
                 })
                 .unwrap();
-            let (px, py) = (x - f.moved[0], y - f.moved[1]);
-            let n = outer.len();
-            let d = (0..n)
-                .map(|k| {
-                    let (p, q) = (outer[k], outer[(k + 1) % n]);
-                    let (ex, ey) = (q[0] - p[0], q[1] - p[1]);
-                    let t = (((px - p[0]) * ex + (py - p[1]) * ey) / (ex * ex + ey * ey))
-                        .clamp(0.0, 1.0);
-                    (px - p[0] - t * ex).hypot(py - p[1] - t * ey)
-                })
-                .fold(f64::INFINITY, f64::min);
+            let d = to_ring([x - f.moved[0], y - f.moved[1]], outer);
             worst = worst.max((d - half).abs());
         }
     }

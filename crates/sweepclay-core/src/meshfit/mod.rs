@@ -221,23 +221,17 @@ fn keep_outside(cut: &mut [sections::Section], bead: f64) -> Result<Option<Strin
         if s.loops.len() == 2 && recess.is_none_or(|(top, _)| k >= top) {
             // The wall's mean thickness: the ring's area over its mean
             // length (exact for concentric circles).
-            let length = |l: &[[f64; 2]]| -> f64 {
-                (0..l.len())
-                    .map(|i| {
-                        let (a, b) = (l[i], l[(i + 1) % l.len()]);
-                        (b[0] - a[0]).hypot(b[1] - a[1])
-                    })
-                    .sum()
-            };
-            let mean = 0.5 * (length(&s.loops[0]) + length(&s.loops[1]));
+            let mean = 0.5 * (perimeter(&s.loops[0]) + perimeter(&s.loops[1]));
             let t = 0.5 * (areas[o] - areas[1 - o]) / mean.max(1e-9);
             if t - bead > THICKER_MM && moved.is_none_or(|m| t - bead > m.0) {
                 moved = Some((t - bead, s.z));
             }
         }
-        let mut parts = crate::floor::offset(&outer, 0.5 * bead);
-        parts.sort_by(|a, b| signed_area2(b).abs().total_cmp(&signed_area2(a).abs()));
-        let Some(mut wall) = parts.into_iter().next() else {
+        let parts = crate::floor::offset(&outer, 0.5 * bead);
+        let Some(mut wall) = parts
+            .into_iter()
+            .max_by(|a, b| signed_area2(a).abs().total_cmp(&signed_area2(b).abs()))
+        else {
             return Err(Error::invalid(
                 "mesh",
                 format!(
@@ -435,7 +429,6 @@ fn fit_with(mesh: &TriMesh, opts: &FitOptions, absorbed: &mut Option<String>) ->
     // The pot is its outside: the bead's outer edge on it.
     let inside = keep_outside(&mut cut, opts.bead_mm)?;
     let kind = if shell { "shell" } else { "solid" };
-    let shell = false;
     let (c, psi) = foot_frame(&cut);
     let loops: Vec<Vec<Vec<[f64; 2]>>> = cut.iter().map(|s| about(s, c)).collect();
     let zs: Vec<f64> = cut.iter().map(|s| s.z).collect();
@@ -443,7 +436,6 @@ fn fit_with(mesh: &TriMesh, opts: &FitOptions, absorbed: &mut Option<String>) ->
     let secs = Sections {
         zs: &zs,
         loops: &loops,
-        shell,
         height,
         tol,
     };
@@ -535,11 +527,8 @@ fn runs(up: &[bool]) -> usize {
 struct Sections<'a> {
     /// Their heights (mm).
     zs: &'a [f64],
-    /// Their loops (one, or two nested for a shell).
+    /// Their loops: one a section, the bead's centre line.
     loops: &'a [Vec<Vec<[f64; 2]>>],
-    /// Two nested loops a section (the inside loop read for the wall's
-    /// thickness only).
-    shell: bool,
     /// The mesh's height (mm).
     height: f64,
     /// The tolerance (mm).
@@ -564,19 +553,18 @@ fn closest_in(
     let Sections {
         zs,
         loops,
-        shell,
         height,
         tol,
     } = *secs;
     let mut best: Option<Candidate> = None;
     let mut why = Vec::new();
     for &offset in frames {
-        match offsets(psi, zs, loops, offset, shell) {
+        match offsets(psi, zs, loops, offset) {
             Ok((mut d, dirs)) => {
                 // Only a profile's change from its foot counts (docs/
-                // FORMATS.md): Ψ is the wall at the lowest section (a
-                // shell's middle, not the foot's outside), and D is
-                // measured from it.
+                // FORMATS.md): Ψ is the wall at the lowest section (the
+                // bead's centre line, half a bead inside the foot's
+                // outside), and D is measured from it.
                 let base = if on_wall {
                     vec![0.0; psi.len()]
                 } else {

@@ -193,7 +193,6 @@ pub(super) fn offsets(
     zs: &[f64],
     loops: &[Vec<Vec<[f64; 2]>>],
     offset: Offset,
-    shell: bool,
 ) -> std::result::Result<Offsets, String> {
     let n = psi.len();
     let rays: Vec<([f64; 2], [f64; 2], f64)> = (0..n)
@@ -216,75 +215,45 @@ pub(super) fn offsets(
         })
         .collect();
     let mut d = Vec::with_capacity(loops.len());
-    // Half the wall's thickness along each ray, where a shell's section
-    // has both its loops.
-    let mut half: Vec<Option<Vec<f64>>> = Vec::with_capacity(loops.len());
     for (k, sec) in loops.iter().enumerate() {
+        // One loop a section: the bead's centre line (docs/MESHES.md,
+        // "The outside is the pot").
+        let Some(l) = sec.first() else {
+            return Err(format!("it has nothing at z = {:.1} mm", zs[k]));
+        };
         let mut row = Vec::with_capacity(n);
-        let mut halves = Vec::with_capacity(n);
         for &(o, dir, base) in &rays {
-            let mut wall = Vec::with_capacity(2);
-            for l in sec {
-                let ts = hits(l, o, dir);
-                let t = match offset {
-                    Offset::Radial => {
-                        let ahead: Vec<f64> = ts.into_iter().filter(|&t| t > 0.0).collect();
-                        if ahead.len() != 1 {
-                            return Err(format!(
-                                "its wall at z = {:.1} mm does not go once round its foot's centre (a ray from the centre meets it {} times, near ({:.1}, {:.1}) mm)",
-                                zs[k],
-                                ahead.len(),
-                                dir[0] * base,
-                                dir[1] * base
-                            ));
-                        }
-                        ahead[0]
+            let ts = hits(l, o, dir);
+            let t = match offset {
+                Offset::Radial => {
+                    let ahead: Vec<f64> = ts.into_iter().filter(|&t| t > 0.0).collect();
+                    if ahead.len() != 1 {
+                        return Err(format!(
+                            "its wall at z = {:.1} mm does not go once round its foot's centre (a ray from the centre meets it {} times, near ({:.1}, {:.1}) mm)",
+                            zs[k],
+                            ahead.len(),
+                            dir[0] * base,
+                            dir[1] * base
+                        ));
                     }
-                    Offset::Normal => match ts
-                        .into_iter()
-                        .min_by(|a, b| a.abs().total_cmp(&b.abs()))
-                    {
-                        Some(t) => t,
-                        None => {
-                            return Err(format!(
-                                "its wall at z = {:.1} mm is not across the foot's wall near ({:.1}, {:.1}) mm (it leans out beyond where the foot reaches)",
-                                zs[k], o[0], o[1]
-                            ))
-                        }
-                    },
-                };
-                wall.push(t);
-            }
-            let t = if shell && wall.len() == 2 {
-                halves.push(0.5 * (wall[0] - wall[1]).abs());
-                0.5 * (wall[0] + wall[1])
-            } else {
-                wall[0]
+                    ahead[0]
+                }
+                Offset::Normal => match ts
+                    .into_iter()
+                    .min_by(|a, b| a.abs().total_cmp(&b.abs()))
+                {
+                    Some(t) => t,
+                    None => {
+                        return Err(format!(
+                            "its wall at z = {:.1} mm is not across the foot's wall near ({:.1}, {:.1}) mm (it leans out beyond where the foot reaches)",
+                            zs[k], o[0], o[1]
+                        ))
+                    }
+                },
             };
             row.push(t - base);
         }
         d.push(row);
-        half.push((halves.len() == n).then_some(halves));
-    }
-    if shell {
-        // A shell's floor slab is cut as one loop, its outside: its wall's
-        // middle lies half the thickness of the nearest whole section in
-        // (toward Ψ's side the inner loop lay on).
-        let whole: Vec<usize> = (0..d.len()).filter(|&k| half[k].is_some()).collect();
-        for k in 0..d.len() {
-            if half[k].is_some() {
-                continue;
-            }
-            let near = whole.iter().min_by_key(|&&w| w.abs_diff(k)).copied();
-            if let Some(w) = near {
-                let h = half[w].clone().expect("whole");
-                for j in 0..n {
-                    // Both frames point out: the middle is half the
-                    // thickness in from the outside.
-                    d[k][j] -= h[j];
-                }
-            }
-        }
     }
     Ok((d, rays.iter().map(|r| r.1).collect()))
 }

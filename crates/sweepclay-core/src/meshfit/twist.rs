@@ -209,11 +209,7 @@ pub(super) fn turns(loops: &[Vec<Vec<[f64; 2]>>], zs: &[f64], height: f64) -> Op
 /// the estimate fitted best. `None` for a loop that shows no turn.
 pub(super) fn twisted(psi: &[[f64; 2]], secs: &Sections) -> Option<Candidate> {
     let Sections {
-        zs,
-        loops,
-        shell,
-        height,
-        ..
+        zs, loops, height, ..
     } = *secs;
     let turns = turns(loops, zs, height)?;
     let tau = turns.twist()?;
@@ -252,7 +248,7 @@ pub(super) fn twisted(psi: &[[f64; 2]], secs: &Sections) -> Option<Candidate> {
         let zs: Vec<f64> = sub.iter().map(|&k| zs[k]).collect();
         let loops: Vec<_> = sub.iter().map(|&k| loops[k].clone()).collect();
         let back = untwisted(&loops, &zs, (turns.turn0(t), t), height);
-        let Ok((d, _)) = offsets(psi, &zs, &back, frame, shell) else {
+        let Ok((d, _)) = offsets(psi, &zs, &back, frame) else {
             return f64::INFINITY;
         };
         let (sum, n) = d.iter().fold((0.0, 0usize), |(sum, n), row| {
