@@ -138,6 +138,63 @@ def main():
     star = Polygon([((45.0 if k % 2 == 0 else 35.0) * np.cos(np.pi * k / 8),
                      (45.0 if k % 2 == 0 else 35.0) * np.sin(np.pi * k / 8)) for k in range(16)])
     forms["star"] = trimesh.creation.extrude_polygon(star, 60.0)
+    # Issue 56, point 2: what potters' meshes carry besides one wall.
+    def cup(r=36.0, h=70.0, wall=4.0, floor=5.0, n=96):
+        o = trimesh.creation.cylinder(radius=r, height=h, sections=n)
+        o.apply_translation((0, 0, h / 2))
+        i = trimesh.creation.cylinder(radius=r - wall, height=h, sections=n)
+        i.apply_translation((0, 0, h / 2 + floor))
+        return o.difference(i)
+    # Four drainage holes 6 mm across through a cup's floor.
+    holes = [trimesh.creation.cylinder(radius=3.0, height=20.0, sections=24) for _ in range(4)]
+    for k, hole in enumerate(holes):
+        hole.apply_translation((15.0 * np.cos(k * np.pi / 2), 15.0 * np.sin(k * np.pi / 2), 0.0))
+    forms["drained-cup"] = cup().difference(trimesh.util.concatenate(holes))
+    # A groove 3 mm wide and 1.5 mm deep round the floor's top, at its edge.
+    groove = trimesh.creation.annulus(r_min=29.0, r_max=32.0, height=3.0, sections=96)
+    groove.apply_translation((0, 0, 5.0))
+    forms["grooved-floor"] = cup().difference(groove)
+    # A mug: the cup and a handle (a bar 10 × 8 mm bent round, its ends
+    # in the wall at 15 and 55 mm).
+    handle = trimesh.creation.box(extents=(8.0, 10.0, 48.0))
+    handle.apply_translation((52.0, 0, 35.0))
+    top = trimesh.creation.box(extents=(22.0, 10.0, 8.0))
+    top.apply_translation((43.0, 0, 55.0))
+    low = top.copy()
+    low.apply_translation((0, 0, -40.0))
+    forms["mug"] = cup().union(handle).union(top).union(low)
+    # A bowl on three feet 10 mm tall.
+    feet = [trimesh.creation.cylinder(radius=4.0, height=10.0, sections=24) for _ in range(3)]
+    for k, foot in enumerate(feet):
+        foot.apply_translation((25.0 * np.cos(2 * k * np.pi / 3), 25.0 * np.sin(2 * k * np.pi / 3), 5.0))
+    bowl = cup(r=40.0, h=50.0)
+    bowl.apply_translation((0, 0, 10.0))
+    forms["footed"] = bowl.union(trimesh.util.concatenate(feet))
+    # A cup tilted 1.5° (an export turned a little): its foot meets the
+    # bed on one side.
+    t = cup()
+    t.apply_transform(trimesh.transformations.rotation_matrix(np.radians(1.5), (1, 0, 0)))
+    forms["tilted-cup"] = t
+    # Six windows 12 mm wide through the wall from 25 to 45 mm.
+    windows = []
+    for k in range(6):
+        w = trimesh.creation.box(extents=(20.0, 12.0, 20.0))
+        w.apply_translation((36.0, 0, 35.0))
+        w.apply_transform(trimesh.transformations.rotation_matrix(k * np.pi / 3, (0, 0, 1)))
+        windows.append(w)
+    forms["windowed"] = cup().difference(trimesh.util.concatenate(windows))
+    # Twelve creases 0.6 mm wide cut 3 mm deep into a solid's outside,
+    # slanting 45° to its rays (a faceted vase's folds).
+    creases = []
+    for k in range(12):
+        c2 = trimesh.creation.box(extents=(6.0, 0.6, 100.0))
+        c2.apply_transform(trimesh.transformations.rotation_matrix(np.pi / 4, (0, 0, 1)))
+        c2.apply_translation((36.0, 0, 40.0))
+        c2.apply_transform(trimesh.transformations.rotation_matrix(k * np.pi / 6, (0, 0, 1)))
+        creases.append(c2)
+    body = trimesh.creation.cylinder(radius=36.0, height=70.0, sections=96)
+    body.apply_translation((0, 0, 35.0))
+    forms["creased"] = body.difference(trimesh.util.concatenate(creases))
     for name, m in forms.items():
         if not m.is_watertight:
             sys.exit(f"{name}: trimesh wrote a mesh that is not watertight")

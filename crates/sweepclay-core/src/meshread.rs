@@ -40,31 +40,24 @@ impl TriMesh {
         Ok(mesh)
     }
 
-    /// The standard repairs that change no surface: vertices less than
-    /// a micrometre apart are merged (a seam written with two roundings
-    /// of one point, which leaves a crack no section can close: Blender's
-    /// "Merge by Distance"), then triangles with a repeated vertex (no
-    /// area, they join nothing) and second copies of a triangle
-    /// (exporters write some twice) are dropped. Returns how many
-    /// triangles were.
+    /// The standard repairs that change no surface: vertices at the same
+    /// place are one; where that leaves the mesh open (a seam written
+    /// with two roundings of one point, a crack no section can close),
+    /// vertices less than a hundred-thousandth of the mesh's size apart
+    /// are merged too (a micrometre on a 100 mm pot, in whatever unit the
+    /// file has: Blender's "Merge by Distance"). A mesh already closed is
+    /// not merged by distance: an OpenSCAD export's points a micrometre
+    /// apart are its own. Then triangles with a repeated vertex (no area,
+    /// they join nothing) and second copies of a triangle (exporters
+    /// write some twice) are dropped. Returns how many triangles were.
     pub fn repair(&mut self) -> usize {
         let before = self.triangles.len();
-        let mut index: rustc_hash::FxHashMap<[i64; 3], u32> = rustc_hash::FxHashMap::default();
-        let mut merged = Vec::with_capacity(self.vertices.len());
-        let remap: Vec<u32> = self
-            .vertices
-            .iter()
-            .map(|v| {
-                let key = v.map(|x| (x * 1e3).round() as i64);
-                *index.entry(key).or_insert_with(|| {
-                    merged.push(*v);
-                    merged.len() as u32 - 1
-                })
-            })
-            .collect();
-        self.vertices = merged;
-        for t in &mut self.triangles {
-            *t = t.map(|i| remap[i as usize]);
+        self.merge(|v| v.map(f64::to_bits));
+        if !self.closed() {
+            let (lo, hi) = self.bounds();
+            let size = (0..3).map(|a| hi[a] - lo[a]).fold(0.0, f64::max);
+            let step = (1e-5 * size).max(f64::MIN_POSITIVE);
+            self.merge(|v| v.map(|x| (x / step).round() as i64 as u64));
         }
         let mut seen = rustc_hash::FxHashSet::default();
         self.triangles.retain(|t| {
@@ -76,6 +69,37 @@ impl TriMesh {
             seen.insert(k)
         });
         before - self.triangles.len()
+    }
+
+    /// Makes the vertices with one `key` one vertex.
+    fn merge(&mut self, key: impl Fn([f64; 3]) -> [u64; 3]) {
+        let mut index: rustc_hash::FxHashMap<[u64; 3], u32> = rustc_hash::FxHashMap::default();
+        let mut merged = Vec::with_capacity(self.vertices.len());
+        let remap: Vec<u32> = self
+            .vertices
+            .iter()
+            .map(|v| {
+                *index.entry(key(*v)).or_insert_with(|| {
+                    merged.push(*v);
+                    merged.len() as u32 - 1
+                })
+            })
+            .collect();
+        self.vertices = merged;
+        for t in &mut self.triangles {
+            *t = t.map(|i| remap[i as usize]);
+        }
+    }
+
+    /// Whether every edge joins exactly two triangles.
+    fn closed(&self) -> bool {
+        let mut count: rustc_hash::FxHashMap<(u32, u32), u32> = rustc_hash::FxHashMap::default();
+        for t in &self.triangles {
+            for (a, b) in [(t[0], t[1]), (t[1], t[2]), (t[2], t[0])] {
+                *count.entry((a.min(b), a.max(b))).or_default() += 1;
+            }
+        }
+        count.values().all(|&c| c == 2)
     }
 
     /// The lowest and highest corner of the mesh's bounding box.
@@ -322,5 +346,38 @@ mod tests {
         let m = TriMesh::read("t.stl", stl).unwrap();
         assert_eq!(m.vertices.len(), 4);
         assert_eq!(m.triangles.len(), 2);
+    }
+
+    /// A tetrahedron of size `k`; with `crack`, one face has its first
+    /// corner written a second time that far away (a seam rounded twice).
+    fn tetra(k: f64, crack: Option<f64>) -> TriMesh {
+        let mut m = TriMesh {
+            vertices: vec![[0.0, 0.0, 0.0], [k, 0.0, 0.0], [0.0, k, 0.0], [0.0, 0.0, k]],
+            triangles: vec![[0, 2, 1], [0, 1, 3], [0, 3, 2], [1, 2, 3]],
+        };
+        if let Some(c) = crack {
+            m.vertices.push([c, 0.0, 0.0]);
+            m.triangles[2] = [4, 3, 2];
+        }
+        m
+    }
+
+    #[test]
+    fn a_crack_is_closed_at_any_unit_and_a_closed_mesh_keeps_its_points() {
+        // 100 mm with a 0.3 µm crack; 0.1 m with 0.3 µm: both closed.
+        for (k, crack) in [(100.0, 3e-4), (0.1, 3e-7)] {
+            let mut m = tetra(k, Some(crack));
+            assert!(!m.closed(), "{k}");
+            m.repair();
+            assert!(m.closed(), "{k}: merged");
+            assert_eq!(m.vertices.len(), 4, "{k}");
+        }
+        // A closed tetrahedron 0.8 mm across in metres: the old merge (a
+        // micrometre in the file's unit, here a millimetre) made it one
+        // point; closed, nothing is merged.
+        let mut m = tetra(0.0008, None);
+        assert!(m.closed());
+        assert_eq!(m.repair(), 0);
+        assert_eq!((m.vertices.len(), m.triangles.len()), (4, 4));
     }
 }

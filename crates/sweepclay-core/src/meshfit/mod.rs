@@ -262,10 +262,24 @@ fn keep_outside(cut: &mut [sections::Section], bead: f64) -> Result<Option<Strin
     Ok((!notes.is_empty()).then(|| notes.join("; ")))
 }
 
-/// Takes the loops of `cut` smaller than [`DETAIL_AREA_MM2`] (never a
-/// section's largest) out of their sections, and says how many, the
-/// largest and where, and between which heights.
-fn absorb_details(cut: &mut [sections::Section]) -> Option<String> {
+/// Whether a bead `bead` wide fits inside loop `l`: its centre line, half
+/// a bead inside the loop, leaves something (docs/MESHES.md, "Details").
+fn holds_a_bead(l: &[[f64; 2]], bead: f64) -> bool {
+    let mut l = l.to_vec();
+    if signed_area2(&l) < 0.0 {
+        l.reverse();
+    }
+    !crate::floor::offset(&l, 0.5 * bead).is_empty()
+}
+
+/// Takes the loops of `cut` that no bead prints (never a section's
+/// largest) out of their sections: smaller than [`DETAIL_AREA_MM2`], or
+/// too narrow for a `bead` wide bead to fit inside (a fin, a thin tab).
+/// Says how many, the heights, and where the largest was. A section
+/// whose largest loop is itself too narrow (the posts of an openwork
+/// wall, as large as each other) keeps its loops, for the refusal to
+/// name.
+fn absorb_details(cut: &mut [sections::Section], bead: f64) -> Option<String> {
     let (mut n, mut zs, mut largest) = (0usize, (f64::MAX, f64::MIN), (0.0f64, [0.0; 3]));
     for s in cut.iter_mut() {
         let areas: Vec<f64> = s
@@ -273,27 +287,33 @@ fn absorb_details(cut: &mut [sections::Section]) -> Option<String> {
             .iter()
             .map(|l| 0.5 * signed_area2(l).abs())
             .collect();
-        let Some(big) = areas
-            .iter()
-            .cloned()
-            .fold(None, |m: Option<f64>, a| Some(m.map_or(a, |m| m.max(a))))
-        else {
+        let Some(o) = (0..areas.len()).max_by(|&a, &b| areas[a].total_cmp(&areas[b])) else {
             continue;
         };
-        let mut keep = |i: usize| {
-            let a = areas[i];
-            let small = a < DETAIL_AREA_MM2 && a < big;
-            if small {
-                n += 1;
-                zs = (zs.0.min(s.z), zs.1.max(s.z));
-                if a >= largest.0 {
-                    let c = centroid(&s.loops[i]);
-                    largest = (a, [c[0], c[1], s.z]);
+        let second = (0..areas.len())
+            .filter(|&i| i != o)
+            .map(|i| areas[i])
+            .fold(0.0, f64::max);
+        if areas[o] < DETAIL_AREA_MM2
+            || (2.0 * second >= areas[o] && !holds_a_bead(&s.loops[o], bead))
+        {
+            continue;
+        }
+        let kept: Vec<bool> = (0..areas.len())
+            .map(|i| {
+                let small =
+                    i != o && (areas[i] < DETAIL_AREA_MM2 || !holds_a_bead(&s.loops[i], bead));
+                if small {
+                    n += 1;
+                    zs = (zs.0.min(s.z), zs.1.max(s.z));
+                    if areas[i] >= largest.0 {
+                        let c = centroid(&s.loops[i]);
+                        largest = (areas[i], [c[0], c[1], s.z]);
+                    }
                 }
-            }
-            !small
-        };
-        let kept: Vec<bool> = (0..areas.len()).map(&mut keep).collect();
+                !small
+            })
+            .collect();
         let mut flags = kept.iter();
         s.loops.retain(|_| *flags.next().unwrap_or(&true));
         let mut flags = kept.iter();
@@ -302,10 +322,230 @@ fn absorb_details(cut: &mut [sections::Section]) -> Option<String> {
     (n > 0).then(|| {
         let (a, at) = largest;
         format!(
-            "took {n} detail(s) too small for a bead into the wall (under {DETAIL_AREA_MM2} mm² in section, between z = {:.1} and {:.1} mm; the largest {a:.1} mm² at ({:.1}, {:.1}, {:.1}) mm): they do not print",
+            "took {n} detail(s) no bead prints into the wall (under {DETAIL_AREA_MM2} mm² in section or narrower than a {bead} mm bead, between z = {:.1} and {:.1} mm; the largest {a:.1} mm² at ({:.1}, {:.1}, {:.1}) mm): they do not print",
             zs.0, zs.1, at[0], at[1], at[2]
         )
     })
+}
+
+/// The least share of a section's outside that the opening inside it
+/// takes to be its cavity: a wall 30 mm thick round a pot 100 mm across
+/// leaves 16 %; a 10 mm drainage hole in its floor is 1 %.
+const CAVITY_SHARE: f64 = 0.1;
+
+/// What a section holds besides its outside (its largest loop): parts
+/// beside it, the openings inside it beyond its largest (the cavity), and
+/// islands inside an opening.
+struct Inner {
+    /// Loops no other loop holds: a second part (area, centre).
+    beside: Vec<(f64, [f64; 2])>,
+    /// Openings beyond the cavity (area, centre).
+    openings: Vec<(f64, [f64; 2])>,
+    /// Loops inside an opening (area, centre).
+    islands: Vec<(f64, [f64; 2])>,
+}
+
+/// Sorts each section's loops: its outside, its cavity (the largest loop
+/// inside it), and the rest ([`Inner`]); the section keeps only its
+/// outside and cavity.
+fn sort_loops(s: &mut sections::Section) -> Inner {
+    let mut inner = Inner {
+        beside: vec![],
+        openings: vec![],
+        islands: vec![],
+    };
+    let area = |l: &[[f64; 2]]| 0.5 * signed_area2(l).abs();
+    let Some(o) =
+        (0..s.loops.len()).max_by(|&a, &b| area(&s.loops[a]).total_cmp(&area(&s.loops[b])))
+    else {
+        return inner;
+    };
+    let depth = |j: usize| {
+        (0..s.loops.len())
+            .filter(|&i| i != j && nested(&s.loops[j], &s.loops[i]))
+            .count()
+    };
+    let mut holes: Vec<usize> = vec![];
+    for j in (0..s.loops.len()).filter(|&j| j != o) {
+        let it = (area(&s.loops[j]), centroid(&s.loops[j]));
+        match depth(j) {
+            0 => inner.beside.push(it),
+            1 => holes.push(j),
+            _ => inner.islands.push(it),
+        }
+    }
+    holes.sort_by(|&a, &b| area(&s.loops[b]).total_cmp(&area(&s.loops[a])));
+    // The cavity: the largest opening, if it is a tenth of the outside's
+    // area or more (a drainage hole in a floor is far less).
+    let cavity = holes
+        .first()
+        .copied()
+        .filter(|&j| area(&s.loops[j]) >= CAVITY_SHARE * area(&s.loops[o]));
+    for &j in holes.iter().skip(usize::from(cavity.is_some())) {
+        inner
+            .openings
+            .push((area(&s.loops[j]), centroid(&s.loops[j])));
+    }
+    let keep: Vec<usize> = std::iter::once(o).chain(cavity).collect();
+    s.loops = keep.iter().map(|&i| s.loops[i].clone()).collect();
+    s.up = keep.iter().map(|&i| s.up[i].clone()).collect();
+    inner
+}
+
+/// The runs of consecutive sections (first, last) where `has` holds.
+fn runs_where(has: &[bool]) -> Vec<(usize, usize)> {
+    let mut out: Vec<(usize, usize)> = vec![];
+    for (k, &h) in has.iter().enumerate() {
+        match out.last_mut() {
+            Some(r) if h && r.1 + 1 == k => r.1 = k,
+            _ if h => out.push((k, k)),
+            _ => {}
+        }
+    }
+    out
+}
+
+/// The largest of the items of `per` over sections `a..=b`, with its
+/// height: (area, [x, y, z]).
+fn largest_in(
+    per: &[Vec<(f64, [f64; 2])>],
+    cut: &[sections::Section],
+    (a, b): (usize, usize),
+) -> (f64, [f64; 3]) {
+    let mut best = (0.0, [0.0; 3]);
+    for k in a..=b {
+        for &(ar, c) in &per[k] {
+            if ar > best.0 {
+                best = (ar, [c[0], c[1], cut[k].z]);
+            }
+        }
+    }
+    best
+}
+
+/// Leaves each section of the wall (`cut`, foot to rim) its outside and
+/// its cavity. A part beside the wall bigger than a detail (a handle, a
+/// knob, a foot) is refused, saying where it leaves and joins the wall;
+/// so is a part standing inside the cavity above its floor. Openings in
+/// the floor and a floor top that is not level (a rise of at most
+/// [`RIM_LIP_MM`] just above where the cavity starts, a groove round its
+/// edge) are filled and said (docs/MESHES.md, "Details").
+fn one_wall(cut: &mut [sections::Section], dz: f64) -> Result<Option<String>> {
+    let inner: Vec<Inner> = cut.iter_mut().map(sort_loops).collect();
+    let z = |k: usize| cut[k].z;
+    let beside: Vec<Vec<(f64, [f64; 2])>> = inner.iter().map(|i| i.beside.clone()).collect();
+    if let Some(&(a, b)) =
+        runs_where(&beside.iter().map(|v| !v.is_empty()).collect::<Vec<_>>()).first()
+    {
+        let n = beside[a..=b].iter().map(Vec::len).max().unwrap_or(0);
+        let (ar, at) = largest_in(&beside, cut, (a, b));
+        let from = if a == 0 {
+            "standing on the bed".to_string()
+        } else {
+            format!("leaving the wall at z = {:.1} mm", z(a) - 0.5 * dz)
+        };
+        let to = if b + 1 == cut.len() {
+            "rising to the rim".to_string()
+        } else {
+            format!("joining it again at z = {:.1} mm", z(b) + 0.5 * dz)
+        };
+        return Err(Error::invalid(
+            "mesh",
+            format!(
+                "splits into {} parts from z = {:.1} to {:.1} mm: {n} beside its wall (the largest {ar:.0} mm² in section, near ({:.1}, {:.1}, {:.1}) mm), {from} and {to} (a handle, a knob, a foot or two bodies): one loop a height makes a vessel; take it off the mesh and join it by hand, leather-hard",
+                n + 1,
+                z(a),
+                z(b),
+                at[0],
+                at[1],
+                at[2]
+            ),
+        ));
+    }
+    let mut notes = vec![];
+    let openings: Vec<Vec<(f64, [f64; 2])>> = inner.iter().map(|i| i.openings.clone()).collect();
+    let runs = runs_where(&openings.iter().map(|v| !v.is_empty()).collect::<Vec<_>>());
+    if let (Some(&(a, _)), Some(&(_, b))) = (runs.first(), runs.last()) {
+        let n = openings[a..=b].iter().map(Vec::len).max().unwrap_or(0);
+        let (ar, at) = largest_in(&openings, cut, (a, b));
+        notes.push(format!(
+            "{n} opening(s) inside its outside besides its cavity (holes through its floor, from z = {:.1} to {:.1} mm; the largest {ar:.0} mm² at ({:.1}, {:.1}, {:.1}) mm) are filled: a clay floor is laid whole (drill them leather-hard)",
+            z(a),
+            z(b),
+            at[0],
+            at[1],
+            at[2]
+        ));
+    }
+    let islands: Vec<Vec<(f64, [f64; 2])>> = inner.iter().map(|i| i.islands.clone()).collect();
+    // Where the cavity starts: the floor's top.
+    let floor_top = cut.iter().position(|s| s.loops.len() == 2);
+    for (a, b) in runs_where(&islands.iter().map(|v| !v.is_empty()).collect::<Vec<_>>()) {
+        let (ar, at) = largest_in(&islands, cut, (a, b));
+        let rise = z(b) - z(a) + dz;
+        let on_floor = floor_top.is_some_and(|f| z(a) - z(f) <= RIM_LIP_MM);
+        if on_floor && rise <= RIM_LIP_MM {
+            notes.push(format!(
+                "its floor's top is not level (a rise or a groove {rise:.1} mm deep from z = {:.1} to {:.1} mm, the largest part {ar:.0} mm² at ({:.1}, {:.1}) mm): the floor is printed level",
+                z(a),
+                z(b),
+                at[0],
+                at[1]
+            ));
+        } else {
+            return Err(Error::invalid(
+                "mesh",
+                format!(
+                    "has a part inside it, apart from its wall, from z = {:.1} to {:.1} mm (the largest {ar:.0} mm² in section, near ({:.1}, {:.1}, {:.1}) mm: a divider, a post or an inner pot): one loop a height makes a vessel, or two nested for a wall with its thickness",
+                    z(a),
+                    z(b),
+                    at[0],
+                    at[1],
+                    at[2]
+                ),
+            ));
+        }
+    }
+    Ok((!notes.is_empty()).then(|| notes.join("; ")))
+}
+
+/// Where a tilted foot becomes whole: the first section within
+/// [`RIM_LIP_MM`] of the bed whose outside no longer runs along the
+/// mesh's underside (a level face), when the foot's first section is
+/// under half its area and off its centre by over a quarter of its
+/// radius (a foot that grows round its centre, a bowl's rounded bottom
+/// or a chamfer, is left as it is). `None` for a level foot.
+fn tilted_foot(cut: &[sections::Section]) -> Option<usize> {
+    let outside = |s: &sections::Section| {
+        (0..s.loops.len())
+            .max_by(|&a, &b| {
+                signed_area2(&s.loops[a])
+                    .abs()
+                    .total_cmp(&signed_area2(&s.loops[b]).abs())
+            })
+            .map(|i| {
+                (
+                    0.5 * signed_area2(&s.loops[i]).abs(),
+                    centroid(&s.loops[i]),
+                    s.up[i].iter().any(|&u| u),
+                )
+            })
+    };
+    let k = cut
+        .iter()
+        .take_while(|s| s.z <= RIM_LIP_MM)
+        .position(|s| outside(s).is_some_and(|(_, _, under)| !under))?;
+    let ((a0, c0, _), (ak, ck, _)) = (outside(&cut[0])?, outside(&cut[k])?);
+    let radius = (ak / std::f64::consts::PI).sqrt();
+    (k > 0 && a0 < 0.5 * ak && (c0[0] - ck[0]).hypot(c0[1] - ck[1]) > 0.25 * radius).then_some(k)
+}
+
+/// Adds `note` to what the fit says it took in or changed.
+fn say(absorbed: &mut Option<String>, note: String) {
+    *absorbed = Some(match absorbed.take() {
+        Some(d) => format!("{d}; {note}"),
+        None => note,
+    });
 }
 
 /// [`fit`], saying in `absorbed` what details it took into the wall.
@@ -334,25 +574,86 @@ fn fit_with(mesh: &TriMesh, opts: &FitOptions, absorbed: &mut Option<String>) ->
     })?;
     let dz = height / n as f64;
     let mut cut = sections::cut(mesh, lo[2] + 0.5 * dz, dz, n, lo[2])?;
-    *absorbed = absorb_details(&mut cut);
+    // A foot that meets the bed on one side first (an export tilted a
+    // degree or two) starts level where its loop is whole.
+    let (mut height, mut bed) = (height, lo[2]);
+    if let Some(k) = tilted_foot(&cut) {
+        let z0 = cut[k].z - 0.5 * dz;
+        cut.drain(..k);
+        for s in &mut cut {
+            s.z -= z0;
+        }
+        height -= z0;
+        bed += z0;
+        let note = format!(
+            "its foot is not level: it meets the bed on one side and is whole {z0:.1} mm up (a tilted export), so the print starts level there, {z0:.1} mm shorter"
+        );
+        say(absorbed, note);
+    }
+    if let Some(note) = absorb_details(&mut cut, opts.bead_mm) {
+        say(absorbed, note);
+    }
     // A rim that is not quite level (a helix's last turn, a rim's
     // rounding) leaves sections near the top that do not go round: the
     // rim is where the last whole section is, if that is within 3 mm of
     // the top; else the rim is uneven, which a design's rim key shapes
     // but the fit does not yet find.
-    let whole = cut
-        .iter()
-        .position(|s| {
-            !s.loops
-                .iter()
-                .any(|l| nested(&[centroid(l)], l) && around(l, &s.loops))
-        })
-        .unwrap_or(cut.len());
+    // A section goes round its centre when one loop holds the centre of
+    // all its loops' areas: a pot's wall does, even leaning; the posts of
+    // an openwork wall or feet round the foot do not.
+    let centre = |s: &sections::Section| {
+        let (mut a, mut c) = (0.0, [0.0; 2]);
+        for l in s.loops.iter().filter(|l| around(l, &s.loops)) {
+            let (w, m) = (signed_area2(l).abs(), centroid(l));
+            a += w;
+            c = [c[0] + w * m[0], c[1] + w * m[1]];
+        }
+        (a > 0.0).then(|| [c[0] / a, c[1] / a])
+    };
+    let holds = |s: &sections::Section, c: [f64; 2]| {
+        s.loops
+            .iter()
+            .any(|l| nested(&[c], l) && around(l, &s.loops))
+    };
+    let round = |s: &sections::Section| centre(s).is_some_and(|c| holds(s, c));
+    let whole = cut.iter().position(|s| !round(s)).unwrap_or(cut.len());
     if whole == 0 {
+        let k = cut[0].loops.len();
         return Err(Error::invalid(
             "mesh",
-            "has no section that goes round its centre at its foot: not a vessel standing on its base (turn it so its opening is up)",
+            if k > 1 {
+                format!("stands on {k} parts at its foot (feet, or a base in pieces), none going round its centre: one loop a height makes a vessel; join the feet into a foot ring, or take them off the mesh")
+            } else {
+                "has no section that goes round its centre at its foot: not a vessel standing on its base (turn it so its opening is up)".to_string()
+            },
         ));
+    }
+    // Sections higher up that go round again: the wall opens in between
+    // (posts, windows, slots), which one spiral cannot lay.
+    let below = centre(&cut[whole - 1]).unwrap_or_default();
+    if let Some(back) = cut[whole..]
+        .iter()
+        .position(|s| round(s) && holds(s, below))
+    {
+        let (a, b) = (cut[whole].z, cut[whole + back - 1].z);
+        let k = cut[whole..whole + back]
+            .iter()
+            .map(|s| s.loops.len())
+            .max()
+            .unwrap_or(0);
+        return Err(Error::invalid(
+            "mesh",
+            if k == 1 {
+                // One loop that does not hold its centre: a wall cut
+                // along its length, as a pot lying down is.
+                format!("its wall from z = {a:.1} to {b:.1} mm does not go round its centre (a slot up its side; or it lies on its side: --up y (or x) stands it up): one spiral lays a closed wall")
+            } else {
+                format!("its wall opens from z = {a:.1} to {b:.1} mm into {k} parts that do not go round its centre (an openwork wall, windows or slots): one spiral lays a closed wall; close the openings in the mesh")
+            },
+        ));
+    }
+    if let Some(note) = one_wall(&mut cut[..whole], dz)? {
+        say(absorbed, note);
     }
     // A solid whose top is a cap that slants (or rises to one side):
     // every section from the first the cap cuts up to the top is cut by
@@ -373,7 +674,7 @@ fn fit_with(mesh: &TriMesh, opts: &FitOptions, absorbed: &mut Option<String>) ->
     let mut whole = whole;
     if let Some(k) = capped.filter(|&k| k > 0 && cut[..k].iter().all(|s| s.loops.len() == 1)) {
         if height - cut[k].z > RIM_LIP_MM {
-            return fit_uneven(&cut, k, dz, opts, lo[2], true);
+            return fit_uneven(&cut, k, dz, opts, bed, true);
         }
         // Within the lip the wall ends where the cap begins, as a level
         // rim's rounding ends it: the design's rim is the top.
@@ -383,7 +684,7 @@ fn fit_with(mesh: &TriMesh, opts: &FitOptions, absorbed: &mut Option<String>) ->
         let z = cut[whole].z;
         if height - z > RIM_LIP_MM && cut[whole - 1].loops.len() == 2 {
             // A wall with its thickness whose rim rises round the loop.
-            return fit_uneven(&cut, whole, dz, opts, lo[2], false);
+            return fit_uneven(&cut, whole, dz, opts, bed, false);
         }
         if height - z > RIM_LIP_MM {
             return Err(Error::invalid(
@@ -438,6 +739,9 @@ fn fit_with(mesh: &TriMesh, opts: &FitOptions, absorbed: &mut Option<String>) ->
         loops: &loops,
         height,
         tol,
+        // A crease narrower than a bead in the outside is under two in
+        // the centre line: the inset moves its sides apart by a bead.
+        fold: 2.0 * opts.bead_mm,
     };
     let mut b = match closest(&psi, &secs) {
         Ok(b) => b,
@@ -475,6 +779,14 @@ fn fit_with(mesh: &TriMesh, opts: &FitOptions, absorbed: &mut Option<String>) ->
         }
     }
     let at = b.turned(b.at, height);
+    if let (n, Some(f)) = b.folds {
+        let f = b.turned(f, height);
+        let note = format!(
+            "read its wall at the outside of {n} ray(s) where it folds back across them in creases narrower than a bead (the first near ({:.1}, {:.1}, {:.1}) mm): the bead runs across them",
+            f[0], f[1], f[2]
+        );
+        say(absorbed, note);
+    }
     let sweep = (b.deviation > opts.tolerance_mm && opts.relief).then_some((b.deviation, at));
     if b.deviation > opts.tolerance_mm && !opts.relief {
         return Err(Error::invalid(
@@ -508,7 +820,7 @@ fn fit_with(mesh: &TriMesh, opts: &FitOptions, absorbed: &mut Option<String>) ->
         at: b.turned(at, height),
         kind,
         sections: cut.len(),
-        moved: [-c[0], -c[1], -lo[2]],
+        moved: [-c[0], -c[1], -bed],
         sweep,
     })
 }
@@ -533,6 +845,8 @@ struct Sections<'a> {
     height: f64,
     /// The tolerance (mm).
     tol: f64,
+    /// The widest fold read at its outside (mm along the centre line).
+    fold: f64,
 }
 
 /// The closer of the fits in both frames (radial and normal) of the
@@ -555,12 +869,13 @@ fn closest_in(
         loops,
         height,
         tol,
+        fold,
     } = *secs;
     let mut best: Option<Candidate> = None;
     let mut why = Vec::new();
     for &offset in frames {
-        match offsets(psi, zs, loops, offset) {
-            Ok((mut d, dirs)) => {
+        match offsets(psi, zs, loops, offset, fold) {
+            Ok((mut d, dirs, folds)) => {
                 // Only a profile's change from its foot counts (docs/
                 // FORMATS.md): Ψ is the wall at the lowest section (the
                 // bead's centre line, half a bead inside the foot's
@@ -583,7 +898,8 @@ fn closest_in(
                         *x -= b;
                     }
                 }
-                let cand = fit_offsets(&psi, zs, &d, offset, height, tol);
+                let mut cand = fit_offsets(&psi, zs, &d, offset, height, tol);
+                cand.folds = folds;
                 if best.as_ref().is_none_or(|b| cand.deviation < b.deviation) {
                     best = Some(cand);
                 }
@@ -615,6 +931,8 @@ struct Candidate {
     /// none): the sections were fitted turned back by both, the first
     /// from the foot, the second as the design turns.
     twist: (f64, f64),
+    /// Rays read at a fold's outside, and where the widest fold was.
+    folds: (usize, Option<[f64; 3]>),
 }
 
 impl Candidate {
@@ -821,6 +1139,7 @@ fn candidate(g: &Frame, d: &[Vec<f64>], s: &[f64], two: Option<(&[f64], &[f64])>
         residual.push(row);
     }
     Candidate {
+        folds: (0, None),
         offset,
         two: two.is_some(),
         psi: psi.to_vec(),

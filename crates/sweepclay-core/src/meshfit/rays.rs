@@ -180,19 +180,22 @@ pub(super) fn crossings(l: &[[f64; 2]], o: [f64; 2], d: [f64; 2]) -> Vec<(f64, u
     ts
 }
 
-/// D(k, j) by section and ray, and each ray's direction.
-type Offsets = (Vec<Vec<f64>>, Vec<[f64; 2]>);
+/// D(k, j) by section and ray, each ray's direction, and the folds taken
+/// in: how many rays, and where the largest fold was (x, y, z).
+type Offsets = (Vec<Vec<f64>>, Vec<[f64; 2]>, (usize, Option<[f64; 3]>));
 
 /// D(k, j): for each section k and each point j of Ψ, the offset of the
 /// section's wall along the ray of the frame (`offset`), and each ray's
-/// direction. A ray that meets
-/// a solid's loop more than once from its start (radial) is refused: the
-/// wall there folds back across the ray.
+/// direction. Where a ray from the centre (radial) meets a loop more than
+/// once, the wall folds back across it: a fold no wider than `fold_mm`
+/// along the wall (a crease a bead cannot follow) is read at its
+/// outermost crossing, the outside; a wider one is refused.
 pub(super) fn offsets(
     psi: &[[f64; 2]],
     zs: &[f64],
     loops: &[Vec<Vec<[f64; 2]>>],
     offset: Offset,
+    fold_mm: f64,
 ) -> std::result::Result<Offsets, String> {
     let n = psi.len();
     let rays: Vec<([f64; 2], [f64; 2], f64)> = (0..n)
@@ -215,6 +218,7 @@ pub(super) fn offsets(
         })
         .collect();
     let mut d = Vec::with_capacity(loops.len());
+    let mut folds = (0usize, None::<(f64, [f64; 3])>);
     for (k, sec) in loops.iter().enumerate() {
         // One loop a section: the bead's centre line (docs/MESHES.md,
         // "The outside is the pot").
@@ -222,38 +226,142 @@ pub(super) fn offsets(
             return Err(format!("it has nothing at z = {:.1} mm", zs[k]));
         };
         let mut row = Vec::with_capacity(n);
-        for &(o, dir, base) in &rays {
-            let ts = hits(l, o, dir);
-            let t = match offset {
-                Offset::Radial => {
-                    let ahead: Vec<f64> = ts.into_iter().filter(|&t| t > 0.0).collect();
-                    if ahead.len() != 1 {
-                        return Err(format!(
-                            "its wall at z = {:.1} mm does not go once round its foot's centre (a ray from the centre meets it {} times, near ({:.1}, {:.1}) mm)",
-                            zs[k],
-                            ahead.len(),
-                            dir[0] * base,
-                            dir[1] * base
-                        ));
-                    }
-                    ahead[0]
+        match offset {
+            Offset::Radial => {
+                let ahead: Vec<Vec<f64>> = rays
+                    .iter()
+                    .map(|&(o, dir, _)| hits(l, o, dir).into_iter().filter(|&t| t > 0.0).collect())
+                    .collect();
+                let refuse = |j: usize| {
+                    let (_, dir, base) = rays[j];
+                    format!(
+                        "its wall at z = {:.1} mm does not go once round its foot's centre (a ray from the centre meets it {} times, near ({:.1}, {:.1}) mm)",
+                        zs[k],
+                        ahead[j].len(),
+                        dir[0] * base,
+                        dir[1] * base
+                    )
+                };
+                // Each run of rays that meet the wall more than once: a
+                // fold as wide as the run and a ray's spacing either side.
+                let bad: Vec<bool> = ahead.iter().map(|a| a.len() != 1).collect();
+                if bad.iter().all(|&b| b) {
+                    return Err(refuse(0));
                 }
-                Offset::Normal => match ts
-                    .into_iter()
-                    .min_by(|a, b| a.abs().total_cmp(&b.abs()))
-                {
-                    Some(t) => t,
-                    None => {
-                        return Err(format!(
-                            "its wall at z = {:.1} mm is not across the foot's wall near ({:.1}, {:.1}) mm (it leans out beyond where the foot reaches)",
-                            zs[k], o[0], o[1]
-                        ))
+                let start = (0..n).find(|&j| !bad[j]).unwrap_or(0);
+                let mut j = 0;
+                while j < n {
+                    let a = (start + j) % n;
+                    if !bad[a] {
+                        j += 1;
+                        continue;
                     }
-                },
-            };
-            row.push(t - base);
+                    let mut len = 0;
+                    while len < n && bad[(a + len) % n] {
+                        len += 1;
+                    }
+                    let run: Vec<usize> = (0..len).map(|i| (a + i) % n).collect();
+                    if run.iter().any(|&i| ahead[i].is_empty()) {
+                        return Err(refuse(run[0]));
+                    }
+                    let r = run
+                        .iter()
+                        .map(|&i| ahead[i].iter().cloned().fold(0.0, f64::max))
+                        .fold(0.0, f64::max);
+                    let wide = (len + 1) as f64 * std::f64::consts::TAU * r / n as f64;
+                    if wide > fold_mm {
+                        return Err(refuse(run[0]));
+                    }
+                    folds.0 += len;
+                    if folds.1.is_none_or(|(w, _)| wide > w) {
+                        let (_, dir, _) = rays[run[0]];
+                        folds.1 = Some((wide, [dir[0] * r, dir[1] * r, zs[k]]));
+                    }
+                    j += len;
+                }
+                for (j, a) in ahead.iter().enumerate() {
+                    let t = a.iter().cloned().fold(f64::MIN, f64::max);
+                    row.push(t - rays[j].2);
+                }
+            }
+            Offset::Normal => {
+                for &(o, dir, base) in &rays {
+                    let t = match hits(l, o, dir).into_iter().min_by(|a, b| a.abs().total_cmp(&b.abs())) {
+                        Some(t) => t,
+                        None => {
+                            return Err(format!(
+                                "its wall at z = {:.1} mm is not across the foot's wall near ({:.1}, {:.1}) mm (it leans out beyond where the foot reaches)",
+                                zs[k], o[0], o[1]
+                            ))
+                        }
+                    };
+                    row.push(t - base);
+                }
+            }
         }
         d.push(row);
     }
-    Ok((d, rays.iter().map(|r| r.1).collect()))
+    Ok((
+        d,
+        rays.iter().map(|r| r.1).collect(),
+        (folds.0, folds.1.map(|f| f.1)),
+    ))
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    /// A circle of radius 40 whose wall folds back across the rays
+    /// between `from` and `to` degrees: out at 40, back at 38, on again.
+    fn folded(from: f64, to: f64) -> Vec<[f64; 2]> {
+        let at = |deg: f64, r: f64| {
+            let (s, c) = deg.to_radians().sin_cos();
+            [r * c, r * s]
+        };
+        let mut l = vec![
+            at(from - 0.5, 40.0),
+            at(to, 40.0),
+            at(from, 38.0),
+            at(to + 0.5, 38.0),
+        ];
+        let mut deg = (to + 1.5).ceil();
+        while deg < from - 1.0 + 360.0 {
+            l.push(at(deg, 40.0));
+            deg += 1.0;
+        }
+        l
+    }
+
+    fn rays_of_a_circle() -> Vec<[f64; 2]> {
+        (0..RAYS)
+            .map(|j| {
+                let (s, c) = (j as f64 * std::f64::consts::TAU / RAYS as f64).sin_cos();
+                [40.0 * c, 40.0 * s]
+            })
+            .collect()
+    }
+
+    #[test]
+    fn a_fold_narrower_than_the_limit_is_read_at_its_outside_and_a_wide_one_refused() {
+        let psi = rays_of_a_circle();
+        // A fold across the ray at 0°, under a degree wide (0.7 mm).
+        let narrow = vec![vec![folded(-0.4, 0.4)]];
+        let (d, _, folds) = offsets(&psi, &[10.0], &narrow, Offset::Radial, 6.0).unwrap();
+        assert_eq!(folds.0, 1, "one ray across the fold");
+        let at = folds.1.unwrap();
+        assert!(
+            (at[0] - 40.0).abs() < 0.1 && at[1].abs() < 0.1 && at[2] == 10.0,
+            "{at:?}"
+        );
+        // Read at the outside: no offset from Ψ's radius.
+        assert!(d[0][0].abs() < 0.01, "{}", d[0][0]);
+        // Twenty degrees (14 mm along the wall): a real overhang in plan.
+        let wide = vec![vec![folded(-10.0, 10.0)]];
+        let e = offsets(&psi, &[10.0], &wide, Offset::Radial, 6.0).unwrap_err();
+        assert!(
+            e.contains("does not go once round its foot's centre"),
+            "{e}"
+        );
+    }
 }

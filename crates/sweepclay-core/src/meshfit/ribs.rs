@@ -185,6 +185,7 @@ pub(super) fn textured(b: &Candidate, zs: &[f64], height: f64, tol: f64) -> Opti
         let turns = spec.count.unwrap_or(0.0) * u[start];
         spec.phase_deg = phase_deg(spec.phase_deg + 360.0 * turns);
         c.twist = b.twist;
+        c.folds = b.folds;
         c.texture = Some(spec);
         c
     };

@@ -248,7 +248,7 @@ pub(super) fn twisted(psi: &[[f64; 2]], secs: &Sections) -> Option<Candidate> {
         let zs: Vec<f64> = sub.iter().map(|&k| zs[k]).collect();
         let loops: Vec<_> = sub.iter().map(|&k| loops[k].clone()).collect();
         let back = untwisted(&loops, &zs, (turns.turn0(t), t), height);
-        let Ok((d, _)) = offsets(psi, &zs, &back, frame) else {
+        let Ok((d, _, _)) = offsets(psi, &zs, &back, frame, secs.fold) else {
             return f64::INFINITY;
         };
         let (sum, n) = d.iter().fold((0.0, 0usize), |(sum, n), row| {

@@ -263,6 +263,7 @@ pub(super) fn fit_uneven(
         wall_worst
     };
     let cand = Candidate {
+        folds: (0, None),
         offset: Offset::Radial,
         two: true,
         psi,
