@@ -1072,6 +1072,31 @@ struct Frame<'a> {
 /// sections' heights, as B-splines through them, and its largest
 /// difference from `d`.
 fn candidate(g: &Frame, d: &[Vec<f64>], s: &[f64], two: Option<(&[f64], &[f64])>) -> Candidate {
+    // The fewest control points that keep each profile within two
+    // thirds of the tolerance, when the design then holds it; else each
+    // within a third, by as many as that takes (docs/MESHES.md, "Few
+    // control points").
+    let few = candidate_with(g, d, s, two, true);
+    if few.deviation <= g.tol {
+        return few;
+    }
+    let close = candidate_with(g, d, s, two, false);
+    if close.deviation < few.deviation {
+        close
+    } else {
+        few
+    }
+}
+
+/// [`candidate`], its profiles by [`fewest`] within two thirds of the
+/// tolerance first (`few`), or through the values within a third.
+fn candidate_with(
+    g: &Frame,
+    d: &[Vec<f64>],
+    s: &[f64],
+    two: Option<(&[f64], &[f64])>,
+    few: bool,
+) -> Candidate {
     let Frame {
         psi,
         zs,
@@ -1094,7 +1119,10 @@ fn candidate(g: &Frame, d: &[Vec<f64>], s: &[f64], two: Option<(&[f64], &[f64])>
             z += step;
         }
         pts.push([last, height]);
-        profile_through(&pts, tol)
+        match few.then(|| fewest(&pts, 2.0 * tol / 3.0)).flatten() {
+            Some(c) => c,
+            None => profile_through(&pts, tol),
+        }
     };
     let start = profile(s);
     let (end, interp) = match two {
