@@ -1126,7 +1126,20 @@ fn candidate_with(
     };
     let start = profile(s);
     let (end, interp) = match two {
-        Some((t, lambda)) => (profile(t), interpolation_through(lambda)),
+        Some((t, lambda)) => {
+            // λ's error moves the wall by it times the profiles' spread.
+            let spread = s
+                .iter()
+                .zip(t)
+                .map(|(a, b)| (a - b).abs())
+                .fold(0.0, f64::max)
+                .max(1e-9);
+            let interp = few
+                .then(|| interpolation_fewest(lambda, 2.0 * tol / (3.0 * spread)))
+                .flatten()
+                .unwrap_or_else(|| interpolation_through(lambda));
+            (profile(t), interp)
+        }
         None => (Vec::new(), Vec::new()),
     };
     // The fitted offsets, as the design will sample them.

@@ -173,6 +173,35 @@ fn polyline(corners: &[[f64; 2]]) -> Vec<[f64; 2]> {
 /// A corner turning more than this (radians, 30°) is kept sharp.
 const SHARP: f64 = 0.52;
 
+/// An interpolation curve through `lambda` (one value a point of Ψ, from
+/// u = 0) by the fewest control points within `limit` of it ([`fewest`],
+/// u in the part of height), its points held in [0, 1] so the curve is.
+pub(super) fn interpolation_fewest(lambda: &[f64], limit: f64) -> Option<Vec<[f64; 2]>> {
+    let jj = lambda.len();
+    let mut pts: Vec<[f64; 2]> = (0..jj)
+        .map(|j| [lambda[j].clamp(0.0, 1.0), j as f64 / jj as f64])
+        .collect();
+    pts.push([0.0, 1.0]);
+    pts[0] = [0.0, 0.0];
+    let c = fewest(&pts, limit)?;
+    let mut c: Vec<[f64; 2]> = c
+        .into_iter()
+        .map(|p| [p[1], p[0].clamp(0.0, 1.0)])
+        .collect();
+    let last = c.len() - 1;
+    c[0] = [0.0, 0.0];
+    c[last] = [1.0, 0.0];
+    // As the design file takes it: u rising strictly (a corner repeated
+    // three times is not).
+    let spec = crate::design::CurveSpec {
+        control_points: c.clone(),
+        points: None,
+    };
+    crate::curves::Interpolation::new_closed(Some(&spec))
+        .is_ok()
+        .then_some(c)
+}
+
 /// At most `k` of `pts`, evenly chosen, the ends kept.
 pub(super) fn thin(pts: &[[f64; 2]], k: usize) -> Vec<[f64; 2]> {
     if pts.len() <= k {

@@ -220,7 +220,16 @@ pub(super) fn fit_uneven(
     }
     let start = profile_through(&sv, tol);
     let end = profile_through(&tv, tol);
-    let interp = interpolation_through(&lambda);
+    // λ sets the rim's height and blends the profiles: its error moves
+    // either by it times their spread; within a third of the tolerance.
+    let spread = sv
+        .iter()
+        .zip(&tv)
+        .map(|(a, b)| (a[0] - b[0]).abs())
+        .fold(zt_hi - zs_lo, f64::max)
+        .max(1e-9);
+    let interp = interpolation_fewest(&lambda, tol / (3.0 * spread))
+        .unwrap_or_else(|| interpolation_through(&lambda));
     // The design as it will be sampled, against every offset found.
     let (sp, ep) = (dense(&start), dense(&end));
     let lc = BSpline::clamped(interp.clone())
