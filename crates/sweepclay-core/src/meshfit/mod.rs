@@ -5,11 +5,14 @@
 //! D(k, j); and D is fitted by the design's own form — one profile, or two
 //! blended round the loop by an interpolation curve, D ≈ S(z) + λ(u)·(T(z)
 //! − S(z)) (the paper's §3 sweep, eq. 1–2). The fit's profiles and
-//! interpolation are B-splines made to pass through the fitted values,
-//! and the largest difference between the fitted design and the mesh's
-//! sections is measured and reported with where it lies. A section that
-//! splits (a handle, two bodies), a wall a ray meets twice, a mesh with a
-//! hole, or a fit beyond the tolerance is refused by name.
+//! interpolation are B-splines of the fewest control points that hold
+//! the tolerance (least squares, or a polyline's corners), and the
+//! largest difference between the fitted design and the mesh's sections
+//! is measured and reported with where it lies. What no bead prints
+//! (details, drainage holes, a floor's groove, creases, a tilted foot)
+//! is taken in and said; a handle, feet, an opened wall, a wall folding
+//! back wider than a bead, a mesh with a hole, or a fit beyond the
+//! tolerance is refused by name (docs/MESHES.md, "Details").
 //!
 //! The pot is its outside: a solid (one loop a section) and a shell (two
 //! nested loops: a wall with its thickness, as sweepclay's own STL export
