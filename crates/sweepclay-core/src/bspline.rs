@@ -80,6 +80,34 @@ impl BSpline {
         d[p]
     }
 
+    /// The basis functions at `t`, one a control point: the weights that
+    /// [`BSpline::eval`] gives the control points there (they sum to one).
+    /// Curves fitted by least squares solve for the points through them.
+    pub fn basis(&self, t: f64) -> Vec<f64> {
+        let p = self.degree;
+        let n = self.ctrl.len();
+        let t = t.clamp(0.0, 1.0);
+        let k = p + self.knots[p + 1..n].partition_point(|&u| u <= t);
+        // N(k − p..=k) by the triangular recursion (Cox–de Boor).
+        let (mut nb, mut left, mut right) = ([0.0f64; 4], [0.0f64; 4], [0.0f64; 4]);
+        nb[0] = 1.0;
+        for j in 1..=p {
+            left[j] = t - self.knots[k + 1 - j];
+            right[j] = self.knots[k + j] - t;
+            let mut saved = 0.0;
+            for r in 0..j {
+                let den = right[r + 1] + left[j - r];
+                let tmp = if den > 0.0 { nb[r] / den } else { 0.0 };
+                nb[r] = saved + right[r + 1] * tmp;
+                saved = left[j - r] * tmp;
+            }
+            nb[j] = saved;
+        }
+        let mut out = vec![0.0; n];
+        out[k - p..=k].copy_from_slice(&nb[..=p]);
+        out
+    }
+
     /// The curve as a polyline with `per_span` segments per span (at least 1),
     /// from the first to the last control point.
     pub fn flatten(&self, per_span: usize) -> Vec<[f64; 2]> {
@@ -108,6 +136,30 @@ pub fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
 #[cfg(test)]
 mod tests {
     use super::*;
+
+    /// The basis, weighted by control points, is the curve BSpline
+    /// evaluates; and the functions sum to one.
+    #[test]
+    fn the_basis_is_the_curves_own() {
+        let ctrl: Vec<[f64; 2]> = (0..9)
+            .map(|i| [(i as f64).sin() * 3.0, i as f64 * 2.0])
+            .collect();
+        let c = BSpline::clamped(ctrl.clone()).unwrap();
+        for k in 0..=100 {
+            let t = k as f64 / 100.0;
+            let b = c.basis(t);
+            assert!((b.iter().sum::<f64>() - 1.0).abs() < 1e-12, "{t}");
+            let p = b
+                .iter()
+                .zip(&ctrl)
+                .fold([0.0; 2], |a, (w, q)| [a[0] + w * q[0], a[1] + w * q[1]]);
+            let q = c.eval(t);
+            assert!(
+                (p[0] - q[0]).abs() < 1e-9 && (p[1] - q[1]).abs() < 1e-9,
+                "{t}: {p:?} {q:?}"
+            );
+        }
+    }
 
     fn close(a: [f64; 2], b: [f64; 2]) -> bool {
         dist(a, b) < 1e-12

@@ -358,9 +358,7 @@ fn sort_loops(s: &mut sections::Section) -> Inner {
         islands: vec![],
     };
     let area = |l: &[[f64; 2]]| 0.5 * signed_area2(l).abs();
-    let Some(o) =
-        (0..s.loops.len()).max_by(|&a, &b| area(&s.loops[a]).total_cmp(&area(&s.loops[b])))
-    else {
+    let Some(o) = outside(&s.loops) else {
         return inner;
     };
     let depth = |j: usize| {
@@ -395,13 +393,14 @@ fn sort_loops(s: &mut sections::Section) -> Inner {
     inner
 }
 
-/// The runs of consecutive sections (first, last) where `has` holds.
-fn runs_where(has: &[bool]) -> Vec<(usize, usize)> {
+/// The runs of consecutive sections (first, last) that hold some loop
+/// of a kind (`per`, section by section).
+fn runs_where(per: &[Vec<(f64, [f64; 2])>]) -> Vec<(usize, usize)> {
     let mut out: Vec<(usize, usize)> = vec![];
-    for (k, &h) in has.iter().enumerate() {
+    for (k, v) in per.iter().enumerate() {
         match out.last_mut() {
-            Some(r) if h && r.1 + 1 == k => r.1 = k,
-            _ if h => out.push((k, k)),
+            Some(r) if !v.is_empty() && r.1 + 1 == k => r.1 = k,
+            _ if !v.is_empty() => out.push((k, k)),
             _ => {}
         }
     }
@@ -434,12 +433,16 @@ fn largest_in(
 /// [`RIM_LIP_MM`] just above where the cavity starts, a groove round its
 /// edge) are filled and said (docs/MESHES.md, "Details").
 fn one_wall(cut: &mut [sections::Section], dz: f64) -> Result<Option<String>> {
-    let inner: Vec<Inner> = cut.iter_mut().map(sort_loops).collect();
+    // Each kind of loop, section by section.
+    let (mut beside, mut openings, mut islands) = (vec![], vec![], vec![]);
+    for s in cut.iter_mut() {
+        let inner = sort_loops(s);
+        beside.push(inner.beside);
+        openings.push(inner.openings);
+        islands.push(inner.islands);
+    }
     let z = |k: usize| cut[k].z;
-    let beside: Vec<Vec<(f64, [f64; 2])>> = inner.iter().map(|i| i.beside.clone()).collect();
-    if let Some(&(a, b)) =
-        runs_where(&beside.iter().map(|v| !v.is_empty()).collect::<Vec<_>>()).first()
-    {
+    if let Some(&(a, b)) = runs_where(&beside).first() {
         let n = beside[a..=b].iter().map(Vec::len).max().unwrap_or(0);
         let (ar, at) = largest_in(&beside, cut, (a, b));
         let from = if a == 0 {
@@ -466,8 +469,7 @@ fn one_wall(cut: &mut [sections::Section], dz: f64) -> Result<Option<String>> {
         ));
     }
     let mut notes = vec![];
-    let openings: Vec<Vec<(f64, [f64; 2])>> = inner.iter().map(|i| i.openings.clone()).collect();
-    let runs = runs_where(&openings.iter().map(|v| !v.is_empty()).collect::<Vec<_>>());
+    let runs = runs_where(&openings);
     if let (Some(&(a, _)), Some(&(_, b))) = (runs.first(), runs.last()) {
         let n = openings[a..=b].iter().map(Vec::len).max().unwrap_or(0);
         let (ar, at) = largest_in(&openings, cut, (a, b));
@@ -480,10 +482,9 @@ fn one_wall(cut: &mut [sections::Section], dz: f64) -> Result<Option<String>> {
             at[2]
         ));
     }
-    let islands: Vec<Vec<(f64, [f64; 2])>> = inner.iter().map(|i| i.islands.clone()).collect();
     // Where the cavity starts: the floor's top.
     let floor_top = cut.iter().position(|s| s.loops.len() == 2);
-    for (a, b) in runs_where(&islands.iter().map(|v| !v.is_empty()).collect::<Vec<_>>()) {
+    for (a, b) in runs_where(&islands) {
         let (ar, at) = largest_in(&islands, cut, (a, b));
         let rise = z(b) - z(a) + dz;
         let on_floor = floor_top.is_some_and(|f| z(a) - z(f) <= RIM_LIP_MM);
@@ -519,26 +520,20 @@ fn one_wall(cut: &mut [sections::Section], dz: f64) -> Result<Option<String>> {
 /// radius (a foot that grows round its centre, a bowl's rounded bottom
 /// or a chamfer, is left as it is). `None` for a level foot.
 fn tilted_foot(cut: &[sections::Section]) -> Option<usize> {
-    let outside = |s: &sections::Section| {
-        (0..s.loops.len())
-            .max_by(|&a, &b| {
-                signed_area2(&s.loops[a])
-                    .abs()
-                    .total_cmp(&signed_area2(&s.loops[b]).abs())
-            })
-            .map(|i| {
-                (
-                    0.5 * signed_area2(&s.loops[i]).abs(),
-                    centroid(&s.loops[i]),
-                    s.up[i].iter().any(|&u| u),
-                )
-            })
+    let read = |s: &sections::Section| {
+        outside(&s.loops).map(|i| {
+            (
+                0.5 * signed_area2(&s.loops[i]).abs(),
+                centroid(&s.loops[i]),
+                s.up[i].iter().any(|&u| u),
+            )
+        })
     };
     let k = cut
         .iter()
         .take_while(|s| s.z <= RIM_LIP_MM)
-        .position(|s| outside(s).is_some_and(|(_, _, under)| !under))?;
-    let ((a0, c0, _), (ak, ck, _)) = (outside(&cut[0])?, outside(&cut[k])?);
+        .position(|s| read(s).is_some_and(|(_, _, under)| !under))?;
+    let ((a0, c0, _), (ak, ck, _)) = (read(&cut[0])?, read(&cut[k])?);
     let radius = (ak / std::f64::consts::PI).sqrt();
     (k > 0 && a0 < 0.5 * ak && (c0[0] - ck[0]).hypot(c0[1] - ck[1]) > 0.25 * radius).then_some(k)
 }
@@ -705,31 +700,18 @@ fn fit_with(mesh: &TriMesh, opts: &FitOptions, absorbed: &mut Option<String>) ->
         }
         cut.truncate(whole);
     }
-    // Each section's wall: its one loop, or two nested (a shell).
-    let mut shell = false;
-    for s in &cut {
-        match s.loops.len() {
-            0 => {
-                return Err(Error::invalid(
-                    "mesh",
-                    format!("has nothing at z = {:.1} mm: a vessel's wall runs from its foot to its rim", s.z),
-                ))
-            }
-            1 => {}
-            2 if nested(&s.loops[0], &s.loops[1]) || nested(&s.loops[1], &s.loops[0]) => {
-                shell = true;
-            }
-            k => {
-                return Err(Error::invalid(
-                    "mesh",
-                    format!(
-                        "splits into {k} parts at z = {:.1} mm (a handle, a knob or two bodies): one loop a height makes a vessel, or two nested for a wall with its thickness",
-                        s.z
-                    ),
-                ))
-            }
-        }
+    // Each section's wall: its outside, and its cavity (a shell) when
+    // `one_wall` kept one.
+    if let Some(s) = cut.iter().find(|s| s.loops.is_empty()) {
+        return Err(Error::invalid(
+            "mesh",
+            format!(
+                "has nothing at z = {:.1} mm: a vessel's wall runs from its foot to its rim",
+                s.z
+            ),
+        ));
     }
+    let shell = cut.iter().any(|s| s.loops.len() == 2);
     // The pot is its outside: the bead's outer edge on it.
     let inside = keep_outside(&mut cut, opts.bead_mm)?;
     let kind = if shell { "shell" } else { "solid" };

@@ -53,12 +53,18 @@ pub(super) fn around(l: &[[f64; 2]], all: &[Vec<[f64; 2]>]) -> bool {
         .all(|o| std::ptr::eq(o.as_slice(), l) || !nested(l, o))
 }
 
+/// Which of a section's loops is its outside: the largest by area.
+pub(super) fn outside(loops: &[Vec<[f64; 2]>]) -> Option<usize> {
+    (0..loops.len()).max_by(|&a, &b| {
+        signed_area2(&loops[a])
+            .abs()
+            .total_cmp(&signed_area2(&loops[b]).abs())
+    })
+}
+
 /// The loop that stands for a section's wall in plan: the outer of two.
 pub(super) fn wall_loop(loops: &[Vec<[f64; 2]>]) -> &[[f64; 2]] {
-    loops
-        .iter()
-        .max_by(|a, b| signed_area2(a).abs().total_cmp(&signed_area2(b).abs()))
-        .expect("a section has a loop")
+    &loops[outside(loops).expect("a section has a loop")]
 }
 
 /// The area centroid of a loop.

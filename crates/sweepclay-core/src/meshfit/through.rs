@@ -307,48 +307,6 @@ fn parameters(pts: &[[f64; 2]], corner: f64) -> Vec<f64> {
     t.iter().map(|x| x / last).collect()
 }
 
-/// The basis functions of the clamped uniform cubic B-spline of `n` ≥ 4
-/// control points at `t` (Cox–de Boor on the knots
-/// [`BSpline::clamped`] uses).
-fn basis(n: usize, t: f64) -> Vec<f64> {
-    const P: usize = 3;
-    let interior = n - P - 1;
-    let knot = |i: usize| -> f64 {
-        if i <= P {
-            0.0
-        } else if i >= n {
-            1.0
-        } else {
-            (i - P) as f64 / (interior + 1) as f64
-        }
-    };
-    let t = t.clamp(0.0, 1.0);
-    // The span k with knot(k) <= t < knot(k + 1), the last one at t = 1.
-    let k = (P..n).rev().find(|&k| knot(k) <= t).unwrap_or(P).min(n - 1);
-    // N(k − P..=k) by the triangular recursion.
-    let mut nb = [0.0f64; P + 1];
-    nb[0] = 1.0;
-    let mut left = [0.0f64; P + 1];
-    let mut right = [0.0f64; P + 1];
-    for j in 1..=P {
-        left[j] = t - knot(k + 1 - j);
-        right[j] = knot(k + j) - t;
-        let mut saved = 0.0;
-        for r in 0..j {
-            let den = right[r + 1] + left[j - r];
-            let tmp = if den.abs() > 0.0 { nb[r] / den } else { 0.0 };
-            nb[r] = saved + right[r + 1] * tmp;
-            saved = left[j - r] * tmp;
-        }
-        nb[j] = saved;
-    }
-    let mut out = vec![0.0; n];
-    for (r, v) in nb.into_iter().enumerate() {
-        out[k - P + r] = v;
-    }
-    out
-}
-
 /// The `n` control points that fit `pts` at parameters `t` in least
 /// squares, the first and last on the ends, with a light pull on the
 /// control polygon's second differences (its fairness).
@@ -356,10 +314,11 @@ fn least_squares(pts: &[[f64; 2]], t: &[f64], n: usize) -> Option<Vec<[f64; 2]>>
     use nalgebra::{DMatrix, DVector};
     let (first, last) = (pts[0], pts[pts.len() - 1]);
     let free = n - 2;
+    let shape = BSpline::clamped(vec![[0.0; 2]; n])?;
     let mut ata = DMatrix::<f64>::zeros(free, free);
     let mut atb = [DVector::<f64>::zeros(free), DVector::<f64>::zeros(free)];
     for (p, &ti) in pts.iter().zip(t) {
-        let b = basis(n, ti);
+        let b = shape.basis(ti);
         let r = [
             p[0] - b[0] * first[0] - b[n - 1] * last[0],
             p[1] - b[0] * first[1] - b[n - 1] * last[1],
@@ -441,30 +400,6 @@ fn reproject(ctrl: &[[f64; 2]], pts: &[[f64; 2]], t: &mut [f64]) {
 #[cfg(test)]
 mod tests {
     use super::*;
-
-    /// The basis, weighted by control points, is the curve BSpline
-    /// evaluates; and the functions sum to one.
-    #[test]
-    fn the_basis_is_the_curves_own() {
-        let ctrl: Vec<[f64; 2]> = (0..9)
-            .map(|i| [(i as f64).sin() * 3.0, i as f64 * 2.0])
-            .collect();
-        let c = BSpline::clamped(ctrl.clone()).unwrap();
-        for k in 0..=100 {
-            let t = k as f64 / 100.0;
-            let b = basis(ctrl.len(), t);
-            assert!((b.iter().sum::<f64>() - 1.0).abs() < 1e-12, "{t}");
-            let p = b
-                .iter()
-                .zip(&ctrl)
-                .fold([0.0; 2], |a, (w, q)| [a[0] + w * q[0], a[1] + w * q[1]]);
-            let q = c.eval(t);
-            assert!(
-                (p[0] - q[0]).abs() < 1e-9 && (p[1] - q[1]).abs() < 1e-9,
-                "{t}: {p:?} {q:?}"
-            );
-        }
-    }
 
     /// A chamfered foot under a straight wall, and a bowl: few points,
     /// within the limit, z rising (issue 56, point 5).
