@@ -76,12 +76,31 @@ pub(crate) fn pick_support(
 /// step (docs/CHECKER.md, "Heights a micrometre apart").
 pub(crate) const SAME_HEIGHT_MM: f64 = 1e-3;
 
+/// Clay at a new bead's own height under its middle: the highest such
+/// bead's top, and its width (a film pressed onto it becomes part of its
+/// top, as wide: docs/CHECKER.md, "Films").
+#[derive(Clone, Copy, Debug)]
+pub(crate) struct Own {
+    pub(crate) z: f64,
+    pub(crate) width: f64,
+}
+
+impl Own {
+    /// The higher of this and `other` (the wider at one height).
+    fn higher(self, other: Option<Own>) -> Own {
+        match other {
+            Some(o) if o.z > self.z || (o.z == self.z && o.width > self.width) => o,
+            _ => self,
+        }
+    }
+}
+
 /// What an earlier bead is to a new one.
 pub(crate) enum Class {
     /// Clay below that may support it.
     Below(Candidate),
-    /// Clay already at its height under its middle.
-    Double(f64),
+    /// Clay already at its height under its middle: its top and width.
+    Double(Own),
     /// Neither: too far, too deep, above it, a step, or behind the nozzle.
     Neither,
 }
@@ -157,10 +176,13 @@ impl Query<'_> {
             // height: no printer steps that finely, and a stack of such
             // beads is then found at its first, not walked whole
             // (docs/CHECKER.md, "Heights a micrometre apart").
-            return Class::Double(if z >= mid[2] - SAME_HEIGHT_MM {
-                mid[2]
-            } else {
-                z
+            return Class::Double(Own {
+                z: if z >= mid[2] - SAME_HEIGHT_MM {
+                    mid[2]
+                } else {
+                    z
+                },
+                width: b.width(),
             });
         }
         Class::Neither
@@ -586,7 +608,7 @@ pub(crate) fn flanked(beads: &Beads, grid: &BeadGrid, q: &Query) -> bool {
 fn laid_twice(beads: &Beads, grid: &BeadGrid, q: &Query) -> bool {
     let (mid, ml) = (q.mid, q.cfg.min_layer_mm);
     let window = (0.5 * q.cfg.width_min, mid[2] - ml, mid[2] + ml);
-    any_near(beads, grid, q, window, |c| matches!(c, Class::Double(_)))
+    any_near(beads, grid, q, window, |c| matches!(c, Class::Double(..)))
 }
 
 /// Whether the full search would find nothing under a bead near the bed
@@ -657,7 +679,7 @@ pub(crate) fn search_support(
     scratch: &mut Scratch,
     q: &Query,
     walk: Walk,
-) -> (Option<Candidate>, Option<f64>) {
+) -> (Option<Candidate>, Option<Own>) {
     let (mid, cfg) = (q.mid, q.cfg);
     let (zlo, zhi) = (mid[2] - cfg.max_gap_mm, mid[2] + cfg.min_layer_mm);
     let Scratch { runs, cands } = scratch;
@@ -685,14 +707,14 @@ pub(crate) fn search_support(
         return search_pruned(beads, blocks, runs, q, wider);
     }
     cands.clear();
-    let mut double: Option<f64> = None;
+    let mut double: Option<Own> = None;
     let covered = std::cell::Cell::new(false);
     let mut classify = |j: u32| match q.classify(&beads[j as usize], j) {
         Class::Below(c) => {
             covered.set(covered.get() || c.covers);
             cands.push(c);
         }
-        Class::Double(z) => double = Some(double.map_or(z, |d: f64| d.max(z))),
+        Class::Double(o) => double = Some(o.higher(double)),
         Class::Neither => {}
     };
     let mut classify_runs = |runs: &[[u32; 2]]| {
@@ -750,7 +772,7 @@ fn search_pruned(
     runs: &mut Vec<[u32; 2]>,
     q: &Query,
     wider: impl FnOnce(&mut Vec<[u32; 2]>),
-) -> (Option<Candidate>, Option<f64>) {
+) -> (Option<Candidate>, Option<Own>) {
     let (mid, cfg) = (q.mid, q.cfg);
     let ml = cfg.min_layer_mm;
     let slack = 1e-6
@@ -841,7 +863,7 @@ impl Nearest<'_> {
         runs: &[[u32; 2]],
         skip: impl Fn(&Bound, f64) -> bool,
         keep: impl Fn(&Candidate) -> bool,
-        mut double: Option<&mut Option<f64>>,
+        mut double: Option<&mut Option<Own>>,
     ) -> Option<Candidate> {
         let (mid, cfg, slack) = (self.q.mid, self.q.cfg, self.slack);
         let ml = cfg.min_layer_mm;
@@ -858,10 +880,10 @@ impl Nearest<'_> {
                             // height (no gap is left), so clay stacked
                             // at one height costs one find, not a walk of
                             // the whole stack.
-                            found.is_none_or(|z| z < mid[2])
+                            found.is_none_or(|o| o.z < mid[2])
                                 && lb < 0.5 * cfg.width_min
                                 && f64::from(b.hi[2]) + slack
-                                    > found.map_or(mid[2] - ml, |z| z.max(mid[2] - ml))
+                                    > found.map_or(mid[2] - ml, |o| o.z.max(mid[2] - ml))
                                 && f64::from(b.lo[2]) - slack < mid[2] + ml
                         })
                 }
@@ -872,9 +894,9 @@ impl Nearest<'_> {
                                 best = Some(c);
                             }
                         }
-                        Class::Double(z) => {
+                        Class::Double(o) => {
                             if let Some(found) = double.as_mut() {
-                                **found = Some(found.map_or(z, |d| d.max(z)));
+                                **found = Some(o.higher(**found));
                             }
                         }
                         Class::Neither => {}

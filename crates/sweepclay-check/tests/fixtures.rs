@@ -1300,6 +1300,12 @@ struct Vase {
     /// At each turn's start: a move this long (mm) at this share of a
     /// bead's clay, or with none (0).
     dip: Option<(f64, f64)>,
+    /// How many 0.4 mm moves at the ramp's start lay only a film (E 0.001
+    /// a move, 0.00–0.04 mm over the loop), as a ramp start written with
+    /// E rounded to 0.001 does.
+    film: usize,
+    /// The E of each film move.
+    film_e: f64,
 }
 
 /// A loop of 4 mm beads on the bed at Z 1.5 (moves 3.1 mm long), then ten turns of a spiral
@@ -1331,6 +1337,18 @@ fn ramp_vase(v: Vase) -> String {
                 (layer, 1.0)
             };
             let mut len = seg;
+            if t == 0 && i == 1 && v.film > 0 {
+                // The film: 0.4 mm moves rising to the first move's
+                // height, E rounded to 0.001.
+                for k in 1..=v.film {
+                    let f = 0.4 * k as f64 / seg;
+                    let (x, y) = (r + 100.0, 100.0 + f * seg);
+                    let z = layer + 0.5 * layer / n as f64 * k as f64 / v.film as f64;
+                    e += v.film_e;
+                    writeln!(g, "G1 X{x:.4} Y{y:.4} Z{z:.3} E{e:.3}").unwrap();
+                }
+                len = seg - 0.4 * v.film as f64;
+            }
             if let (1, Some((dip, share))) = (i, v.dip.filter(|_| t > 0)) {
                 // The dip: the first `dip` mm of the turn's first move.
                 let (x0, y0) = at(std::f64::consts::TAU * (i - 1) as f64 / n as f64);
@@ -1351,6 +1369,8 @@ fn ramp_vase(v: Vase) -> String {
 const SLICED: Vase = Vase {
     ramp_clay: 1.0,
     dip: None,
+    film: 0,
+    film_e: 0.001,
 };
 
 /// A ramp whose clay follows the gap under it lays what that gap holds:
@@ -1386,4 +1406,20 @@ fn a_move_shorter_than_a_bead_is_no_flow_change() {
     assert_eq!(r.extrusion_runs, 1);
     fails_for(&with(2.5, 0.05), "under-extruded", &[]);
     fails_for(&with(3.1, 0.0), "travel", &["extrusion runs"]);
+}
+
+/// A film laid over the loop at a ramp's start (issue 55, class 1) is
+/// part of the loop's top, not the bead the next turn rests on.
+#[test]
+fn a_film_on_a_bead_is_its_top() {
+    for film in [3, 7] {
+        for film_e in [0.001, 0.004, 0.01, 0.02] {
+            let r = verdict(&ramp_vase(Vase {
+                film,
+                film_e,
+                ..SLICED
+            }));
+            assert!(r.printable, "{film} {film_e}: {}", r.render());
+        }
+    }
 }

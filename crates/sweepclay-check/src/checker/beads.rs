@@ -98,6 +98,8 @@ impl Checker<'_> {
         // from `width` (a ramp over the loop below, a film): what the
         // under-extrusion rule reads (docs/CHECKER.md, "Ramps").
         let mut flow_width = f64::NAN;
+        // The least footprint it leaves: a film's, the clay it lies on.
+        let mut footprint = 0.0f64;
         let horizon = s_start - 2.0 * cfg.width_max;
         settle(
             beads,
@@ -186,12 +188,19 @@ impl Checker<'_> {
                 None => search_support(beads, grid, blocks, scratch, &q, *walk),
             };
             *prev_support = support.map(|c| c.id);
-            if let Some(z_own) = own {
+            if let Some(crate::support::Own {
+                z: z_own,
+                width: under,
+            }) = own
+            {
                 // Clay at its own height under its middle: the bead is
                 // pressed onto it. Its clay has the gap above that clay to
                 // spread in, at most twice the widest bead wide.
                 on_clay = true;
                 r.support.on_clay += 1;
+                // A film on a bead is part of that bead's top, as wide
+                // (docs/CHECKER.md, "Films").
+                footprint = under;
                 let gap = (mid[2] - z_own).max(0.0);
                 let room = len * gap * (1.0 + WIDTH_TOLERANCE) * cfg.width_max;
                 // The gap at the bead's two ends, over the clay under its
@@ -433,9 +442,11 @@ impl Checker<'_> {
             m.from,
             m.to,
             if width.is_finite() {
-                width.clamp(0.0, cfg.width_max * (1.0 + WIDTH_TOLERANCE))
+                width
+                    .max(footprint)
+                    .clamp(0.0, cfg.width_max * (1.0 + WIDTH_TOLERANCE))
             } else {
-                cfg.width_min
+                cfg.width_min.max(footprint)
             },
             s,
             step,
