@@ -49,7 +49,9 @@ impl TriMesh {
     /// not merged by distance: an OpenSCAD export's points a micrometre
     /// apart are its own. Then triangles with a repeated vertex (no area,
     /// they join nothing) and second copies of a triangle (exporters
-    /// write some twice) are dropped. Returns how many triangles were.
+    /// write some twice) are dropped, and a triangle with a copy wound
+    /// the other way goes with it (two faces back to back: a sheet of no
+    /// thickness where two bodies of a union touch). Returns how many triangles were.
     pub fn repair(&mut self) -> usize {
         let before = self.triangles.len();
         self.merge(|v| v.map(f64::to_bits));
@@ -59,14 +61,38 @@ impl TriMesh {
             let step = (1e-5 * size).max(f64::MIN_POSITIVE);
             self.merge(|v| v.map(|x| (x / step).round() as i64 as u64));
         }
-        let mut seen = rustc_hash::FxHashSet::default();
-        self.triangles.retain(|t| {
+        // Each triangle's corners in order, and which way round they run.
+        let mut seen: rustc_hash::FxHashMap<[u32; 3], (usize, bool)> =
+            rustc_hash::FxHashMap::default();
+        let mut keep = vec![true; self.triangles.len()];
+        for (i, t) in self.triangles.iter().enumerate() {
             if t[0] == t[1] || t[1] == t[2] || t[0] == t[2] {
-                return false;
+                keep[i] = false;
+                continue;
             }
             let mut k = *t;
             k.sort_unstable();
-            seen.insert(k)
+            // A rotation of the sorted corners keeps the winding.
+            let way = [k, [k[1], k[2], k[0]], [k[2], k[0], k[1]]].contains(t);
+            match seen.entry(k) {
+                std::collections::hash_map::Entry::Vacant(v) => {
+                    v.insert((i, way));
+                }
+                std::collections::hash_map::Entry::Occupied(o) => {
+                    keep[i] = false;
+                    // A copy wound the other way: the two are a sheet of
+                    // no thickness (a union's shared face), and both go.
+                    let (j, first) = *o.get();
+                    if first != way && keep[j] {
+                        keep[j] = false;
+                    }
+                }
+            }
+        }
+        let mut i = 0;
+        self.triangles.retain(|_| {
+            i += 1;
+            keep[i - 1]
         });
         before - self.triangles.len()
     }
@@ -360,6 +386,26 @@ mod tests {
             m.triangles[2] = [4, 3, 2];
         }
         m
+    }
+
+    /// Two tetrahedra joined on a face, each written whole (a union
+    /// exported unmerged): the shared face, twice and wound both ways, is
+    /// no surface; a face written twice the same way is one.
+    #[test]
+    fn a_face_back_to_back_goes_and_a_copy_is_one() {
+        let mut m = tetra(10.0, None);
+        m.vertices.push([10.0, 10.0, 10.0]);
+        // The second body, over face [1, 2, 3] wound the other way.
+        m.triangles
+            .extend([[1, 3, 2], [1, 4, 3], [2, 3, 4], [1, 2, 4]]);
+        assert!(!m.closed());
+        assert_eq!(m.repair(), 2);
+        assert!(m.closed());
+        assert_eq!(m.triangles.len(), 6);
+        let mut m = tetra(10.0, None);
+        m.triangles.push([2, 3, 1]);
+        assert_eq!(m.repair(), 1);
+        assert!(m.closed());
     }
 
     #[test]

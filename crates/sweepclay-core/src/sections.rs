@@ -3,8 +3,10 @@
 //! between two of its edges, and segments sharing an edge are chained
 //! into loops. Edges are named by their vertices' indices, so the chaining
 //! is exact (no tolerance): a loop that cannot close is a hole in the
-//! mesh, an edge with three or more segments a non-manifold one, each
-//! refused naming the height. Linear in the triangles and the segments,
+//! mesh, refused naming the height. An edge with four or six segments
+//! (bodies of a union touching along it) is chained body by body by the
+//! faces' winding; one whose segments do not pair is refused as
+//! non-manifold. Linear in the triangles and the segments,
 //! with the segments capped ([`MAX_SEGMENTS`]) and each section thinned
 //! as it is cut, so memory follows the mesh read, not its facets' height.
 
@@ -38,6 +40,10 @@ struct Seg {
     at: [[f64; 2]; 2],
     /// Its face lies within 26° of level ([`UP`]).
     up: bool,
+    /// Its face's winding runs it from `at[0]` to `at[1]` with the solid
+    /// on its left (an outward normal): how it is paired at an edge four
+    /// faces share.
+    fwd: bool,
 }
 
 /// The most segments one cut computes: the sum over triangles of the
@@ -121,6 +127,12 @@ fn segment(mesh: &TriMesh, t: [u32; 3], z: f64, up: bool) -> Option<Seg> {
     let mut ends = [0u64; 2];
     let mut at = [[0.0; 2]; 2];
     let mut m = 0;
+    let [p0, p1, p2] = t.map(|i| v[i as usize]);
+    // The normal's plan part: the solid lies away from it.
+    let n = [
+        (p1[1] - p0[1]) * (p2[2] - p0[2]) - (p1[2] - p0[2]) * (p2[1] - p0[1]),
+        (p1[2] - p0[2]) * (p2[0] - p0[0]) - (p1[0] - p0[0]) * (p2[2] - p0[2]),
+    ];
     for (a, b) in [(0, 1), (1, 2), (2, 0)] {
         if below[a] != below[b] && m < 2 {
             let (i, j) = (t[a].min(t[b]), t[a].max(t[b]));
@@ -131,7 +143,10 @@ fn segment(mesh: &TriMesh, t: [u32; 3], z: f64, up: bool) -> Option<Seg> {
             m += 1;
         }
     }
-    Some(Seg { ends, at, up })
+    // Along (−n_y, n_x) the solid is on the left.
+    let d = [at[1][0] - at[0][0], at[1][1] - at[0][1]];
+    let fwd = -n[1] * d[0] + n[0] * d[1] >= 0.0;
+    Some(Seg { ends, at, up, fwd })
 }
 
 /// Whether a triangle lies within 26° of level ([`UP`]), either way up: a
@@ -296,6 +311,8 @@ type Loop = (Vec<[f64; 2]>, Vec<bool>);
 /// Chains the segments of one section into closed loops.
 fn chain(segs: &[Seg], z: f64) -> Result<Vec<Loop>> {
     let mut by_edge: FxHashMap<u64, [u32; 2]> = FxHashMap::default();
+    // Edges shared by more than two faces: all their segments.
+    let mut shared: FxHashMap<u64, Vec<u32>> = FxHashMap::default();
     for (s, g) in segs.iter().enumerate() {
         for e in g.ends {
             let slot = by_edge.entry(e).or_insert([u32::MAX; 2]);
@@ -304,12 +321,24 @@ fn chain(segs: &[Seg], z: f64) -> Result<Vec<Loop>> {
             } else if slot[1] == u32::MAX {
                 slot[1] = s as u32;
             } else {
-                return Err(Error::invalid(
-                    "mesh",
-                    format!("an edge at z = {z:.2} mm is shared by three or more faces (a non-manifold mesh): repair it (MeshLab, Blender's 3D-Print toolbox)"),
-                ));
+                shared
+                    .entry(e)
+                    .or_insert_with(|| slot.to_vec())
+                    .push(s as u32);
             }
         }
+    }
+    // Where two bodies touch along an edge (a union exported without
+    // merging), each segment arriving there goes on with the one leaving
+    // nearest clockwise: each body's loop keeps to itself.
+    let mut paired: FxHashMap<(u64, u32), u32> = FxHashMap::default();
+    for (&e, list) in &shared {
+        pair_at_edge(segs, e, list, &mut paired).ok_or_else(|| {
+            Error::invalid(
+                "mesh",
+                format!("an edge at z = {z:.2} mm is shared by {} faces (a non-manifold mesh) that do not pair into closed surfaces: repair it (MeshLab, Blender's 3D-Print toolbox)", list.len()),
+            )
+        })?;
     }
     let mut used = vec![false; segs.len()];
     let mut loops = Vec::new();
@@ -324,7 +353,11 @@ fn chain(segs: &[Seg], z: f64) -> Result<Vec<Loop>> {
         used[start] = true;
         loop {
             let [a, b] = by_edge[&e];
-            let next = if a as usize == s { b } else { a };
+            let next = match paired.get(&(e, s as u32)) {
+                Some(&n) => n,
+                None if a as usize == s => b,
+                None => a,
+            };
             if next == u32::MAX {
                 let p = segs[s].at[1];
                 return Err(Error::invalid(
@@ -366,6 +399,51 @@ fn chain(segs: &[Seg], z: f64) -> Result<Vec<Loop>> {
         }
     }
     Ok(loops)
+}
+
+/// Pairs the segments `list` that meet at edge `e` (more than two):
+/// each arriving one (running into the edge with the solid on its left)
+/// with the leaving one first met turning clockwise from where it came
+/// from, both ways in `paired`. `None` when they do not pair (an odd
+/// count, a face wound against its neighbours).
+fn pair_at_edge(
+    segs: &[Seg],
+    e: u64,
+    list: &[u32],
+    paired: &mut FxHashMap<(u64, u32), u32>,
+) -> Option<()> {
+    // Each segment's far end seen from the edge's crossing.
+    let from_edge = |s: u32| {
+        let g = &segs[s as usize];
+        let (here, far) = if g.ends[0] == e { (0, 1) } else { (1, 0) };
+        let arrives = (here == 1) == g.fwd;
+        (
+            arrives,
+            [g.at[far][0] - g.at[here][0], g.at[far][1] - g.at[here][1]],
+        )
+    };
+    let (arriving, leaving): (Vec<_>, Vec<_>) = list
+        .iter()
+        .map(|&s| (s, from_edge(s)))
+        .partition(|(_, (arrives, _))| *arrives);
+    if arriving.len() != leaving.len() {
+        return None;
+    }
+    let mut taken = vec![false; leaving.len()];
+    for (a, (_, back)) in arriving {
+        let cw = |o: [f64; 2]| {
+            let ccw = (back[0] * o[1] - back[1] * o[0]).atan2(back[0] * o[0] + back[1] * o[1]);
+            (-ccw).rem_euclid(std::f64::consts::TAU)
+        };
+        let k = (0..leaving.len())
+            .filter(|&k| !taken[k])
+            .min_by(|&i, &j| cw(leaving[i].1 .1).total_cmp(&cw(leaving[j].1 .1)))?;
+        taken[k] = true;
+        let l = leaving[k].0;
+        paired.insert((e, a), l);
+        paired.insert((e, l), a);
+    }
+    Some(())
 }
 
 /// Twice the signed area of a loop (positive counter-clockwise).
@@ -426,6 +504,36 @@ mod tests {
         // side faces' top edges only and still closes.
         let top = cut(&cube(10.0, 20.0), 20.0, 1.0, 1, 0.0).unwrap();
         assert!(top[0].loops.len() <= 1);
+    }
+
+    /// Two boxes touching along an edge (a union exported unmerged): the
+    /// edge is shared by four faces, and each box's loop keeps to itself.
+    #[test]
+    fn boxes_touching_along_an_edge_cut_into_two_loops() {
+        let mut m = cube(10.0, 20.0);
+        let b = cube(10.0, 20.0);
+        let n = m.vertices.len() as u32;
+        m.vertices
+            .extend(b.vertices.iter().map(|v| [v[0] + 10.0, v[1] + 10.0, v[2]]));
+        m.triangles
+            .extend(b.triangles.iter().map(|t| t.map(|i| i + n)));
+        m.repair();
+        let s = cut(&m, 0.5, 1.0, 19, 0.0).unwrap();
+        for sec in &s {
+            assert_eq!(sec.loops.len(), 2, "at {}", sec.z);
+            for l in &sec.loops {
+                assert!((signed_area2(l).abs() - 200.0).abs() < 1e-9, "{l:?}");
+            }
+        }
+        // Wound against its neighbours, the fourth face does not pair.
+        let flipped = m
+            .triangles
+            .iter()
+            .position(|t| t.contains(&3) && t.contains(&7))
+            .unwrap();
+        m.triangles[flipped].swap(0, 1);
+        let e = cut(&m, 0.5, 1.0, 19, 0.0).unwrap_err().to_string();
+        assert!(e.contains("non-manifold"), "{e}");
     }
 
     #[test]
