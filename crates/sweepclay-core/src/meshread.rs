@@ -83,17 +83,14 @@ impl TriMesh {
                     // A copy wound the other way: the two are a sheet of
                     // no thickness (a union's shared face), and both go.
                     let (j, first) = *o.get();
-                    if first != way && keep[j] {
+                    if first != way {
                         keep[j] = false;
                     }
                 }
             }
         }
-        let mut i = 0;
-        self.triangles.retain(|_| {
-            i += 1;
-            keep[i - 1]
-        });
+        let mut kept = keep.into_iter();
+        self.triangles.retain(|_| kept.next().unwrap_or(false));
         before - self.triangles.len()
     }
 

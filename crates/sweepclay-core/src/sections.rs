@@ -40,10 +40,9 @@ struct Seg {
     at: [[f64; 2]; 2],
     /// Its face lies within 26° of level ([`UP`]).
     up: bool,
-    /// Its face's winding runs it from `at[0]` to `at[1]` with the solid
-    /// on its left (an outward normal): how it is paired at an edge four
-    /// faces share.
-    fwd: bool,
+    /// Its triangle: where four faces share an edge, its winding tells
+    /// which way the segment runs ([`runs_forward`]).
+    tri: u32,
 }
 
 /// The most segments one cut computes: the sum over triangles of the
@@ -118,8 +117,9 @@ pub fn sections_within(
 }
 
 /// The segment a triangle `t` cuts at height `z`, if it crosses it.
-fn segment(mesh: &TriMesh, t: [u32; 3], z: f64, up: bool) -> Option<Seg> {
+fn segment(mesh: &TriMesh, tri: u32, z: f64, up: bool) -> Option<Seg> {
     let v = &mesh.vertices;
+    let t = mesh.triangles[tri as usize];
     let below = t.map(|i| v[i as usize][2] < z);
     if below.iter().all(|&b| b) || below.iter().all(|&b| !b) {
         return None;
@@ -127,12 +127,6 @@ fn segment(mesh: &TriMesh, t: [u32; 3], z: f64, up: bool) -> Option<Seg> {
     let mut ends = [0u64; 2];
     let mut at = [[0.0; 2]; 2];
     let mut m = 0;
-    let [p0, p1, p2] = t.map(|i| v[i as usize]);
-    // The normal's plan part: the solid lies away from it.
-    let n = [
-        (p1[1] - p0[1]) * (p2[2] - p0[2]) - (p1[2] - p0[2]) * (p2[1] - p0[1]),
-        (p1[2] - p0[2]) * (p2[0] - p0[0]) - (p1[0] - p0[0]) * (p2[2] - p0[2]),
-    ];
     for (a, b) in [(0, 1), (1, 2), (2, 0)] {
         if below[a] != below[b] && m < 2 {
             let (i, j) = (t[a].min(t[b]), t[a].max(t[b]));
@@ -143,27 +137,39 @@ fn segment(mesh: &TriMesh, t: [u32; 3], z: f64, up: bool) -> Option<Seg> {
             m += 1;
         }
     }
-    // Along (−n_y, n_x) the solid is on the left.
-    let d = [at[1][0] - at[0][0], at[1][1] - at[0][1]];
-    let fwd = -n[1] * d[0] + n[0] * d[1] >= 0.0;
-    Some(Seg { ends, at, up, fwd })
+    Some(Seg { ends, at, up, tri })
+}
+
+/// Whether `g`'s face's winding runs it from `at[0]` to `at[1]` with the
+/// solid on its left (an outward normal). Asked only at an edge more
+/// than two faces share, so the cut's every segment does not pay for it.
+fn runs_forward(mesh: &TriMesh, g: &Seg) -> bool {
+    // The solid lies away from the normal: along (−n_y, n_x), on the left.
+    let n = normal(mesh, mesh.triangles[g.tri as usize]);
+    let d = [g.at[1][0] - g.at[0][0], g.at[1][1] - g.at[0][1]];
+    -n[1] * d[0] + n[0] * d[1] >= 0.0
 }
 
 /// Whether a triangle lies within 26° of level ([`UP`]), either way up: a
 /// mesh whose faces are flipped (or wound inside out) has its cap facing
 /// down.
 fn level(mesh: &TriMesh, t: [u32; 3]) -> bool {
+    let n = normal(mesh, t);
+    n[2].abs() > UP * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt()
+}
+
+/// A triangle's normal by its winding (not of unit length).
+fn normal(mesh: &TriMesh, t: [u32; 3]) -> [f64; 3] {
     let [a, b, c] = t.map(|i| mesh.vertices[i as usize]);
     let (e, f) = (
         [b[0] - a[0], b[1] - a[1], b[2] - a[2]],
         [c[0] - a[0], c[1] - a[1], c[2] - a[2]],
     );
-    let n = [
+    [
         e[1] * f[2] - e[2] * f[1],
         e[2] * f[0] - e[0] * f[2],
         e[0] * f[1] - e[1] * f[0],
-    ];
-    n[2].abs() > UP * (n[0] * n[0] + n[1] * n[1] + n[2] * n[2]).sqrt()
+    ]
 }
 
 /// Cuts `mesh` at `n` heights `z0`, `z0 + dz`, …. A vertex exactly at a
@@ -220,13 +226,9 @@ pub fn cut(mesh: &TriMesh, z0: f64, dz: f64, n: usize, bed: f64) -> Result<Vec<S
         }
         let z = z0 + k as f64 * dz;
         segs.clear();
-        segs.extend(
-            active
-                .iter()
-                .filter_map(|&(i, up)| segment(mesh, mesh.triangles[i as usize], z, up)),
-        );
+        segs.extend(active.iter().filter_map(|&(i, up)| segment(mesh, i, z, up)));
         let zb = z - bed;
-        let (loops, up) = chain(&segs, zb)?
+        let (loops, up) = chain(mesh, &segs, zb)?
             .into_iter()
             .map(|(p, u)| thin(p, u, SIMPLIFY_MM))
             .unzip();
@@ -309,7 +311,7 @@ fn thin(pts: Vec<[f64; 2]>, up: Vec<bool>, eps: f64) -> Loop {
 type Loop = (Vec<[f64; 2]>, Vec<bool>);
 
 /// Chains the segments of one section into closed loops.
-fn chain(segs: &[Seg], z: f64) -> Result<Vec<Loop>> {
+fn chain(mesh: &TriMesh, segs: &[Seg], z: f64) -> Result<Vec<Loop>> {
     let mut by_edge: FxHashMap<u64, [u32; 2]> = FxHashMap::default();
     // Edges shared by more than two faces: all their segments.
     let mut shared: FxHashMap<u64, Vec<u32>> = FxHashMap::default();
@@ -333,7 +335,7 @@ fn chain(segs: &[Seg], z: f64) -> Result<Vec<Loop>> {
     // nearest clockwise: each body's loop keeps to itself.
     let mut paired: FxHashMap<(u64, u32), u32> = FxHashMap::default();
     for (&e, list) in &shared {
-        pair_at_edge(segs, e, list, &mut paired).ok_or_else(|| {
+        pair_at_edge(mesh, segs, e, list, &mut paired).ok_or_else(|| {
             Error::invalid(
                 "mesh",
                 format!("an edge at z = {z:.2} mm is shared by {} faces (a non-manifold mesh) that do not pair into closed surfaces: repair it (MeshLab, Blender's 3D-Print toolbox)", list.len()),
@@ -407,6 +409,7 @@ fn chain(segs: &[Seg], z: f64) -> Result<Vec<Loop>> {
 /// from, both ways in `paired`. `None` when they do not pair (an odd
 /// count, a face wound against its neighbours).
 fn pair_at_edge(
+    mesh: &TriMesh,
     segs: &[Seg],
     e: u64,
     list: &[u32],
@@ -416,7 +419,7 @@ fn pair_at_edge(
     let from_edge = |s: u32| {
         let g = &segs[s as usize];
         let (here, far) = if g.ends[0] == e { (0, 1) } else { (1, 0) };
-        let arrives = (here == 1) == g.fwd;
+        let arrives = (here == 1) == runs_forward(mesh, g);
         (
             arrives,
             [g.at[far][0] - g.at[here][0], g.at[far][1] - g.at[here][1]],
