@@ -29,6 +29,11 @@ pub struct SendArgs {
     /// printer's `host`).
     #[arg(long, value_name = "URL")]
     host: Option<String>,
+    /// An `https://` host's own certificate to accept, by its SHA-256
+    /// fingerprint (as the refusal names it) [default: the printer's
+    /// `host.cert_sha256`; none: this computer's trusted roots].
+    #[arg(long, value_name = "SHA256")]
+    cert_sha256: Option<String>,
     /// The print host's kind with --host: octoprint, moonraker or reprap.
     #[arg(long, value_name = "KIND")]
     kind: Option<String>,
@@ -51,15 +56,16 @@ pub struct SendArgs {
     save_key: bool,
 }
 
-/// The host's kind and address, from the flags or the printer profile.
-fn host_of(a: &SendArgs) -> Result<(Kind, String)> {
+/// The host's kind, address and accepted certificate, from the flags or
+/// the printer profile.
+fn host_of(a: &SendArgs) -> Result<(Kind, String, Option<String>)> {
     if let Some(url) = &a.host {
         let kind = a.kind.as_deref().context(
             "--host: also say which host it is with --kind octoprint, --kind moonraker or --kind reprap",
         )?;
         let kind = Kind::from_name(kind)
             .with_context(|| format!("--kind: `{kind}` is none of octoprint, moonraker, reprap"))?;
-        return Ok((kind, url.clone()));
+        return Ok((kind, url.clone(), a.cert_sha256.clone()));
     }
     if a.kind.is_some() {
         bail!("--kind goes with --host URL");
@@ -73,11 +79,11 @@ fn host_of(a: &SendArgs) -> Result<(Kind, String)> {
     })?;
     let kind =
         Kind::from_name(h.kind.name()).context("a print host kind the link does not know")?;
-    Ok((kind, h.url))
+    Ok((kind, h.url, a.cert_sha256.clone().or(h.cert_sha256)))
 }
 
 pub fn run(a: SendArgs) -> Result<i32> {
-    let (kind, url) = host_of(&a)?;
+    let (kind, url, cert) = host_of(&a)?;
     sweepclay_link::check_url(&url).map_err(|e| anyhow::anyhow!("{e}"))?;
     let keys_file = keys::default_path();
     if a.save_key {
@@ -118,7 +124,8 @@ pub fn run(a: SendArgs) -> Result<i32> {
     }
 
     let name = a.name.clone().unwrap_or_else(|| file_name(&a.file));
-    let link = Link::new(kind, &url, secret).map_err(|e| anyhow::anyhow!("{e}"))?;
+    let link = Link::with_certificate(kind, &url, secret, cert.as_deref())
+        .map_err(|e| anyhow::anyhow!("{e}"))?;
     let rt = tokio::runtime::Builder::new_current_thread()
         .enable_all()
         .build()
@@ -146,6 +153,12 @@ pub fn run(a: SendArgs) -> Result<i32> {
         Ok::<i32, anyhow::Error>(0)
     })
     .map_err(|e| match e.downcast::<sweepclay_link::LinkError>() {
+        Ok(le @ sweepclay_link::LinkError::Certificate { .. }) => {
+            let sweepclay_link::LinkError::Certificate { sha256, .. } = &le else {
+                unreachable!()
+            };
+            anyhow::anyhow!("{le}: send again with --cert-sha256 {sha256}, or put \"cert_sha256\": \"{sha256}\" in the printer's host")
+        }
         Ok(le) => anyhow::anyhow!("{le}"),
         Err(e) => e,
     })

@@ -102,26 +102,45 @@ impl HostKind {
     }
 }
 
-/// A print host: its kind and its plain `http://` address on the studio's
-/// network, e.g. `{"kind": "octoprint", "url": "http://octopi.local"}`.
+/// A print host: its kind and its `http://` or `https://` address on the
+/// studio's network, e.g. `{"kind": "octoprint", "url":
+/// "http://octopi.local"}`; for an `https://` host with its own
+/// (self-signed) certificate, that certificate's SHA-256 fingerprint.
 #[derive(Clone, Debug, PartialEq, Serialize, Deserialize)]
 #[serde(deny_unknown_fields)]
 pub struct PrintHost {
     /// The host software.
     pub kind: HostKind,
-    /// Its address: `http://` a host name or IP address, an optional port
-    /// and path; no user name or password in it.
+    /// Its address: `http://` or `https://`, a host name or IP address, an
+    /// optional port and path; no user name or password in it.
     pub url: String,
+    /// The SHA-256 fingerprint of the certificate accepted for an
+    /// `https://` host (64 hex digits): its own, which this computer's
+    /// roots do not vouch for. Public, unlike the key.
+    #[serde(default, skip_serializing_if = "Option::is_none")]
+    pub cert_sha256: Option<String>,
 }
 
 impl PrintHost {
     /// Checks the address's form; `key` names the field in messages.
     pub fn validate(&self, key: &str) -> Result<()> {
-        let why = if !self.url.starts_with("http://") {
-            Some("must start with http:// (e.g. http://octopi.local); printers on the studio's network speak plain HTTP")
-        } else if self.url["http://".len()..]
-            .split('/')
-            .next()
+        let rest = self
+            .url
+            .strip_prefix("http://")
+            .or_else(|| self.url.strip_prefix("https://"));
+        if let Some(fp) = &self.cert_sha256 {
+            let hex: String = fp.chars().filter(|c| !matches!(c, ':' | ' ')).collect();
+            if hex.len() != 64 || !hex.chars().all(|c| c.is_ascii_hexdigit()) {
+                return Err(Error::invalid(
+                    format!("{key}.cert_sha256"),
+                    "a certificate's SHA-256 fingerprint is 64 hex digits, e.g. AB:CD:…",
+                ));
+            }
+        }
+        let why = if rest.is_none() {
+            Some("must start with http:// or https:// (e.g. http://octopi.local)")
+        } else if rest
+            .and_then(|r| r.split('/').next())
             .is_none_or(str::is_empty)
         {
             Some("has no host name after http://")
@@ -731,5 +750,35 @@ mod tests {
             ..Printer::default()
         };
         assert!(p.validate("printer").is_ok());
+    }
+
+    #[test]
+    fn a_host_is_http_or_https_and_its_certificate_a_sha256() {
+        let host = |url: &str, cert: Option<&str>| PrintHost {
+            kind: HostKind::Octoprint,
+            url: url.into(),
+            cert_sha256: cert.map(str::to_string),
+        };
+        let fp = ["3F"; 32].join(":");
+        assert!(host("http://octopi.local", None).validate("h").is_ok());
+        assert!(host("https://octopi.local", Some(&fp))
+            .validate("h")
+            .is_ok());
+        let e = host("ftp://octopi.local", None)
+            .validate("h")
+            .unwrap_err()
+            .to_string();
+        assert!(e.starts_with("h.url") && e.contains("https://"), "{e}");
+        let e = host("https://octopi.local", Some("3F:A0"))
+            .validate("h")
+            .unwrap_err()
+            .to_string();
+        assert!(
+            e.starts_with("h.cert_sha256") && e.contains("64 hex"),
+            "{e}"
+        );
+        // Written only when there is one: older profiles read unchanged.
+        let j = serde_json::to_string(&host("http://octopi.local", None)).unwrap();
+        assert!(!j.contains("cert_sha256"), "{j}");
     }
 }

@@ -18,6 +18,7 @@ pub mod keys;
 mod moonraker;
 mod octoprint;
 mod reprap;
+pub mod tls;
 
 use serde::Serialize;
 use std::fmt;
@@ -142,6 +143,19 @@ pub enum LinkError {
         /// Where it pointed, without any query (which may carry a secret).
         to: String,
     },
+    /// An `https://` host showed a certificate this computer does not
+    /// trust, or not the one accepted for it (docs/PRINTING.md, "https").
+    #[error("{host} at {url} showed a certificate {why}. Its SHA-256 fingerprint is {sha256}: if that is your printer's (its settings page or `openssl x509 -fingerprint -sha256` on it shows the same), accept it as the printer's certificate")]
+    Certificate {
+        /// The host's name in messages.
+        host: &'static str,
+        /// Its address.
+        url: String,
+        /// What was wrong with it.
+        why: String,
+        /// The fingerprint of the certificate the host showed.
+        sha256: String,
+    },
     /// An answer that is not the host's API (another program on the port).
     #[error("{host} at {url} answered something that is not its API ({why}): is the kind right?")]
     BadAnswer {
@@ -217,6 +231,10 @@ pub struct Link {
     base: reqwest::Url,
     secret: Option<String>,
     http: reqwest::Client,
+    /// The certificate accepted for an `https://` host, if one was.
+    pin: Option<String>,
+    /// The fingerprint the last TLS handshake was shown.
+    seen: Option<std::sync::Arc<std::sync::Mutex<Option<String>>>>,
 }
 
 impl fmt::Debug for Link {
@@ -235,8 +253,9 @@ pub fn normalize_url(url: &str) -> String {
     url.trim().trim_end_matches('/').to_string()
 }
 
-/// Checks a print host address: plain `http://` with a host name or IP
-/// address and optionally a port and path, no user name or password in it.
+/// Checks a print host address: `http://` or `https://` with a host name
+/// or IP address and optionally a port and path, no user name or password
+/// in it.
 pub fn check_url(url: &str) -> Result<reqwest::Url, LinkError> {
     let bad = |why: &str| LinkError::Address {
         url: url.to_string(),
@@ -248,9 +267,12 @@ pub fn check_url(url: &str) -> Result<reqwest::Url, LinkError> {
         ))
     })?;
     match u.scheme() {
-        "http" => {}
-        "https" => return Err(bad("sweepclay talks plain http:// to printers on the studio's network; use the host's http:// address")),
-        s => return Err(bad(&format!("`{s}:` is no web address; write it as http://octopi.local"))),
+        "http" | "https" => {}
+        s => {
+            return Err(bad(&format!(
+                "`{s}:` is no web address; write it as http://octopi.local"
+            )))
+        }
     }
     if u.host_str().is_none_or(str::is_empty) {
         return Err(bad("no host name"));
@@ -268,29 +290,56 @@ pub fn check_url(url: &str) -> Result<reqwest::Url, LinkError> {
 
 impl Link {
     /// A link to the host at `url` with its API key or password, if it
-    /// needs one.
+    /// needs one; an `https://` host's certificate must be one this
+    /// computer trusts.
     pub fn new(kind: Kind, url: &str, secret: Option<String>) -> Result<Link, LinkError> {
+        Link::with_certificate(kind, url, secret, None)
+    }
+
+    /// A link as [`Link::new`], accepting for an `https://` host the
+    /// certificate whose SHA-256 fingerprint is `cert_sha256` (a printer's
+    /// own self-signed one) and no other.
+    pub fn with_certificate(
+        kind: Kind,
+        url: &str,
+        secret: Option<String>,
+        cert_sha256: Option<&str>,
+    ) -> Result<Link, LinkError> {
         let mut base = check_url(url)?;
         if !base.path().ends_with('/') {
             base.set_path(&format!("{}/", base.path()));
         }
-        let http = reqwest::Client::builder()
+        let bad = |why: String| LinkError::Address {
+            url: url.to_string(),
+            why,
+        };
+        let pin = cert_sha256
+            .filter(|s| !s.trim().is_empty())
+            .map(tls::parse_fingerprint)
+            .transpose()
+            .map_err(bad)?;
+        tls::install_provider();
+        let mut builder = reqwest::Client::builder()
             .connect_timeout(CONNECT)
             // Printers sit on the local network: no system proxy.
             .no_proxy()
             // A redirect would carry the key (a header, or a Duet's
             // password in the query) to wherever it points: follow none.
-            .redirect(reqwest::redirect::Policy::none())
-            .build()
-            .map_err(|e| LinkError::Address {
-                url: url.to_string(),
-                why: e.to_string(),
-            })?;
+            .redirect(reqwest::redirect::Policy::none());
+        let mut seen = None;
+        if base.scheme() == "https" {
+            let t = tls::host_tls(pin.clone()).map_err(bad)?;
+            seen = Some(t.seen);
+            builder = builder.tls_backend_preconfigured(t.config);
+        }
+        let http = builder.build().map_err(|e| bad(e.to_string()))?;
         Ok(Link {
             kind,
             base,
             secret: secret.filter(|s| !s.is_empty()),
             http,
+            pin,
+            seen,
         })
     }
 
@@ -370,6 +419,9 @@ impl Link {
         // The timeout runs until the answer's body is read, so a host that
         // trickles an endless answer is cut off too.
         let resp = req.timeout(timeout).send().await.map_err(|e| {
+            if let Some(c) = self.certificate_error(&e) {
+                return c;
+            }
             let why = if e.is_timeout() {
                 format!("no answer within {} s", timeout.as_secs())
             } else if e.is_connect() {
@@ -399,6 +451,33 @@ impl Link {
             });
         }
         Ok(resp)
+    }
+
+    /// A failed request as a certificate refusal, when the handshake was
+    /// shown a certificate and refused it.
+    fn certificate_error(&self, e: &reqwest::Error) -> Option<LinkError> {
+        let seen = self.seen.as_ref()?.lock().ok()?.clone()?;
+        // A refused certificate fails the connection before any answer.
+        if !e.is_connect() && !e.is_request() {
+            return None;
+        }
+        let refused = match &self.pin {
+            Some(pin) if *pin == seen => return None,
+            Some(pin) => format!("other than the one accepted for it ({pin}): it may have been renewed, or another machine answers in its place"),
+            None => {
+                let text = format!("{e:?}");
+                if !(text.contains("Certificate") || text.contains("certificate")) {
+                    return None;
+                }
+                "this computer does not trust (a self-signed one, as a printer's usually is)".to_string()
+            }
+        };
+        Some(LinkError::Certificate {
+            host: self.kind.title(),
+            url: self.url(),
+            why: refused,
+            sha256: seen,
+        })
     }
 
     /// At most `cap` bytes of an answer's body, or `None` (with what was
@@ -547,11 +626,12 @@ mod tests {
     use super::*;
 
     #[test]
-    fn addresses_are_plain_http_without_credentials() {
+    fn addresses_are_http_or_https_without_credentials() {
         assert!(check_url("http://octopi.local").is_ok());
         assert!(check_url("http://192.168.1.20:7125/").is_ok());
+        assert!(check_url("https://octopi.local").is_ok());
         for (url, says) in [
-            ("https://octopi.local", "plain http://"),
+            ("https://pi:raspberry@octopi.local", "user name or password"),
             ("octopi.local", "not an address"),
             ("ftp://octopi.local", "no web address"),
             ("http://pi:raspberry@octopi.local", "user name or password"),

@@ -48,6 +48,7 @@ export function openPrinter() {
   nozzleNote();
   $('pr-host-kind').value = base.host ? base.host.kind : '';
   $('pr-host-url').value = base.host ? base.host.url : '';
+  $('pr-host-cert').value = (base.host && base.host.cert_sha256) || '';
   $('pr-host-key').value = '';
   $('pr-error').textContent = '';
   $('printer-dialog').returnValue = '';
@@ -175,8 +176,13 @@ $('printer-form').addEventListener('submit', (e) => {
   else delete printer.nozzle_diameter;
   const hostKind = $('pr-host-kind').value;
   const hostUrl = $('pr-host-url').value.trim().replace(/\/+$/, '');
-  if (hostKind) printer.host = { kind: hostKind, url: hostUrl };
-  else delete printer.host;
+  // A fingerprint as people copy it: colons, spaces, any case.
+  const certText = $('pr-host-cert').value.trim().replace(/^sha256( fingerprint)?[=:]\s*/i, '');
+  const certHex = certText.replace(/[:\s]/g, '');
+  if (hostKind) {
+    printer.host = { kind: hostKind, url: hostUrl };
+    if (/^[0-9a-fA-F]{64}$/.test(certHex)) printer.host.cert_sha256 = certHex.toUpperCase().match(/../g).join(':');
+  } else delete printer.host;
   const bad = [
     [!printer.name, 'give the printer a name'],
     [!printer.build_volume.every((v) => v > 0), 'the build volume must be positive on every axis'],
@@ -186,7 +192,9 @@ $('printer-form').addEventListener('submit', (e) => {
     [!(printer.nozzle_radius >= 0), 'the nozzle body radius must be a number of mm'],
     [!(h > 0), 'the nozzle body height must be positive'],
     [nozzle != null && !(nozzle > 0 && nozzle <= 100), `nozzle diameter "${nozzleText}": a bore from above 0 to 100 mm, or empty if not known`],
-    [hostKind && !/^http:\/\/[^\s/@?#]+(\/[^\s@?#]*)?$/.test(hostUrl), 'the print host address is http:// and its name or IP address, e.g. http://octopi.local (no user name or password in it)'],
+    [hostKind && !/^https?:\/\/[^\s/@?#]+(\/[^\s@?#]*)?$/.test(hostUrl), 'the print host address is http:// or https:// and its name or IP address, e.g. http://octopi.local (no user name or password in it)'],
+    [hostKind && certHex && !/^[0-9a-fA-F]{64}$/.test(certHex), `certificate "${certText.slice(0, 20)}…": a SHA-256 fingerprint is 64 hex digits, e.g. AB:CD:…, as the refusal on sending names it`],
+    [hostKind && certHex && !hostUrl.startsWith('https://'), 'a certificate goes with an https:// address only'],
     [said != null && said !== printer.relative_e, said ? 'the start code sets relative extrusion (M83) but "relative extrusion" is off: the G-code\'s own M82 would cancel it; tick it or take M83 out' : 'the start code sets absolute extrusion (M82) but "relative extrusion" is on: untick it or take M82 out'],
   ].find(([b]) => b);
   if (bad) {

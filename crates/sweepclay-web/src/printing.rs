@@ -59,7 +59,7 @@ fn link_for(
             )
             .with_key(format!("{key}.url"))
         })?;
-    sweepclay_link::Link::new(kind, &host.url, secret)
+    sweepclay_link::Link::with_certificate(kind, &host.url, secret, host.cert_sha256.as_deref())
         .map_err(|e| ApiError::new(422, e.to_string()).with_key(format!("{key}.url")))
 }
 
@@ -71,6 +71,13 @@ fn host_error(e: sweepclay_link::LinkError) -> ApiError {
             502,
             format!("{host} refused the {what}: copy it again from {host}'s settings into \"key\" in Edit printer…, and save"),
         );
+    }
+    if let sweepclay_link::LinkError::Certificate { sha256, .. } = &e {
+        return ApiError::new(
+            502,
+            format!("{e}: paste {sha256} into \"certificate\" in Edit printer…, and save"),
+        )
+        .with_key("printer.host.cert_sha256");
     }
     ApiError::new(502, e.to_string())
 }

@@ -4,6 +4,8 @@ use sweepclay_web::api::Limits;
 
 /// Starts the server on 127.0.0.1:0 in the background; returns its base URL.
 pub async fn server(limits: Limits) -> String {
+    // The tests' own HTTP clients share the link's TLS provider.
+    sweepclay_link::tls::install_provider();
     let listener = tokio::net::TcpListener::bind("127.0.0.1:0").await.unwrap();
     let addr = listener.local_addr().unwrap();
     tokio::spawn(async move {
