@@ -1416,6 +1416,29 @@ async fn the_printer_dialog_and_a_rows_error_fit_a_phone() {
     )
     .await;
     assert_eq!(small, json!([]), "the printer dialog: controls under 44 px");
+    // An https:// host's certificate: a fingerprint cut short, or one
+    // with a plain http:// address, is refused beside the button.
+    set_value(&c, "pr-host-kind", "octoprint").await;
+    set_value(&c, "pr-host-url", "https://octopi.local").await;
+    set_value(&c, "pr-host-cert", "3f:a0:9c").await;
+    tap_id(&c, "pr-save").await;
+    let said = js(&c, "return document.getElementById('pr-error').textContent").await;
+    assert!(said.as_str().unwrap().contains("64 hex digits"), "{said}");
+    if let Ok(path) = std::env::var("SWEEPCLAY_PHONE_CERT_SCREENSHOT") {
+        std::fs::write(&path, c.screenshot().await.unwrap()).unwrap();
+    }
+    set_value(&c, "pr-host-url", "http://octopi.local").await;
+    set_value(&c, "pr-host-cert", &"3f".repeat(32)).await;
+    tap_id(&c, "pr-save").await;
+    let said = js(&c, "return document.getElementById('pr-error').textContent").await;
+    assert!(said.as_str().unwrap().contains("https://"), "{said}");
+    assert!(
+        js(&c, "return document.getElementById('printer-dialog').open")
+            .await
+            .as_bool()
+            .unwrap(),
+        "a refused entry keeps the dialog open"
+    );
     js(
         &c,
         "document.getElementById('printer-dialog').close(); return 0",
