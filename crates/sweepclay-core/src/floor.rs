@@ -131,17 +131,20 @@ impl std::fmt::Display for FloorRefusal {
 /// first, running against the polygon's order (so the same path reversed,
 /// run outward, ends at point 0 heading along the polygon's order).
 pub fn spiral_floor(outer: &[[f64; 2]], beads: FloorBeads) -> Result<FloorSpiral, FloorRefusal> {
-    spiral_floor_covering(outer, beads, MIN_COVER)
+    spiral_floor_covering(outer, beads, MIN_COVER, true)
 }
 
 /// [`spiral_floor`], taking the spiral that covers most of the region
 /// whenever it covers at least `min_cover` of it (0: any spiral whose
 /// turns keep their distance; the path stage lays the best there is
 /// where the corrections bent the outline after sampling checked it).
+/// `flush`: try stepped rings whose outermost lies on the outline first
+/// (a flush foot); else only the turns blended from half a pitch outside.
 pub fn spiral_floor_covering(
     outer: &[[f64; 2]],
     beads: FloorBeads,
     min_cover: f64,
+    flush: bool,
 ) -> Result<FloorSpiral, FloorRefusal> {
     let n = outer.len();
     let pitch = beads.pitch();
@@ -167,7 +170,15 @@ pub fn spiral_floor_covering(
     // exact spacing along straight sides and into corners; unusable where
     // the offsets split. Then the rays to each candidate spine, nearest
     // and along the normals: a region that pinches at a waist.
-    if let Some(m) = offset_spiral(outer, beads) {
+    // First stepped rings, the outermost on the outline (a flush foot),
+    // with a short step and a longer one; then the offsets blended over
+    // whole turns, the outermost from half a pitch outside the outline.
+    let steps = STEP_WIDTHS.map(|k| Some(k * beads.width));
+    let steps = steps.into_iter().filter(|_| flush).chain([None]);
+    for step in steps {
+        let Some(m) = offset_spiral(outer, beads, step) else {
+            continue;
+        };
         // An offset spiral ends round its last offset: a thin lens there
         // (an oval's) stays bare, a hole under 1 % of the floor. Where it
         // covers less than all, the rays, which close over their spine,
@@ -211,6 +222,15 @@ pub fn spiral_floor_covering(
     }
 }
 
+/// How long a ring's step to the next ring is, in bead widths, tried in
+/// turn: neighbouring steps' diagonals lie a pitch apart radially, a
+/// little less square to them (docs/ALGORITHMS.md §8).
+pub const STEP_WIDTHS: [f64; 2] = [1.5, 3.0];
+
+/// How far a widened step bead reaches inward, in pitches: short of the
+/// next turn's middle.
+const STEP_REACH: f64 = 0.95;
+
 /// The least share of the floor a spiral must cover.
 pub const MIN_COVER: f64 = 0.97;
 
@@ -225,7 +245,7 @@ const WHOLE: f64 = 0.999;
 /// k + 1 begins. The last offset winds in toward its centroid, and the
 /// spiral ends before it would come within [`MIN_GAP`] pitches of its
 /// own earlier turns. `None` where the offsets split into islands.
-fn offset_spiral(outer: &[[f64; 2]], beads: FloorBeads) -> Option<Measured> {
+fn offset_spiral(outer: &[[f64; 2]], beads: FloorBeads, step: Option<f64>) -> Option<Measured> {
     let pitch = beads.pitch();
     let ccw = signed_area2(outer) > 0.0;
     // Points closer than 0.45 of the floor's spacing add offsetting work,
@@ -243,9 +263,12 @@ fn offset_spiral(outer: &[[f64; 2]], beads: FloorBeads) -> Option<Measured> {
     // (a kidney's 13th had 29,000 and took 9 s).
     let mut last = base.clone();
     for k in 0..MAX_FLOOR_TURNS {
+        // The outermost ring on the outline itself: the wall's first turn
+        // stands on it, flush at the foot (docs/ALGORITHMS.md §8).
+        let outer_start = if step.is_some() { 0.0 } else { OUTER_START };
         let (from, d) = match k {
-            0 => (&base, -OUTER_START * pitch),
-            1 => (&base, (1.0 - OUTER_START) * pitch),
+            0 => (&base, -outer_start * pitch),
+            1 => (&base, (1.0 - outer_start) * pitch),
             _ => (&last, pitch),
         };
         // Nothing is left of the last offset shrunk by a pitch more than
@@ -299,12 +322,17 @@ fn offset_spiral(outer: &[[f64; 2]], beads: FloorBeads) -> Option<Measured> {
         });
         let c = centroid(&ring);
         let total = perimeter(&ring);
+        // Stepped, each ring goes over to the next over its last `step`
+        // mm: the outermost lies on the outline all round but there. (The
+        // same share of each ring instead measured gaps of 1.9 pitches
+        // across the jogs, which lie end to end.)
+        let blend = step.unwrap_or(total).min(total);
         let mut acc = 0.0;
         for (j, &a) in ring.iter().enumerate() {
             if j > 0 {
                 acc += dist(a, ring[j - 1]);
             }
-            let sigma = acc / total;
+            let sigma = ((acc - (total - blend)) / blend).clamp(0.0, 1.0);
             let goal = match walker.as_mut() {
                 Some(w) => w.nearest(a),
                 None => {
@@ -331,7 +359,52 @@ fn offset_spiral(outer: &[[f64; 2]], beads: FloorBeads) -> Option<Measured> {
     if pts.len() < 2 {
         return None;
     }
-    Some(measure_path(pts, turn_of, turns, beads))
+    let deep = if step.is_some() {
+        outermost_depths(&pts, &turn_of, outer, beads)
+    } else {
+        vec![]
+    };
+    let mut m = measure_path(pts, turn_of, turns, beads);
+    // Where the outermost ring steps in to the next, its beads widen to
+    // keep their outer edge on the outline's (up to the widest bead): the
+    // wall's first turn above rests on them all round (docs/ALGORITHMS.md
+    // §8).
+    // Its inner edge stops short of the next turn's middle, a pitch in:
+    // a wider bead would lie under that turn, on clay of its own layer.
+    let cap = beads.widest.min(2.0 * STEP_REACH * beads.pitch());
+    for (i, depth) in deep {
+        let w = &mut m.spiral.widths[i];
+        *w = w.max((beads.width + 2.0 * depth).min(cap));
+    }
+    Some(m)
+}
+
+/// The points of the outermost turn that lie inside the outline (its
+/// step to the next ring), with their distance to it.
+fn outermost_depths(
+    pts: &[[f64; 2]],
+    turn_of: &[u32],
+    outer: &[[f64; 2]],
+    beads: FloorBeads,
+) -> Vec<(usize, f64)> {
+    let pitch = beads.pitch();
+    let mut grid = Grid2::new(pitch.max(1.0));
+    let n = outer.len();
+    for i in 0..n {
+        grid.insert_segment(outer[i], outer[(i + 1) % n], i as u32);
+    }
+    let mut out = vec![];
+    for (i, &p) in pts.iter().enumerate().take_while(|&(i, _)| turn_of[i] == 0) {
+        let mut depth = f64::INFINITY;
+        grid.for_each_near_segment(p, p, 1.5 * pitch, |j| {
+            let j = j as usize;
+            depth = depth.min(segment_distance(p, outer[j], outer[(j + 1) % n]));
+        });
+        if depth.is_finite() && depth > 0.01 * pitch {
+            out.push((i, depth));
+        }
+    }
+    out
 }
 
 /// The contours of a counter-clockwise closed contour offset inward by
@@ -982,31 +1055,33 @@ mod tests {
     }
 
     #[test]
-    fn a_circles_spiral_has_turns_a_pitch_apart_and_its_area_over_the_pitch_as_length() {
+    fn a_circles_spiral_has_rings_a_pitch_apart_and_its_area_over_the_pitch_as_length() {
         let r = 40.0;
         let ring = ellipse(r, r, 228);
         let s = spiral_floor(&ring, BEADS).unwrap();
         let p = BEADS.pitch();
-        // Offsets of a circle are circles a pitch apart, from r + p/2
-        // (half a pitch outside) in: (r + p/2) / p turns, the last winding
-        // in to the centre; neighbouring turns a pitch apart (within 7 %:
-        // the innermost winds in by a pitch a turn on a ring 3 mm across).
-        let whole = (r + 0.5 * p) / p;
+        // Rings a pitch apart from the outline itself in (the flush foot):
+        // r / p turns, the last winding in to the centre.
+        let whole = r / p;
         assert!(
             (f64::from(s.turns) - whole).abs() < 1.0,
             "{} turns, {whole:.2} expected",
             s.turns
         );
+        // Neighbouring rings a pitch apart within 7 %; where a ring steps
+        // to the next over 3 bead widths, the steps of the rings near the
+        // middle (a ring 27 mm round) lie up to 1.4 pitches apart, which
+        // the beads there widen to fill.
         assert!(
-            (s.min_gap - p).abs() < 0.07 * p && (s.max_gap - p).abs() < 0.07 * p,
+            (s.min_gap - p).abs() < 0.07 * p && s.max_gap < 1.4 * p,
             "gaps {}–{} mm, expected {p:.3}",
             s.min_gap,
             s.max_gap
         );
-        // An Archimedean spiral from r + p/2 to the centre: its length is
-        // the area it sweeps over its pitch, π (r + p/2)² / p.
-        let outer_r = r + 0.5 * p;
-        let closed = std::f64::consts::PI * outer_r * outer_r / p;
+        // Rings at r, r − p, … to the centre: Σ 2π (r − k p) over r / p
+        // rings, π r (r / p + 1) (the area over the pitch, plus half the
+        // outline: the outermost ring lies on it, not half a pitch in).
+        let closed = std::f64::consts::PI * r * (r / p + 1.0);
         let l = length(&s);
         assert!(
             (l - closed).abs() < 0.03 * closed,
@@ -1050,16 +1125,41 @@ mod tests {
     }
 
     #[test]
-    fn the_spiral_starts_outside_point_zero_and_runs_against_the_polygon() {
+    fn the_outermost_ring_is_the_outline_and_its_step_keeps_the_outer_edge() {
         let ring = ellipse(30.0, 30.0, 120);
         let s = spiral_floor(&ring, BEADS).unwrap();
         let p = BEADS.pitch();
-        // Half a pitch outside point 0 (the offset's polygon is within
-        // 0.01 mm of the circle there)...
+        // On point 0 of the outline: the wall's first turn stands on it...
         let d = (s.pts[0][0] - 30.0).hypot(s.pts[0][1]);
-        assert!((d - OUTER_START * p).abs() < 0.01, "starts {d} mm out");
+        assert!(d < 0.01, "starts {d} mm out");
         // ... turning clockwise round a counter-clockwise polygon ...
         assert!(s.pts[1][1] < 0.0, "{:?}", s.pts[1]);
+        // ... on the outline all round but its step to the next ring,
+        // where its beads widen to keep their outer edge on the outline's
+        // (short of the next ring's middle, a pitch in).
+        let first = s
+            .pts
+            .iter()
+            .take_while(|q| q[0].hypot(q[1]) > 30.0 - p + 0.05)
+            .count();
+        let outer_edge = |i: usize| s.pts[i][0].hypot(s.pts[i][1]) + 0.5 * s.widths[i];
+        let on = (0..first)
+            .filter(|&i| (s.pts[i][0].hypot(s.pts[i][1]) - 30.0).abs() < 0.05)
+            .count();
+        let around = std::f64::consts::TAU * 30.0;
+        assert!(
+            (first - on) as f64 * BEADS.spacing < STEP_WIDTHS[1] * BEADS.width + 1.0,
+            "{} of {first} outermost points off the outline, {around:.0} mm round",
+            first - on
+        );
+        let low = (0..first).map(outer_edge).fold(f64::INFINITY, f64::min);
+        let flush = 30.0 + 0.5 * BEADS.width;
+        // Flush but at the step's end, where the widest bead short of the
+        // next ring (1.9 p) leaves its edge 1.9 p / 2 − p + w/2 inside.
+        assert!(
+            flush - low < 0.5 * BEADS.width,
+            "outer edge {low:.2}, flush {flush:.2}"
+        );
         // ... and ending within a pitch of the centre.
         let e = s.pts.last().unwrap();
         assert!(e[0].hypot(e[1]) < p, "{e:?}");

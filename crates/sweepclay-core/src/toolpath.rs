@@ -322,7 +322,7 @@ fn vessel_floor(c: &Corrected, v: &VesselPlan) -> Result<LaidFloor, FloorRefusal
     // The cover reported and judged is measured on a 0.5 mm grid (the
     // spiral was chosen on a 1 mm one).
     let lay = |ring: Vec<[f64; 2]>| {
-        spiral_floor_covering(&ring, beads, 0.0).map(|spiral| LaidFloor {
+        spiral_floor_covering(&ring, beads, 0.0, !c.blended_floor).map(|spiral| LaidFloor {
             cover: coverage(&ring, &spiral, 0.5),
             ring,
             spiral,

@@ -13,6 +13,7 @@ use std::io::{self, Write};
 use std::sync::Arc;
 use sweepclay_check::{Finding, Report};
 use sweepclay_core::correct::{correct_with, Tightening};
+use sweepclay_core::toolpath::PointKind;
 use sweepclay_core::{surface, Design, Sliced};
 
 /// Most rounds of the correction loop after the first slicing.
@@ -232,7 +233,7 @@ fn run<W: Write>(
     let mut radius: Vec<Option<f64>> = vec![None; vertices.len()];
     let mut round = |sampled: &surface::Surface,
                      tight: &Tightening|
-     -> Result<(Checked<W>, Vec<usize>, bool), Unchecked> {
+     -> Result<(Checked<W>, Vec<usize>, bool, bool), Unchecked> {
         let corrected = correct_with(sampled, tight)?;
         go_on(cancel)?;
         let sliced = sweepclay_core::finish(corrected)?;
@@ -241,7 +242,7 @@ fn run<W: Write>(
             verify_lines(&sliced, min_overlap, CancelWriter(&mut w, cancel.clone()))?;
         // A bead over clay two layers down has lost the pass below as an
         // overhang has: the same tightening brings the pass back under it.
-        let mut support: Vec<usize> = [
+        let failed: Vec<usize> = [
             Finding::Overhang,
             Finding::UnderMinOverlap,
             Finding::LayerGap,
@@ -250,9 +251,24 @@ fn run<W: Write>(
         .flat_map(|&k| report.findings[k].lines.iter())
         .filter_map(|&l| {
             let i = lines.partition_point(|&x| x < l);
-            (lines.get(i) == Some(&l)).then(|| sliced.toolpath.points[i].column as usize)
+            (lines.get(i) == Some(&l)).then_some(i)
         })
         .collect();
+        // A wall bead of the two turns on the floor that does not rest on
+        // it (the checker reads the second turn over the first's start on
+        // the floor's top too): the floor's step, not the wall, is to
+        // change.
+        let path = &sliced.toolpath;
+        let floor = |i: usize| path.points[i].kind == PointKind::Floor;
+        let on_floor = |i: usize| !floor(i) && path.below[i].is_none_or(|b| floor(b as usize));
+        let foot = path.vessel.is_some()
+            && failed
+                .iter()
+                .any(|&i| on_floor(i) || path.below[i].is_some_and(|b| on_floor(b as usize)));
+        let mut support: Vec<usize> = failed
+            .iter()
+            .map(|&i| path.points[i].column as usize)
+            .collect();
         support.sort_unstable();
         support.dedup();
         let body = report.findings[Finding::NozzleCollision].count > 0;
@@ -264,11 +280,18 @@ fn run<W: Write>(
             locations,
             point_lines: lines,
         };
-        Ok((checked, support, body))
+        Ok((checked, support, body, foot))
     };
     loop {
-        let (checked, support, body) = round(&sampled, &tight)?;
+        let (checked, support, body, foot) = round(&sampled, &tight)?;
         let printable = checked.report.printable;
+        // A flush foot the wall's first turn cannot stand on: the floor
+        // blended from outside the foot instead, as before it was flush
+        // (docs/ALGORITHMS.md §8, "A flush foot"); not a round.
+        if !printable && foot && !tight.blended_floor {
+            tight.blended_floor = true;
+            continue;
+        }
         if printable {
             let Some(f) = tight.body else {
                 return Ok((checked, sampled));

@@ -36,6 +36,8 @@ pub struct Corrected {
     pub kept: Vec<f64>,
     /// What changed.
     pub report: CorrectionReport,
+    /// The floor is laid blended, not flush ([`Tightening::blended_floor`]).
+    pub blended_floor: bool,
 }
 
 impl Corrected {
@@ -60,6 +62,11 @@ pub struct Tightening {
     pub body: Option<f64>,
     /// Rounds of the loop so far (reported).
     pub rounds: u32,
+    /// Lay the floor's outermost turn from half a pitch outside the foot
+    /// over a whole turn, not as stepped rings flush with the wall: the
+    /// loop's answer when the wall's first turn does not rest on the
+    /// stepped floor's step (docs/ALGORITHMS.md §8, "A flush foot").
+    pub blended_floor: bool,
 }
 
 /// Applies both corrections.
@@ -194,6 +201,7 @@ pub fn correct_with(surface: &Surface, tight: &Tightening) -> Result<Corrected> 
             deviation,
         },
         surface: out,
+        blended_floor: tight.blended_floor,
     })
 }
 
