@@ -175,8 +175,19 @@ pub fn spiral_floor_covering(
     // whole turns, the outermost from half a pitch outside the outline.
     let steps = STEP_WIDTHS.map(|k| Some(k * beads.width));
     let steps = steps.into_iter().filter(|_| flush).chain([None]);
+    // The offsets cost most (i_overlay): computed once for the stepped
+    // rings (on the outline) and once for the blended turns.
+    let mut flush_rings = None;
     for step in steps {
-        let Some(m) = offset_spiral(outer, beads, step) else {
+        let start = if step.is_some() { 0.0 } else { OUTER_START };
+        let rings = match step {
+            Some(_) => flush_rings.get_or_insert_with(|| offset_rings(outer, beads, start)),
+            None => &mut offset_rings(outer, beads, start),
+        };
+        let Some(m) = rings
+            .as_deref()
+            .and_then(|r| offset_spiral(outer, beads, r, step))
+        else {
             continue;
         };
         // An offset spiral ends round its last offset: a thin lens there
@@ -238,14 +249,15 @@ pub const MIN_COVER: f64 = 0.97;
 /// cover is measured on): a spiral that covers it ends the search.
 const WHOLE: f64 = 0.999;
 
-/// The spiral that blends each inward offset of `outer` into the next
-/// along the turn (Held & Spielberger): offsets at depths (k − 0.6)
-/// pitches; each point of offset k moves toward its nearest point on
-/// offset k + 1 by the share of the turn done, so turn k ends where turn
-/// k + 1 begins. The last offset winds in toward its centroid, and the
-/// spiral ends before it would come within [`MIN_GAP`] pitches of its
-/// own earlier turns. `None` where the offsets split into islands.
-fn offset_spiral(outer: &[[f64; 2]], beads: FloorBeads, step: Option<f64>) -> Option<Measured> {
+/// The inward offsets of `outer` a pitch apart, the outermost
+/// `outer_start` pitches outside it (0: on it, for stepped rings), each
+/// against the outline's order, as the spiral runs. `None` where the
+/// offsets split into islands, or fewer than two fit.
+fn offset_rings(
+    outer: &[[f64; 2]],
+    beads: FloorBeads,
+    outer_start: f64,
+) -> Option<Vec<Vec<[f64; 2]>>> {
     let pitch = beads.pitch();
     let ccw = signed_area2(outer) > 0.0;
     // Points closer than 0.45 of the floor's spacing add offsetting work,
@@ -263,9 +275,6 @@ fn offset_spiral(outer: &[[f64; 2]], beads: FloorBeads, step: Option<f64>) -> Op
     // (a kidney's 13th had 29,000 and took 9 s).
     let mut last = base.clone();
     for k in 0..MAX_FLOOR_TURNS {
-        // The outermost ring on the outline itself: the wall's first turn
-        // stands on it, flush at the foot (docs/ALGORITHMS.md §8).
-        let outer_start = if step.is_some() { 0.0 } else { OUTER_START };
         let (from, d) = match k {
             0 => (&base, -outer_start * pitch),
             1 => (&base, (1.0 - outer_start) * pitch),
@@ -304,9 +313,22 @@ fn offset_spiral(outer: &[[f64; 2]], beads: FloorBeads, step: Option<f64>) -> Op
         }
         rings.push(densified(&ring, fine));
     }
-    if rings.len() < 2 {
-        return None;
-    }
+    (rings.len() >= 2).then_some(rings)
+}
+
+/// The offsets of [`offset_rings`] walked into one spiral (Held &
+/// Spielberger): each point of ring k moves toward its nearest point on
+/// ring k + 1 by the share of the turn done (blended), or of the ring's
+/// last `step` mm (stepped), so turn k ends where turn k + 1 begins. The
+/// last ring winds in toward its centroid, and the spiral ends before it
+/// would come within [`MIN_GAP`] pitches of its own earlier turns.
+fn offset_spiral(
+    outer: &[[f64; 2]],
+    beads: FloorBeads,
+    rings: &[Vec<[f64; 2]>],
+    step: Option<f64>,
+) -> Option<Measured> {
+    let pitch = beads.pitch();
     let turns = rings.len();
     let mut pts = Vec::new();
     let mut turn_of = Vec::new();
