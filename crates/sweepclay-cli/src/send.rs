@@ -153,13 +153,10 @@ pub fn run(a: SendArgs) -> Result<i32> {
         Ok::<i32, anyhow::Error>(0)
     })
     .map_err(|e| match e.downcast::<sweepclay_link::LinkError>() {
-        Ok(le @ sweepclay_link::LinkError::Certificate { .. }) => {
-            let sweepclay_link::LinkError::Certificate { sha256, .. } = &le else {
-                unreachable!()
-            };
-            anyhow::anyhow!("{le}: send again with --cert-sha256 {sha256}, or put \"cert_sha256\": \"{sha256}\" in the printer's host")
-        }
-        Ok(le) => anyhow::anyhow!("{le}"),
+        Ok(le) => match &le {
+            sweepclay_link::LinkError::Certificate { sha256, .. } => anyhow::anyhow!("{le}: send again with --cert-sha256 {sha256}, or put \"cert_sha256\": \"{sha256}\" in the printer's host"),
+            _ => anyhow::anyhow!("{le}"),
+        },
         Err(e) => e,
     })
 }

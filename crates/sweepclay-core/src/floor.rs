@@ -175,19 +175,23 @@ pub fn spiral_floor_covering(
     // whole turns, the outermost from half a pitch outside the outline.
     let steps = STEP_WIDTHS.map(|k| Some(k * beads.width));
     let steps = steps.into_iter().filter(|_| flush).chain([None]);
-    // The offsets cost most (i_overlay): computed once for the stepped
-    // rings (on the outline) and once for the blended turns.
-    let mut flush_rings = None;
+    // The offsets cost most (i_overlay): the rings on the outline serve
+    // both step lengths; the blended turns' are computed only if reached.
+    let on_outline = if flush {
+        offset_rings(outer, beads, 0.0)
+    } else {
+        None
+    };
     for step in steps {
-        let start = if step.is_some() { 0.0 } else { OUTER_START };
+        let blended;
         let rings = match step {
-            Some(_) => flush_rings.get_or_insert_with(|| offset_rings(outer, beads, start)),
-            None => &mut offset_rings(outer, beads, start),
+            Some(_) => on_outline.as_deref(),
+            None => {
+                blended = offset_rings(outer, beads, OUTER_START);
+                blended.as_deref()
+            }
         };
-        let Some(m) = rings
-            .as_deref()
-            .and_then(|r| offset_spiral(outer, beads, r, step))
-        else {
+        let Some(m) = rings.and_then(|r| offset_spiral(outer, beads, r, step)) else {
             continue;
         };
         // An offset spiral ends round its last offset: a thin lens there

@@ -465,8 +465,7 @@ impl Link {
             Some(pin) if *pin == seen => return None,
             Some(pin) => format!("other than the one accepted for it ({pin}): it may have been renewed, or another machine answers in its place"),
             None => {
-                let text = format!("{e:?}");
-                if !(text.contains("Certificate") || text.contains("certificate")) {
+                if !format!("{e:?}").to_lowercase().contains("certificate") {
                     return None;
                 }
                 "this computer does not trust (a self-signed one, as a printer's usually is)".to_string()

@@ -59,6 +59,15 @@ async fn tls_front(upstream: String, cert: Vec<u8>, key: Vec<u8>) -> String {
     format!("https://127.0.0.1:{port}")
 }
 
+/// The certificate refusal `link` answers a status with: the fingerprint
+/// it names and why.
+async fn refusal(link: &Link) -> (String, String) {
+    match link.status().await.unwrap_err() {
+        LinkError::Certificate { sha256, why, .. } => (sha256, why),
+        e => panic!("expected a certificate refusal, got {e}"),
+    }
+}
+
 #[tokio::test(flavor = "multi_thread")]
 async fn an_https_octoprint_is_reached_once_its_certificate_is_accepted() {
     let dir = tempfile::tempdir().unwrap();
@@ -73,39 +82,31 @@ async fn an_https_octoprint_is_reached_once_its_certificate_is_accepted() {
     let (cert, key) = self_signed();
     let fp = fingerprint(&cert);
     let url = tls_front(upstream, cert, key).await;
+    let link = |cert: Option<&str>| {
+        Link::with_certificate(Kind::OctoPrint, &url, Some(server.key.clone()), cert).unwrap()
+    };
 
     // Not trusted by this computer: refused, naming the fingerprint.
-    let link = Link::new(Kind::OctoPrint, &url, Some(server.key.clone())).unwrap();
-    match link.status().await.unwrap_err() {
-        LinkError::Certificate { sha256, why, .. } => {
-            assert_eq!(sha256, fp);
-            assert!(why.contains("does not trust"), "{why}");
-        }
-        e => panic!("expected a certificate refusal, got {e}"),
-    }
+    let (sha256, why) = refusal(&link(None)).await;
+    assert_eq!(sha256, fp);
+    assert!(why.contains("does not trust"), "{why}");
 
     // Accepted by its fingerprint (as copied: lower case, no colons): the
     // file goes up, prints and ends.
     let copied = fp.replace(':', "").to_lowercase();
-    let link = Link::with_certificate(
-        Kind::OctoPrint,
-        &url,
-        Some(server.key.clone()),
-        Some(&copied),
-    )
-    .unwrap();
-    let stored = link
+    let accepted = link(Some(&copied));
+    let stored = accepted
         .upload(
             "tls",
             b"G21\nG90\nM82\nG92 E0\nG1 X110 Y100 Z1 E1 F1200\n".to_vec(),
         )
         .await
         .unwrap();
-    assert!(link.files().await.unwrap().contains(&stored));
-    link.start(&stored).await.unwrap();
+    assert!(accepted.files().await.unwrap().contains(&stored));
+    accepted.start(&stored).await.unwrap();
     let mut done = false;
     for _ in 0..300 {
-        if !link.status().await.unwrap().printing {
+        if !accepted.status().await.unwrap().printing {
             done = true;
             break;
         }
@@ -116,20 +117,9 @@ async fn an_https_octoprint_is_reached_once_its_certificate_is_accepted() {
     // Another certificate in its place: refused, both named.
     let (other, _) = self_signed();
     let wrong = fingerprint(&other);
-    let link = Link::with_certificate(
-        Kind::OctoPrint,
-        &url,
-        Some(server.key.clone()),
-        Some(&wrong),
-    )
-    .unwrap();
-    match link.status().await.unwrap_err() {
-        LinkError::Certificate { sha256, why, .. } => {
-            assert_eq!(sha256, fp);
-            assert!(why.contains(&wrong), "{why}");
-        }
-        e => panic!("expected a certificate refusal, got {e}"),
-    }
+    let (sha256, why) = refusal(&link(Some(&wrong))).await;
+    assert_eq!(sha256, fp);
+    assert!(why.contains(&wrong), "{why}");
 }
 
 #[test]
