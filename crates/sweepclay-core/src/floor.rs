@@ -171,7 +171,8 @@ pub fn spiral_floor_covering(
     // the offsets split. Then the rays to each candidate spine, nearest
     // and along the normals: a region that pinches at a waist.
     // First stepped rings, the outermost on the outline (a flush foot),
-    // with a short step and a longer one; then the offsets blended over
+    // stepping in over a short step, then over a longer one should the
+    // short one's turns come too close; then the offsets blended over
     // whole turns, the outermost from half a pitch outside the outline.
     let steps = STEP_WIDTHS.map(|k| Some(k * beads.width));
     let steps = steps.into_iter().filter(|_| flush).chain([None]);
@@ -182,7 +183,13 @@ pub fn spiral_floor_covering(
     } else {
         None
     };
+    let mut stepped_kept = false;
     for step in steps {
+        // The steps differ only in the outermost turn's: once one keeps
+        // its turns apart, the other covers the same.
+        if step.is_some() && stepped_kept {
+            continue;
+        }
         let blended;
         let rings = match step {
             Some(_) => on_outline.as_deref(),
@@ -194,6 +201,7 @@ pub fn spiral_floor_covering(
         let Some(m) = rings.and_then(|r| offset_spiral(outer, beads, r, step)) else {
             continue;
         };
+        stepped_kept |= step.is_some() && m.closest.1 >= MIN_GAP * pitch;
         // An offset spiral ends round its last offset: a thin lens there
         // (an oval's) stays bare, a hole under 1 % of the floor. Where it
         // covers less than all, the rays, which close over their spine,
@@ -237,10 +245,16 @@ pub fn spiral_floor_covering(
     }
 }
 
-/// How long a ring's step to the next ring is, in bead widths, tried in
-/// turn: neighbouring steps' diagonals lie a pitch apart radially, a
-/// little less square to them (docs/ALGORITHMS.md §8).
+/// How long the outermost ring's step to the next ring is, in bead
+/// widths, tried in turn: neighbouring steps' diagonals lie a pitch apart
+/// radially, a little less square to them (docs/ALGORITHMS.md §8). The
+/// short step keeps the notch it leaves at the foot short.
 pub const STEP_WIDTHS: [f64; 2] = [1.5, 3.0];
+
+/// How long the inner rings' steps are, in bead widths: on small rings
+/// and an oval's sharp ends a short step spans much of the turn, and the
+/// turns met across the jogs (docs/ALGORITHMS.md §8).
+pub const INNER_STEP_WIDTH: f64 = 3.0;
 
 /// How far a widened step bead reaches inward, in pitches: short of the
 /// next turn's middle.
@@ -323,7 +337,8 @@ fn offset_rings(
 /// The offsets of [`offset_rings`] walked into one spiral (Held &
 /// Spielberger): each point of ring k moves toward its nearest point on
 /// ring k + 1 by the share of the turn done (blended), or of the ring's
-/// last `step` mm (stepped), so turn k ends where turn k + 1 begins. The
+/// last `step` mm (stepped; the inner rings' at least
+/// [`INNER_STEP_WIDTH`] widths), so turn k ends where turn k + 1 begins. The
 /// last ring winds in toward its centroid, and the spiral ends before it
 /// would come within [`MIN_GAP`] pitches of its own earlier turns.
 fn offset_spiral(
@@ -342,25 +357,41 @@ fn offset_spiral(
         let next = rings.get(k + 1);
         // Walking along the next offset as this one is walked: the
         // nearest point moves on monotonically, a few segments a point.
-        let mut walker = next.map(|r| Walker {
-            at: nearest_on(r, ring[0]).0,
-            ring: r,
-        });
+        // Started where the blend starts: a stepped ring's points before
+        // its step need no goal (the walk was most of a floor's time).
+        let mut walker: Option<Walker> = None;
         let c = centroid(&ring);
         let total = perimeter(&ring);
         // Stepped, each ring goes over to the next over its last `step`
-        // mm: the outermost lies on the outline all round but there. (The
+        // mm (the inner ones over a longer step: a short one on a small
+        // ring spans much of its turn and cut the spiral short): the
+        // outermost lies on the outline all round but there. (The
         // same share of each ring instead measured gaps of 1.9 pitches
         // across the jogs, which lie end to end.)
-        let blend = step.unwrap_or(total).min(total);
+        let blend = match step {
+            Some(s) if k == 0 => s,
+            Some(s) => s.max(INNER_STEP_WIDTH * beads.width),
+            None => total,
+        }
+        .min(total);
         let mut acc = 0.0;
         for (j, &a) in ring.iter().enumerate() {
             if j > 0 {
                 acc += dist(a, ring[j - 1]);
             }
             let sigma = ((acc - (total - blend)) / blend).clamp(0.0, 1.0);
-            let goal = match walker.as_mut() {
-                Some(w) => w.nearest(a),
+            if sigma == 0.0 {
+                pts.push(a);
+                turn_of.push(k as u32);
+                continue;
+            }
+            let goal = match next {
+                Some(r) => walker
+                    .get_or_insert_with(|| Walker {
+                        at: nearest_on(r, a).0,
+                        ring: r,
+                    })
+                    .nearest(a),
                 None => {
                     let d = dist(a, c);
                     let step = pitch.min(d);
@@ -381,8 +412,12 @@ fn offset_spiral(
         }
     }
     thin(&mut pts, &mut turn_of, 0.6 * beads.spacing);
+    let walked = path_length(&pts);
     truncate_where_close(&mut pts, &mut turn_of, MIN_GAP * pitch, 2.5 * pitch);
-    if pts.len() < 2 {
+    // A floor's area is its path's length times the pitch: a stepped
+    // spiral cut short by more than the hole allowed cannot be kept, and
+    // measuring it cost as much as walking it.
+    if pts.len() < 2 || (step.is_some() && path_length(&pts) < MIN_COVER * walked) {
         return None;
     }
     let deep = if step.is_some() {
@@ -397,16 +432,19 @@ fn offset_spiral(
     // §8).
     // Its inner edge stops short of the next turn's middle, a pitch in:
     // a wider bead would lie under that turn, on clay of its own layer.
+    // Nor does any bead of it, widened to touch its inner neighbour,
+    // reach past the outline's outer edge: a ledge at the foot.
     let cap = beads.widest.min(2.0 * STEP_REACH * beads.pitch());
     for (i, depth) in deep {
+        let flush = beads.width + 2.0 * depth;
         let w = &mut m.spiral.widths[i];
-        *w = w.max((beads.width + 2.0 * depth).min(cap));
+        *w = w.max(flush.min(cap)).min(flush);
     }
     Some(m)
 }
 
-/// The points of the outermost turn that lie inside the outline (its
-/// step to the next ring), with their distance to it.
+/// The points of the outermost turn with their distance inside the
+/// outline (0 on it; more on its step to the next ring).
 fn outermost_depths(
     pts: &[[f64; 2]],
     turn_of: &[u32],
@@ -426,7 +464,7 @@ fn outermost_depths(
             let j = j as usize;
             depth = depth.min(segment_distance(p, outer[j], outer[(j + 1) % n]));
         });
-        if depth.is_finite() && depth > 0.01 * pitch {
+        if depth.is_finite() {
             out.push((i, depth));
         }
     }
@@ -597,6 +635,11 @@ fn norm(x: f64, y: f64) -> f64 {
 
 fn dist(a: [f64; 2], b: [f64; 2]) -> f64 {
     norm(a[0] - b[0], a[1] - b[1])
+}
+
+/// The length of an open path.
+fn path_length(pts: &[[f64; 2]]) -> f64 {
+    pts.windows(2).map(|w| dist(w[0], w[1])).sum()
 }
 
 fn perimeter(ring: &[[f64; 2]]) -> f64 {
@@ -1094,12 +1137,12 @@ mod tests {
             "{} turns, {whole:.2} expected",
             s.turns
         );
-        // Neighbouring rings a pitch apart within 7 %; where a ring steps
-        // to the next over 3 bead widths, the steps of the rings near the
-        // middle (a ring 27 mm round) lie up to 1.4 pitches apart, which
-        // the beads there widen to fill.
+        // Neighbouring rings a pitch apart within 13 %; the outermost
+        // steps in over 1.5 bead widths, the next over 3, so where the
+        // outermost's step begins the next is already half way down its
+        // own, 1.5 pitches away, which the beads there widen to fill.
         assert!(
-            (s.min_gap - p).abs() < 0.07 * p && s.max_gap < 1.4 * p,
+            (s.min_gap - p).abs() < 0.13 * p && s.max_gap < 1.5 * p,
             "gaps {}–{} mm, expected {p:.3}",
             s.min_gap,
             s.max_gap
