@@ -334,6 +334,7 @@ pub(crate) fn slice_design(a: SliceArgs, text: String, source: String) -> Result
         locations,
         point_lines,
         most_twist: _,
+        most_rise: _,
     } = checked;
     drop((written, point_lines));
     let reshaped = sliced.corrected.reshaped();

@@ -5,6 +5,7 @@
 use crate::check::locate;
 use crate::plan::Checked;
 use sweepclay_check::Finding;
+use sweepclay_core::rim::RimShape;
 
 impl<W> Checked<W> {
     /// For each kind of failure the loop could not correct: the cause,
@@ -26,6 +27,28 @@ impl<W> Checked<W> {
         } else {
             String::new()
         };
+        // The most rise of this rim that prints, said once: with the
+        // body's collisions (the usual cause), else on its own.
+        let rise = self.most_rise.as_ref().map(|(most, rim)| {
+            let shape = match (rim.shape, rim.peaks) {
+                (RimShape::Wave, Some(k)) if k > 1 => format!("{k}-crest wave"),
+                (RimShape::Wave, _) => "wave".to_string(),
+                (RimShape::Slant, _) => "slant".to_string(),
+                (RimShape::Raised, _) => "raised arc".to_string(),
+            };
+            format!(
+                "the rim's {shape} rises {:.1} mm, more than one continuous path climbs here; at most {most:.1} mm of rise prints this pot (rim.rise){}",
+                rim.rise,
+                if rim.shape == RimShape::Wave && rim.peaks.unwrap_or(1) > 1 {
+                    ", or more with fewer crests"
+                } else {
+                    ""
+                }
+            )
+        });
+        let collides = self.report.findings[Finding::NozzleCollision]
+            .first_line
+            .is_some();
         Finding::ALL
             .iter()
             .filter_map(|&k| {
@@ -35,6 +58,10 @@ impl<W> Checked<W> {
                 let place = locate(s, &self.point_lines, line)
                     .unwrap_or_else(|| format!("line {line}"));
                 let change = match k {
+                    Finding::NozzleCollision if rise.is_some() => format!(
+                        "the extruder body ({r} mm radius) meets clay {worst:.1} mm above the nozzle{tried}: {}",
+                        rise.as_deref().expect("matched")
+                    ),
                     Finding::Overhang => format!(
                         "an overhang of {worst:.0}° beyond the {}° limit{tried}: lean the profiles less there, or raise params.max_overhang_deg if your clay stands steeper",
                         p.max_overhang_deg
@@ -66,6 +93,7 @@ impl<W> Checked<W> {
                 };
                 Some(format!("{change} — at {place}"))
             })
+            .chain(rise.clone().filter(|_| !collides))
             .chain(self.most_twist.map(|most| {
                 let t = s.corrected.surface.columns.first().map_or(0.0, |c| c.twist.to_degrees());
                 format!(

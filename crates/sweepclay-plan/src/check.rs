@@ -53,6 +53,9 @@ pub struct Verified {
     /// How far the corrections moved the shape, when beyond
     /// `params.max_correction_mm` (`CorrectionReport::reshaped`).
     pub reshaped: Option<String>,
+    /// For a rim that does not print: the most rise of it that does (see
+    /// [`crate::Checked::most_rise`]; `None` when not looked for).
+    pub most_rise: Option<f64>,
 }
 
 /// Writes to two writers.
@@ -125,6 +128,7 @@ pub fn verify_until(s: &Sliced, min_overlap: f64, cancel: &Cancel) -> io::Result
         locations,
         advice: Vec::new(),
         reshaped: s.corrected.reshaped(),
+        most_rise: None,
     })
 }
 

@@ -37,6 +37,12 @@ pub struct Checked<W> {
     /// does), found by bisection. `None` when it prints, has no twist, or
     /// does not print untwisted either (the twist is not the cause).
     pub most_twist: Option<f64>,
+    /// For a design with a `rim` that does not print: the largest rise of
+    /// the same rim (shape, crests, angle) that does (mm, to 0.5 mm
+    /// below; 0 when only a level rim does), found by bisection, and that
+    /// rim as designed. `None` when it prints, has no rim, or does not
+    /// print level either.
+    pub most_rise: Option<(f64, sweepclay_core::rim::RimSpec)>,
 }
 
 /// Why a slicing whose check fails cannot be corrected: the error
@@ -115,7 +121,61 @@ pub fn plan<W: Write>(
     if !checked.report.printable && twist != 0.0 {
         checked.most_twist = most_twist(job, cancel)?;
     }
+    if !checked.report.printable && job.design().rim.as_ref().is_some_and(|r| r.rise > 0.0) {
+        checked.most_rise = most_rise(job, cancel)?.zip(job.design().rim.clone());
+    }
     Ok(Planned { checked, drawn })
+}
+
+/// Whether `d` plans to printable G-code, sampled apart from the job's
+/// store (a bisection's designs would push the potter's out of it); a
+/// design that does not slice does not print.
+fn prints(d: &Design, min_overlap: f64, cancel: &Cancel) -> Result<bool, Unchecked> {
+    let Ok(sampled) = surface::sample_surface(d) else {
+        return Ok(false);
+    };
+    match run(Arc::new(sampled), d, min_overlap, cancel, || Ok(io::sink())) {
+        Ok((c, _)) => Ok(c.report.printable),
+        Err(Unchecked::Design(_)) => Ok(false),
+        Err(e) => Err(e),
+    }
+}
+
+/// The largest rise of the design's rim (its shape, crests and angle
+/// kept, at most its own rise) whose plan prints, to 0.5 mm below, by
+/// bisection between a level rim and the design's: where the rim rises
+/// in several places, one path reaches the crests only while the spiral
+/// absorbs the valleys between them (docs/ALGORITHMS.md §8), and the
+/// refusal names the most that does. `None` if the design does not print
+/// with its rim level.
+fn most_rise(job: &Job, cancel: &Cancel) -> Result<Option<f64>, Unchecked> {
+    let d = job.design();
+    let Some(rim) = d.rim.clone() else {
+        return Ok(None);
+    };
+    let with = |rise: f64| {
+        let mut t = d.clone();
+        t.rim = Some(sweepclay_core::rim::RimSpec {
+            rise,
+            ..rim.clone()
+        });
+        t
+    };
+    if !prints(&with(0.0), job.min_overlap(), cancel)? {
+        return Ok(None);
+    }
+    // On a 0.5 mm grid, so that the figure said is one that printed.
+    let (mut good, mut bad) = (0u32, (rim.rise / 0.5).ceil() as u32);
+    while bad - good > 1 {
+        go_on(cancel)?;
+        let mid = (good + bad) / 2;
+        if prints(&with(0.5 * f64::from(mid)), job.min_overlap(), cancel)? {
+            good = mid;
+        } else {
+            bad = mid;
+        }
+    }
+    Ok(Some(0.5 * f64::from(good)))
 }
 
 /// The largest twist of the design's sense (at most its own) whose plan
@@ -125,21 +185,10 @@ pub fn plan<W: Write>(
 /// does not print untwisted.
 fn most_twist(job: &Job, cancel: &Cancel) -> Result<Option<f64>, Unchecked> {
     let d = job.design();
-    let prints = |deg: f64| -> Result<bool, Unchecked> {
+    let prints = |deg: f64| {
         let mut t = d.clone();
         t.twist_deg = deg;
-        // Sampled apart from the job's store: the bisection's designs
-        // would push the potter's out of it.
-        let Ok(sampled) = surface::sample_surface(&t) else {
-            return Ok(false);
-        };
-        match run(Arc::new(sampled), &t, job.min_overlap(), cancel, || {
-            Ok(io::sink())
-        }) {
-            Ok((c, _)) => Ok(c.report.printable),
-            Err(Unchecked::Design(_)) => Ok(false),
-            Err(e) => Err(e),
-        }
+        prints(&t, job.min_overlap(), cancel)
     };
     if !prints(0.0)? {
         return Ok(None);
@@ -274,6 +323,7 @@ fn run<W: Write>(
         let body = report.findings[Finding::NozzleCollision].count > 0;
         let checked = Checked {
             most_twist: None,
+            most_rise: None,
             sliced,
             out: w,
             report,
@@ -533,6 +583,42 @@ mod tests {
         // A design that prints has no such figure; nor one without twist.
         d.twist_deg = 0.0;
         assert_eq!(checked(&d, 0.5).most_twist, None);
+    }
+
+    #[test]
+    fn a_wave_rim_too_high_for_one_path_names_the_most_that_prints() {
+        // Three 20 mm crests on the 80 mm cylinder: the spiral would climb
+        // and fall between them faster than the body clears, and partial
+        // layers reach only one crest. The refusal names the most rise of
+        // the same wave that prints, and that much prints.
+        let mut d = Design::from_json(examples::example("cylinder").unwrap()).unwrap();
+        d.rim = Some(sweepclay_core::rim::RimSpec {
+            shape: sweepclay_core::rim::RimShape::Wave,
+            rise: 20.0,
+            toward_deg: 90.0,
+            peaks: Some(3),
+            width_deg: None,
+        });
+        let c = checked(&d, 0.5);
+        assert!(!c.report.printable);
+        let (most, _) = c.most_rise.clone().expect("the level cylinder prints");
+        assert!((5.0..20.0).contains(&most), "{most}");
+        assert!(
+            c.advice()
+                .iter()
+                .any(|a| a.contains("3-crest wave rises 20.0 mm")
+                    && a.contains(&format!("at most {most:.1} mm of rise"))),
+            "{:?}",
+            c.advice()
+        );
+        d.rim.as_mut().unwrap().rise = most;
+        let ok = checked(&d, 0.5);
+        assert!(
+            ok.report.printable,
+            "at {most} mm: {:?}",
+            ok.report.failures
+        );
+        assert_eq!(ok.most_rise, None);
     }
 
     #[test]

@@ -17,7 +17,7 @@ import { list, plainWords, setBusy, setVerdict, showError, showNote } from './st
 import { fmtMm } from './numbers.js';
 import { currentPrinter, fillPrinterOptions, keptPrinters, openPrinter, withMyPrinter } from './printer-dialog.js';
 import { editors } from './editors-panel.js';
-import './pots-panel.js';
+import { showRimMost } from './pots-panel.js';
 import { downloadFrom } from './files.js';
 import './transform-panel.js';
 
@@ -251,6 +251,7 @@ function showSlice(job, res, t0) {
   // The preview carries its verdict: one edit, one plan (docs/MODELER.md).
   if (current && body.verdict) {
     setVerdict(body.verdict);
+    showRimMost(body.verdict);
     // For the speed budget (docs/MODELER.md): last edit → its verdict.
     if (state.lastEditAt != null) state.verdictTimes.push(performance.now() - state.lastEditAt);
     if (state.verdictTimes.length > 100) state.verdictTimes.shift();

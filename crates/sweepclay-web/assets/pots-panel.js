@@ -203,8 +203,33 @@ function fillRim(d) {
   put('rim-width', r ? r.width_deg ?? 120 : null);
 }
 
-// A shape's starting values: a rim 20 mm higher at the back.
+// A shape's starting values: a rim 20 mm higher at the back; a wave
+// 5 mm high (three crests of 20 mm meet the extruder body on most pots:
+// the spiral must climb and fall between them faster than it clears).
 const RIM_START = { rise: 20, toward_deg: 90 };
+const WAVE_START_RISE = 5;
+
+/**
+ * Beside the rim's fields, the most rise of this rim that prints, when
+ * the verdict found it (docs/MODELER.md), with a button that takes it.
+ */
+export function showRimMost(verdict) {
+  const most = verdict?.most_rise;
+  const rim = state.design?.rim;
+  const show = most != null && rim != null && most < rim.rise;
+  $('rim-most').hidden = !show;
+  if (show) {
+    $('rim-most-mm').textContent = fmtMm(most);
+    $('rim-most-use').dataset.mm = String(most);
+    // The panel scrolls: the offer is beside the field, where it is read.
+    $('rim-most').scrollIntoView({ block: 'nearest' });
+  }
+}
+$('rim-most-use').addEventListener('click', (e) => {
+  const most = Number(e.target.dataset.mm);
+  $('rim-most').hidden = true;
+  edit((d) => { if (d.rim) d.rim.rise = most; }, true);
+});
 
 $('rim-shape').addEventListener('change', (e) => edit((d) => {
   const shape = e.target.value;
@@ -213,7 +238,8 @@ $('rim-shape').addEventListener('change', (e) => edit((d) => {
     return;
   }
   const old = d.rim || RIM_START;
-  d.rim = { shape, rise: old.rise, toward_deg: old.toward_deg ?? 90 };
+  const rise = shape === 'wave' && old.shape !== 'wave' ? Math.min(old.rise, WAVE_START_RISE) : old.rise;
+  d.rim = { shape, rise, toward_deg: old.toward_deg ?? 90 };
   if (shape === 'wave') d.rim.peaks = old.peaks ?? 3;
   if (shape === 'raised') d.rim.width_deg = old.width_deg ?? 120;
 }, true));

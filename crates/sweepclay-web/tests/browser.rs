@@ -2151,6 +2151,105 @@ async fn a_pot_gets_a_raised_back_from_the_rim_control() {
     no_page_errors_and_close(c).await;
 }
 
+/// The wavy rim (docs/MODELER.md): picked on a new pot it prints as it
+/// comes (three crests of 5 mm); raised to 20 mm the spiral cannot climb
+/// and fall between the crests, and the verdict's most rise shows beside
+/// the field; taking it prints.
+#[tokio::test(flavor = "multi_thread")]
+async fn a_wavy_rim_prints_as_it_comes_and_offers_the_most_that_prints() {
+    let Some(Session {
+        tmp: _tmp,
+        downloads: _downloads,
+        driver: _driver,
+        c,
+        base,
+    }) = Session::start().await
+    else {
+        return;
+    };
+    c.goto(&format!("{base}/?example=vase")).await.unwrap();
+    close_guide(&c).await;
+    wait_js(&c, PRINTABLE, "the vase").await;
+    click(&c, "new-pot").await;
+    wait_js(
+        &c,
+        &format!(
+            "return {IDLE} && !window.sweepclay.design.profile_end && {}",
+            &PRINTABLE[7..]
+        ),
+        "a new pot",
+    )
+    .await;
+    set_value(&c, "rim-shape", "wave").await;
+    wait_js(
+        &c,
+        &format!(
+            "return {IDLE} && window.sweepclay.design.rim?.shape === 'wave' && {}",
+            &PRINTABLE[7..]
+        ),
+        "the wavy rim as it comes, printable",
+    )
+    .await;
+    assert_eq!(
+        js(&c, "return [window.sweepclay.design.rim.rise, window.sweepclay.design.rim.peaks, document.getElementById('rim-most').hidden]").await,
+        json!([5, 3, true])
+    );
+    set_value(&c, "rim-rise", "20").await;
+    let most = wait_js(
+        &c,
+        &format!(
+            "return {IDLE} && window.sweepclay.design.rim.rise === 20 && document.getElementById('verdict').dataset.printable === 'false' && !document.getElementById('rim-most').hidden ? Number(document.getElementById('rim-most-mm').textContent) : null"
+        ),
+        "the 20 mm wave refused, with the most that prints",
+    )
+    .await;
+    let most = most.as_f64().unwrap();
+    assert!((5.0..20.0).contains(&most), "{most}");
+    let verdict = js(&c, "return document.getElementById('verdict').textContent").await;
+    assert!(
+        verdict
+            .as_str()
+            .unwrap()
+            .contains(&format!("at most {most:.1} mm of rise")),
+        "{verdict}"
+    );
+    if let Ok(dir) = std::env::var("SWEEPCLAY_SCREENSHOTS") {
+        std::fs::write(
+            format!("{dir}/wavy-most.png"),
+            c.screenshot().await.unwrap(),
+        )
+        .unwrap();
+        c.set_window_size(390, 844).await.unwrap();
+        let _ = c
+            .execute(
+                "document.getElementById('rim-most').scrollIntoView({block: 'center'})",
+                vec![],
+            )
+            .await;
+        std::fs::write(
+            format!("{dir}/wavy-most-phone.png"),
+            c.screenshot().await.unwrap(),
+        )
+        .unwrap();
+        c.set_window_size(1440, 900).await.unwrap();
+    }
+    click(&c, "rim-most-use").await;
+    wait_js(
+        &c,
+        &format!(
+            "return {IDLE} && window.sweepclay.design.rim.rise === {most} && {}",
+            &PRINTABLE[7..]
+        ),
+        "the most rise taken, printable",
+    )
+    .await;
+    assert_eq!(
+        js(&c, "return document.getElementById('rim-most').hidden").await,
+        json!(true)
+    );
+    no_page_errors_and_close(c).await;
+}
+
 #[tokio::test(flavor = "multi_thread", worker_threads = 2)]
 async fn the_cold_open_is_a_pot_and_its_guide_starts_from_new_pot() {
     // A potter's first minute: the page opens on a pot typed as widths at

@@ -67,6 +67,7 @@ pub fn slice_view(job: &Job, cancel: &Cancel) -> Result<SliceView, ApiError> {
         reshaped: checked.sliced.corrected.reshaped(),
         min_overlap: checked.report.support.min_overlap.map(|(f, _)| f),
         lines: checked.report.lines,
+        most_rise: checked.most_rise.as_ref().map(|(most, _)| *most),
     };
     let (moved, printed) = moved_from(&drawn, &checked.sliced.corrected);
     drop(drawn);
@@ -148,6 +149,9 @@ pub struct Verdict {
     pub min_overlap: Option<f64>,
     /// Lines of G-code.
     pub lines: usize,
+    /// For a rim that does not print: the most rise of it that does (mm;
+    /// the modeler offers it beside the rim's field).
+    pub most_rise: Option<f64>,
 }
 
 /// Plans, emits and checks a job, through the correction loop
@@ -162,6 +166,7 @@ pub fn verified(job: &Job, cancel: &Cancel) -> Result<Verified, ApiError> {
         locations: c.locations,
         advice,
         reshaped,
+        most_rise: c.most_rise.map(|(most, _)| most),
     })
 }
 
@@ -175,6 +180,7 @@ pub fn verdict(v: &Verified) -> Verdict {
         reshaped: v.reshaped.clone(),
         min_overlap: v.report.support.min_overlap.map(|(f, _)| f),
         lines: v.report.lines,
+        most_rise: v.most_rise,
     }
 }
 
