@@ -380,6 +380,21 @@ fn rims_slanted_raised_and_waved_print_as_drawn() {
         assert_eq!(v.arc.is_some(), raised, "{what}");
         let r = common::check_full(&s);
         assert!(r.printable, "{what}: {}", r.render());
+        // The returning turns' climbs lay no bead narrower than w_min, as
+        // the checker reads each against the clay under it, nor taller
+        // than it is wide (issue 57, point 5: 1.3–1.5 mm beads 2 mm tall
+        // climbed the slanted rim's edge).
+        assert_eq!(r.support.thin.count, 0, "{what}: {}", r.render());
+        let (w, h) = (&s.extrusion.width, &s.extrusion.layer_height);
+        let w_min = s.corrected.surface.params.width_min;
+        for i in 0..w.len() {
+            assert!(
+                w[i] >= w_min - 1e-9 && h[i] <= w[i] + 1e-9,
+                "{what}: point {i}: {} wide, {} tall",
+                w[i],
+                h[i]
+            );
+        }
         let top = path_top(&s);
         let rim = tallest(&s);
         // A raised arc's tops reach the rim; a spiral's rim turn ends
