@@ -192,7 +192,7 @@ pub fn spiral_floor_covering(
         }
         // A flush spiral that covers nearly all is kept over a blended
         // one that covers a little more.
-        if step.is_none() && flush && best.as_ref().is_some_and(|(c, _)| *c >= FLUSH_ENOUGH) {
+        if step.is_none() && best.as_ref().is_some_and(|(c, _)| *c >= FLUSH_ENOUGH) {
             return Ok(best.expect("just kept").1.spiral);
         }
         let blended;
@@ -654,11 +654,10 @@ fn path_length(pts: &[[f64; 2]]) -> f64 {
     pts.windows(2).map(|w| dist(w[0], w[1])).sum()
 }
 
+/// The length of a ring given with its first point again at its end
+/// (never 0: it divides).
 fn perimeter(ring: &[[f64; 2]]) -> f64 {
-    ring.windows(2)
-        .map(|w| dist(w[0], w[1]))
-        .sum::<f64>()
-        .max(1e-12)
+    path_length(ring).max(1e-12)
 }
 
 /// A ray from a polygon point inward to its foot on the spine.

@@ -30,20 +30,17 @@ impl<W> Checked<W> {
         // The most rise of this rim that prints, said once: with the
         // body's collisions (the usual cause), else on its own.
         let rise = self.most_rise.as_ref().map(|(most, rim)| {
-            let shape = match (rim.shape, rim.peaks) {
-                (RimShape::Wave, Some(k)) if k > 1 => format!("{k}-crest wave"),
-                (RimShape::Wave, _) => "wave".to_string(),
-                (RimShape::Slant, _) => "slant".to_string(),
-                (RimShape::Raised, _) => "raised arc".to_string(),
+            let (shape, fewer) = match (rim.shape, rim.peaks) {
+                (RimShape::Wave, Some(k)) if k > 1 => {
+                    (format!("{k}-crest wave"), ", or more with fewer crests")
+                }
+                (RimShape::Wave, _) => ("wave".to_string(), ""),
+                (RimShape::Slant, _) => ("slant".to_string(), ""),
+                (RimShape::Raised, _) => ("raised arc".to_string(), ""),
             };
             format!(
-                "the rim's {shape} rises {:.1} mm, more than one continuous path climbs here; at most {most:.1} mm of rise prints this pot (rim.rise){}",
-                rim.rise,
-                if rim.shape == RimShape::Wave && rim.peaks.unwrap_or(1) > 1 {
-                    ", or more with fewer crests"
-                } else {
-                    ""
-                }
+                "the rim's {shape} rises {:.1} mm, more than one continuous path climbs here; at most {most:.1} mm of rise prints this pot (rim.rise){fewer}",
+                rim.rise
             )
         });
         let collides = self.report.findings[Finding::NozzleCollision]

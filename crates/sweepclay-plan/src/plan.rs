@@ -13,6 +13,7 @@ use std::io::{self, Write};
 use std::sync::Arc;
 use sweepclay_check::{Finding, Report};
 use sweepclay_core::correct::{correct_with, Tightening};
+use sweepclay_core::rim::RimSpec;
 use sweepclay_core::toolpath::PointKind;
 use sweepclay_core::{surface, Design, Sliced};
 
@@ -42,7 +43,7 @@ pub struct Checked<W> {
     /// below; 0 when only a level rim does), found by bisection, and that
     /// rim as designed. `None` when it prints, has no rim, or does not
     /// print level either.
-    pub most_rise: Option<(f64, sweepclay_core::rim::RimSpec)>,
+    pub most_rise: Option<(f64, RimSpec)>,
 }
 
 /// Why a slicing whose check fails cannot be corrected: the error
@@ -122,7 +123,7 @@ pub fn plan<W: Write>(
         checked.most_twist = most_twist(job, cancel)?;
     }
     if !checked.report.printable && job.design().rim.as_ref().is_some_and(|r| r.rise > 0.0) {
-        checked.most_rise = most_rise(job, cancel)?.zip(job.design().rim.clone());
+        checked.most_rise = most_rise(job, cancel)?;
     }
     Ok(Planned { checked, drawn })
 }
@@ -141,69 +142,67 @@ fn prints(d: &Design, min_overlap: f64, cancel: &Cancel) -> Result<bool, Uncheck
     }
 }
 
+/// The largest multiple of `grid` up to `limit` at which the job's design,
+/// changed by `at`, prints: bisected on the grid from 0, so the figure a
+/// refusal names is one that printed. `None` if it does not print at 0
+/// (the knob is not the cause).
+fn most_that_prints(
+    job: &Job,
+    cancel: &Cancel,
+    limit: f64,
+    grid: f64,
+    at: impl Fn(f64) -> Design,
+) -> Result<Option<f64>, Unchecked> {
+    let prints = |v: f64| prints(&at(v), job.min_overlap(), cancel);
+    if !prints(0.0)? {
+        return Ok(None);
+    }
+    let (mut good, mut bad) = (0u32, (limit / grid).ceil() as u32);
+    while bad - good > 1 {
+        go_on(cancel)?;
+        let mid = (good + bad) / 2;
+        if prints(grid * f64::from(mid))? {
+            good = mid;
+        } else {
+            bad = mid;
+        }
+    }
+    Ok(Some(grid * f64::from(good)))
+}
+
 /// The largest rise of the design's rim (its shape, crests and angle
-/// kept, at most its own rise) whose plan prints, to 0.5 mm below, by
-/// bisection between a level rim and the design's: where the rim rises
-/// in several places, one path reaches the crests only while the spiral
-/// absorbs the valleys between them (docs/ALGORITHMS.md §8), and the
-/// refusal names the most that does. `None` if the design does not print
-/// with its rim level.
-fn most_rise(job: &Job, cancel: &Cancel) -> Result<Option<f64>, Unchecked> {
+/// kept, at most its own rise) whose plan prints, to 0.5 mm below, and
+/// that rim: where the rim rises in several places, one path reaches the
+/// crests only while the spiral absorbs the valleys between them
+/// (docs/ALGORITHMS.md §8), and the refusal names the most that does.
+/// `None` if the design has no rim or does not print with it level.
+fn most_rise(job: &Job, cancel: &Cancel) -> Result<Option<(f64, RimSpec)>, Unchecked> {
     let d = job.design();
     let Some(rim) = d.rim.clone() else {
         return Ok(None);
     };
-    let with = |rise: f64| {
+    let most = most_that_prints(job, cancel, rim.rise, 0.5, |rise| {
         let mut t = d.clone();
-        t.rim = Some(sweepclay_core::rim::RimSpec {
+        t.rim = Some(RimSpec {
             rise,
             ..rim.clone()
         });
         t
-    };
-    if !prints(&with(0.0), job.min_overlap(), cancel)? {
-        return Ok(None);
-    }
-    // On a 0.5 mm grid, so that the figure said is one that printed.
-    let (mut good, mut bad) = (0u32, (rim.rise / 0.5).ceil() as u32);
-    while bad - good > 1 {
-        go_on(cancel)?;
-        let mid = (good + bad) / 2;
-        if prints(&with(0.5 * f64::from(mid)), job.min_overlap(), cancel)? {
-            good = mid;
-        } else {
-            bad = mid;
-        }
-    }
-    Ok(Some(0.5 * f64::from(good)))
+    })?;
+    Ok(most.map(|m| (m, rim)))
 }
 
 /// The largest twist of the design's sense (at most its own) whose plan
-/// prints, to 5° below, by bisection between the
-/// untwisted design and the design's twist: a refusal then names the
-/// most the shape takes (docs/ALGORITHMS.md §11). `None` if the design
-/// does not print untwisted.
+/// prints, to 5° below: a refusal then names the most the shape takes
+/// (docs/ALGORITHMS.md §11). `None` if the design does not print
+/// untwisted.
 fn most_twist(job: &Job, cancel: &Cancel) -> Result<Option<f64>, Unchecked> {
     let d = job.design();
-    let prints = |deg: f64| {
+    most_that_prints(job, cancel, d.twist_deg.abs(), 5.0, |deg| {
         let mut t = d.clone();
-        t.twist_deg = deg;
-        prints(&t, job.min_overlap(), cancel)
-    };
-    if !prints(0.0)? {
-        return Ok(None);
-    }
-    let (mut good, mut bad) = (0.0f64, d.twist_deg.abs());
-    while bad - good > 5.0 {
-        go_on(cancel)?;
-        let mid = 0.5 * (good + bad);
-        if prints(mid.copysign(d.twist_deg))? {
-            good = mid;
-        } else {
-            bad = mid;
-        }
-    }
-    Ok(Some((good / 5.0).floor() * 5.0))
+        t.twist_deg = deg.copysign(d.twist_deg);
+        t
+    })
 }
 
 /// A print that does not fit its printer, laid as the stages lay it: what

@@ -2045,6 +2045,24 @@ async fn a_texture_and_a_twist_are_added_and_their_gcode_prints() {
     no_page_errors_and_close(c).await;
 }
 
+/// Opens the vase, then New pot, and waits for the new pot's verdict:
+/// printable, with one profile.
+async fn new_pot_from_the_vase(c: &Client, base: &str) {
+    c.goto(&format!("{base}/?example=vase")).await.unwrap();
+    close_guide(c).await;
+    wait_js(c, PRINTABLE, "the vase").await;
+    click(c, "new-pot").await;
+    wait_js(
+        c,
+        &format!(
+            "return {IDLE} && !window.sweepclay.design.profile_end && {}",
+            &PRINTABLE[7..]
+        ),
+        "a new pot",
+    )
+    .await;
+}
+
 /// The pot panel's rim control (docs/MODELER.md): a new pot's rim raised
 /// 30 mm at the back becomes the design's `rim`, prints (the raised part as
 /// partial layers, which the statistics say), and the G-code downloaded
@@ -2061,19 +2079,7 @@ async fn a_pot_gets_a_raised_back_from_the_rim_control() {
     else {
         return;
     };
-    c.goto(&format!("{base}/?example=vase")).await.unwrap();
-    close_guide(&c).await;
-    wait_js(&c, PRINTABLE, "the vase").await;
-    click(&c, "new-pot").await;
-    wait_js(
-        &c,
-        &format!(
-            "return {IDLE} && !window.sweepclay.design.profile_end && {}",
-            &PRINTABLE[7..]
-        ),
-        "a new pot",
-    )
-    .await;
+    new_pot_from_the_vase(&c, &base).await;
     // Only a shape's own fields show.
     assert_eq!(
         js(&c, "return ['rim-rise-l', 'rim-peaks-l', 'rim-width-l'].map((id) => document.getElementById(id).hidden)").await,
@@ -2167,19 +2173,7 @@ async fn a_wavy_rim_prints_as_it_comes_and_offers_the_most_that_prints() {
     else {
         return;
     };
-    c.goto(&format!("{base}/?example=vase")).await.unwrap();
-    close_guide(&c).await;
-    wait_js(&c, PRINTABLE, "the vase").await;
-    click(&c, "new-pot").await;
-    wait_js(
-        &c,
-        &format!(
-            "return {IDLE} && !window.sweepclay.design.profile_end && {}",
-            &PRINTABLE[7..]
-        ),
-        "a new pot",
-    )
-    .await;
+    new_pot_from_the_vase(&c, &base).await;
     set_value(&c, "rim-shape", "wave").await;
     wait_js(
         &c,
