@@ -143,17 +143,21 @@ PRUSA_START = (
 )
 
 
-def prusa(tool, stl, out, tmp, layer=LAYER, width=WIDTH):
+def prusa(tool, stl, out, tmp, layer=LAYER, width=WIDTH, first_width=None, retract=2):
+    """`tool`'s spiral vase of `stl`: `width` beads on `layer` layers, the
+    first layer's beads `first_width` wide (default `width`), retracting
+    `retract` mm where the slicer travels."""
+    first_width = width if first_width is None else first_width
     cmd = [
         tool, "--export-gcode" if tool == "prusa-slicer" else "--gcode-comments",
         "--spiral-vase", "--perimeters", "1", "--layer-height", str(layer),
         "--first-layer-height", str(layer), "--nozzle-diameter", str(width),
-        "--extrusion-width", str(width), "--first-layer-extrusion-width", str(width),
+        "--extrusion-width", str(width), "--first-layer-extrusion-width", str(first_width),
         "--filament-diameter", str(FEED_DIA), "--bottom-solid-layers", "0",
         "--top-solid-layers", "0", "--skirts", "0", "--fill-density", "0",
         "--center" if tool == "prusa-slicer" else "--print-center", "100,100", "--bed-shape", "0x0,200x0,200x200,0x200",
         "--perimeter-speed", "30", "--first-layer-speed", "30",
-        "--retract-length", "2", "-o", out, stl,
+        "--retract-length", str(retract), "-o", out, stl,
     ]
     if tool == "prusa-slicer":
         cmd[1:1] = ["--max-print-height", "200", "--start-gcode", PRUSA_START.replace("\\n", "\n")]
@@ -371,6 +375,23 @@ def vase_call(stl, path, layer, width, first, *more):
             *more, "-o", path, stl]
 
 
+def wide_first_files(tmp):
+    """Issue 55, class 1: vases whose first layer is laid wider than the
+    wall (a first-layer width of 9.5 mm under 4 mm beads: a setting for a
+    footing that holds on the board), retraction off as clay needs. The
+    wall's first turn rises from that loop's top, 2.75 mm in from its
+    outer edge, from a short move across the loop just laid."""
+    cyl = os.path.join(tmp, "wide-cylinder.stl")
+    write_stl(cyl, lambda z, t: 30.0, 24, 16, 128)
+    prusa("prusa-slicer", cyl, os.path.join(OUT, "prusa-wide-first.gcode"), tmp,
+          layer=1.5, width=4.0, first_width=9.5, retract=0)
+    bowl = os.path.join(tmp, "bowl.stl")
+    write_stl(bowl, bowl_r, 36, 20, 64)
+    lw = dict(layer=BOWL_LAYER, width=BOWL_WIDTH, first_width=9.5, retract=0)
+    prusa("prusa-slicer", bowl, os.path.join(OUT, "prusa-wide-bowl.gcode"), tmp, **lw)
+    prusa("slic3r", bowl, os.path.join(OUT, "slic3r-wide-bowl.gcode"), tmp, **lw)
+
+
 def round5_files(tmp, vase):
     """Issue 55: PrusaSlicer's vase of a plain cylinder whose first layer
     is 3.0 mm, the tallest first layer the checker takes (class 1: its
@@ -400,6 +421,7 @@ def main():
         cone_files(tmp, defs)
         firmware_files(tmp, defs, vase)
         round5_files(tmp, vase)
+        wide_first_files(tmp)
         prusa("prusa-slicer", vase, os.path.join(OUT, "prusa-vase.gcode"), tmp)
         prusa("prusa-slicer", ripple, os.path.join(OUT, "prusa-ripple.gcode"), tmp)
         prusa("slic3r", vase, os.path.join(OUT, "slic3r-vase.gcode"), tmp)

@@ -5,6 +5,10 @@
 
 use super::*;
 
+/// At most this many of the run's last beads are asked whether a move
+/// climbing from them lies on their fresh clay: work bounded per move.
+const FRESH_BEADS: usize = 64;
+
 /// A thin bead fails for its gap only beyond this many times the gap
 /// under the beads before it (docs/CHECKER.md, "Layer gaps").
 pub(super) const DEEP_GAP: f64 = 1.5;
@@ -257,6 +261,28 @@ impl Checker<'_> {
                     }
                 }
             }
+            // A move climbing from the run's fresh clay across its top (a
+            // spiral's first move from a wider first loop out to its wall)
+            // lies on clay no search counts (the last 2 w_max of path is
+            // the tip's own): its clay is read against the gap over it,
+            // as a ramp's is (docs/CHECKER.md, "Ramps").
+            if !on_clay && support.is_none() && m.to[2] > m.from[2] {
+                let fresh = (0..id as usize)
+                    .rev()
+                    .take(FRESH_BEADS)
+                    .map_while(|k| beads.get(k))
+                    .take_while(|b| b.s_end > s_start - 2.0 * cfg.width_max)
+                    .filter(|b| !b.step && !crate::support::is_smear(b.width(), cfg))
+                    .find_map(|b| {
+                        let (d, z, _) = b.closest(mid);
+                        let gap = mid[2] - z;
+                        (d < b.width() / 2.0 && (0.0..cfg.min_layer_mm).contains(&gap))
+                            .then_some(gap)
+                    });
+                if let Some(gap) = fresh {
+                    flow_width = volume / (len * gap.max(crate::support::SAME_HEIGHT_MM));
+                }
+            }
             rest = Some(match support {
                 _ if on_clay => Rest::Clay,
                 Some(c) => Rest::Bead(c.id),
@@ -313,7 +339,21 @@ impl Checker<'_> {
                     } else {
                         width
                     };
-                    (dz, overlap_fraction(core, c.width, c.d), c.d, c.height)
+                    // Its lean is how far its edge passes the edge of the
+                    // bead below, never more than the centrelines' offset: a
+                    // narrower bead leans only where it passes that bead's
+                    // edge. One thinner than that bead is as wide as its clay
+                    // would lie on a layer as tall (its angle is taken over
+                    // that height, below), and no narrower than the nozzle
+                    // lays: clay squeezed wider is pressed out, not a lean
+                    // (docs/CHECKER.md, "Overhangs").
+                    let lean_width = if dz < 0.95 * c.height {
+                        core.min((volume / (len * c.height.max(1e-9))).max(cfg.width_min))
+                    } else {
+                        core
+                    };
+                    let offset = c.d.min((c.d + 0.5 * (lean_width - c.width)).max(0.0));
+                    (dz, overlap_fraction(core, c.width, c.d), offset, c.height)
                 }
                 None if near_bed => {
                     r.support.on_bed += 1;
@@ -646,6 +686,75 @@ mod tests {
             "{}",
             r.render()
         );
+    }
+
+    #[test]
+    fn a_narrow_bead_on_a_wide_one_leans_only_past_its_edge() {
+        // Three 6 mm passes, then 3.2 mm beads 1.9 mm to the side: their
+        // centrelines lean atan(1.9 / 1.2) = 57.7°, past the limit (every
+        // move failed), but their edge passes the wide bead's by 0.5 mm:
+        // atan(0.5 / 1.2) = 22.6°. The same passes on 3.2 mm passes still
+        // fail.
+        let passes = |first: f64| {
+            let mut g = G::new([50.0, 50.0, LAYER]);
+            for k in 1..=3 {
+                let (z, x) = (LAYER * k as f64, if k % 2 == 1 { 90.0 } else { 50.0 });
+                if k > 1 {
+                    g.bead([g.at[0], 50.0, z], first, LAYER);
+                }
+                g.run([x, 50.0, z], first, LAYER);
+            }
+            g.bead([90.0, 50.0, 4.0 * LAYER], W, LAYER);
+            g.bead([90.0, 51.9, 4.0 * LAYER], W, LAYER);
+            g.run([50.0, 51.9, 4.0 * LAYER], W, LAYER);
+            g.bead([50.0, 51.9, 5.0 * LAYER], W, LAYER);
+            g.run([90.0, 51.9, 5.0 * LAYER], W, LAYER);
+            verdict(&g.out)
+        };
+        let r = passes(6.0);
+        assert!(r.printable, "{}", r.render());
+        let (angle, _) = r.support.max_overhang_deg.unwrap();
+        assert!((angle - 22.6).abs() < 1.0, "{angle}\n{}", r.render());
+        assert!(!passes(W).printable);
+    }
+
+    #[test]
+    fn a_move_across_the_loop_just_laid_is_read_against_its_gap() {
+        // A 6 mm flat loop, then a 2 mm move out across its end to the
+        // wall's line, climbing 0.1 mm with the clay of its gap
+        // (PrusaSlicer's and Slic3r's first move from a wide first loop),
+        // then the wall's spiral. The loop under that move was laid within
+        // the last 2 w_max of path, so no search counts it: the move read
+        // as a bead on the bed, 1.25 mm tall and 0.13 mm wide,
+        // under-extruded. With a fifth of its gap's clay it still is.
+        let wall = |share: f64| {
+            // The loop and the wall share their angles, as a slicer's
+            // vase does: each bead's middle lies over a bead of the loop.
+            let (c, r, rw) = ((100.0, 100.0), 20.0, 22.0);
+            let per = (std::f64::consts::TAU * rw).round();
+            let at = |k: f64, r: f64| {
+                let a = std::f64::consts::TAU * k / per;
+                (c.0 + r * a.cos(), c.1 + r * a.sin())
+            };
+            let mut g = G::new([c.0 + r, c.1, LAYER]);
+            for k in 1..=per as usize {
+                let (x, y) = at(k as f64, r);
+                g.bead([x, y, LAYER], 6.0, LAYER);
+            }
+            // Straight out to the wall's line, 2 mm: longer than a dip the
+            // flow is averaged over.
+            let (x, y) = at(0.0, rw);
+            let start = LAYER + 0.1;
+            g.bead([x, y, start], share * W, 0.05);
+            for k in 1..=3 * per as usize {
+                let (x, y) = at(k as f64, rw);
+                g.bead([x, y, start + LAYER * k as f64 / per], W, LAYER);
+            }
+            verdict(&g.out)
+        };
+        let r = wall(1.0);
+        assert!(r.printable, "{}", r.render());
+        fails_for(&wall(0.2), "under-extruded", &[]);
     }
 
     #[test]
