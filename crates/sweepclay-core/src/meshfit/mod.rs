@@ -1073,6 +1073,41 @@ fn candidate(g: &Frame, d: &[Vec<f64>], s: &[f64], two: Option<(&[f64], &[f64])>
     }
 }
 
+/// A profile's values `v` at the sections' heights `zs`, from the bed
+/// to the rim at `height`: the lowest section's value carried down to
+/// z 0 as the lowest two sections lean (held upright there, the curve
+/// had to turn a corner a cubic rounds by up to a fifth of a millimetre
+/// at a flaring foot, and took four times the points), the highest held
+/// up to the top through a lip as far apart as the sections (one far
+/// point there let the curve through them turn back down); a rim within
+/// half a section of the highest is reached as the wall leans too.
+fn bed_to_rim(v: &[f64], zs: &[f64], height: f64) -> Vec<[f64; 2]> {
+    let foot = match (v.get(1), zs.get(1)) {
+        (Some(&v1), Some(&z1)) if z1 > zs[0] => v[0] - (v1 - v[0]) / (z1 - zs[0]) * zs[0],
+        _ => v[0],
+    };
+    let mut pts: Vec<[f64; 2]> = vec![[foot, 0.0]];
+    pts.extend(v.iter().zip(zs).map(|(&x, &z)| [x, z]));
+    let (n, last) = (v.len(), v[v.len() - 1]);
+    let step = zs.get(1).map_or(height, |z1| z1 - zs[0]).max(1e-3);
+    let top = zs[n - 1];
+    if top + 0.5 * step >= height && n > 1 && top > zs[n - 2] {
+        // The rim within half a section of the highest: on as it leans.
+        pts.push([
+            last + (last - v[n - 2]) / (top - zs[n - 2]) * (height - top),
+            height,
+        ]);
+        return pts;
+    }
+    let mut z = top + step;
+    while z < height - 0.5 * step {
+        pts.push([last, z]);
+        z += step;
+    }
+    pts.push([last, height]);
+    pts
+}
+
 /// [`candidate`], its profiles by [`fewest`] within two thirds of the
 /// tolerance first (`few`), or through the values within a third.
 fn candidate_with(
@@ -1090,20 +1125,7 @@ fn candidate_with(
         tol,
     } = *g;
     let profile = |v: &[f64]| -> Vec<[f64; 2]> {
-        // From the bed to the rim: the lowest and highest sections'
-        // values held to z 0 and the top, through a lip as far apart as
-        // the sections (one far point there let the curve through them
-        // turn back down).
-        let mut pts: Vec<[f64; 2]> = vec![[v[0], 0.0]];
-        pts.extend(v.iter().zip(zs).map(|(&x, &z)| [x, z]));
-        let last = v[v.len() - 1];
-        let step = zs.get(1).map_or(height, |z1| z1 - zs[0]).max(1e-3);
-        let mut z = zs[zs.len() - 1] + step;
-        while z < height - 0.5 * step {
-            pts.push([last, z]);
-            z += step;
-        }
-        pts.push([last, height]);
+        let pts = bed_to_rim(v, zs, height);
         match few.then(|| fewest(&pts, 2.0 * tol / 3.0)).flatten() {
             Some(c) => c,
             None => profile_through(&pts, tol),
