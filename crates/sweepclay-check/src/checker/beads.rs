@@ -333,7 +333,8 @@ impl Checker<'_> {
                     // wider than the widest bead, is pressed onto it and
                     // spreads over its shoulders: judged by its core, a
                     // bead as wide as the one it is pressed on.
-                    let pressed = width > c.width && dz < 0.95 * c.height;
+                    let thinner = dz < 0.95 * c.height;
+                    let pressed = width > c.width && thinner;
                     let core = if width > cfg.width_max || pressed {
                         width.min(c.width.max(cfg.width_min))
                     } else {
@@ -347,7 +348,7 @@ impl Checker<'_> {
                     // that height, below), and no narrower than the nozzle
                     // lays: clay squeezed wider is pressed out, not a lean
                     // (docs/CHECKER.md, "Overhangs").
-                    let lean_width = if dz < 0.95 * c.height {
+                    let lean_width = if thinner {
                         core.min((volume / (len * c.height.max(1e-9))).max(cfg.width_min))
                     } else {
                         core

@@ -1082,21 +1082,14 @@ fn candidate(g: &Frame, d: &[Vec<f64>], s: &[f64], two: Option<(&[f64], &[f64])>
 /// point there let the curve through them turn back down); a rim within
 /// half a section of the highest is reached as the wall leans too.
 fn bed_to_rim(v: &[f64], zs: &[f64], height: f64) -> Vec<[f64; 2]> {
-    let foot = match (v.get(1), zs.get(1)) {
-        (Some(&v1), Some(&z1)) if z1 > zs[0] => v[0] - (v1 - v[0]) / (z1 - zs[0]) * zs[0],
-        _ => v[0],
-    };
-    let mut pts: Vec<[f64; 2]> = vec![[foot, 0.0]];
-    pts.extend(v.iter().zip(zs).map(|(&x, &z)| [x, z]));
-    let (n, last) = (v.len(), v[v.len() - 1]);
+    let n = v.len();
+    let at = |i: usize| [v[i], zs[i]];
+    let mut pts: Vec<[f64; 2]> = vec![[lean_to(at(0), at(1.min(n - 1)), 0.0), 0.0]];
+    pts.extend((0..n).map(at));
     let step = zs.get(1).map_or(height, |z1| z1 - zs[0]).max(1e-3);
-    let top = zs[n - 1];
-    if top + 0.5 * step >= height && n > 1 && top > zs[n - 2] {
-        // The rim within half a section of the highest: on as it leans.
-        pts.push([
-            last + (last - v[n - 2]) / (top - zs[n - 2]) * (height - top),
-            height,
-        ]);
+    let (last, top) = (v[n - 1], zs[n - 1]);
+    if top + 0.5 * step >= height {
+        pts.push([lean_to(at(n - 1), at(n.saturating_sub(2)), height), height]);
         return pts;
     }
     let mut z = top + step;
@@ -1106,6 +1099,17 @@ fn bed_to_rim(v: &[f64], zs: &[f64], height: f64) -> Vec<[f64; 2]> {
     }
     pts.push([last, height]);
     pts
+}
+
+/// The value at height `z` on the line through `near` and `far` (`[x,
+/// z]`): `near`'s own where the two are level.
+fn lean_to(near: [f64; 2], far: [f64; 2], z: f64) -> f64 {
+    let rise = near[1] - far[1];
+    if rise.abs() > 1e-12 {
+        near[0] + (near[0] - far[0]) / rise * (z - near[1])
+    } else {
+        near[0]
+    }
 }
 
 /// [`candidate`], its profiles by [`fewest`] within two thirds of the
