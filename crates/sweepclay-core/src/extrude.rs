@@ -262,6 +262,35 @@ pub fn plan_extrusion(path: &Toolpath, params: &Params, origin: [f64; 2]) -> Ext
     }
 }
 
+/// The width [`plan_extrusion`] gives the lowest bead of a column of
+/// beads each resting on the one before, `leans[k]` the offset of bead
+/// k + 1 from bead k (mm): each bead as wide as the lean onto it and off
+/// it needs (Algorithm 3), and widened to the bead above where that one
+/// would overlap it too little, the rule run down from the top, as
+/// `plan_extrusion` runs it over the path backwards. Linear in the beads.
+/// The floor plans its outer ring with it before the path exists
+/// (docs/ALGORITHMS.md §8, "A flush foot").
+pub fn lowest_bead_width(leans: &[f64], params: &Params) -> f64 {
+    let (wmin, wmax, ov) = (params.width_min, params.width_max, params.overlap);
+    let need = |d: f64| (d / (1.0 - ov)).clamp(wmin, wmax);
+    // Bead j + 1 is final when bead j is reached: (its width, its lean).
+    let mut above: Option<(f64, f64)> = None;
+    for j in (0..=leans.len()).rev() {
+        let own = j.checked_sub(1).map_or(wmin, |k| need(leans[k]));
+        let mut w = own.max(leans.get(j).map_or(wmin, |&d| need(d)));
+        if let Some((wa, d)) = above {
+            if overlap_fraction(wa, w, d) < ov {
+                w = w.max(wa);
+            }
+        }
+        match j.checked_sub(1) {
+            Some(k) => above = Some((w, leans[k])),
+            None => return w,
+        }
+    }
+    wmin
+}
+
 /// Whether the move into point `i` is a step: it climbs (or drops) at
 /// least half as much as it runs in plan, as the checker reads a step
 /// (docs/CHECKER.md, "Turns"), on the coordinates the G-code carries
@@ -371,6 +400,44 @@ mod tests {
                 (t.points[i].pos[0] - t.points[i - 1].pos[0]).abs(),
             );
             assert!(f >= p.overlap - 1e-12, "bead {i} overlap {f}");
+        }
+    }
+
+    #[test]
+    fn the_lowest_bead_of_a_column_is_as_wide_as_the_path_makes_it() {
+        let p = Params::default();
+        // Closed forms (w_min 3, w_max 6, overlap 2/3: a lean of d needs
+        // 3d): upright, one lean of 1.5, a lean past w_max.
+        assert_eq!(lowest_bead_width(&[], &p), 3.0);
+        assert_eq!(lowest_bead_width(&[0.0, 0.0], &p), 3.0);
+        assert!((lowest_bead_width(&[1.5], &p) - 4.5).abs() < 1e-12);
+        assert_eq!(lowest_bead_width(&[0.0, 3.0], &p), 6.0);
+        // A lean high up widens the whole column below it: beads 4.5
+        // wide, 0.96 apart, overlap a 3 mm bead by 0.62 < 2/3.
+        assert!((lowest_bead_width(&[0.96, 0.96, 1.5], &p) - 4.5).abs() < 1e-12);
+        // The same as `plan_extrusion` over such columns, leaning either
+        // way by up to 2 mm a layer.
+        let mut x = 0.37_f64;
+        for _ in 0..200 {
+            let leans: Vec<f64> = (0..6)
+                .map(|_| {
+                    x = (x * 7.31 + 0.17).fract();
+                    4.0 * x - 2.0
+                })
+                .collect();
+            let offsets: Vec<f64> = std::iter::once(0.0)
+                .chain(leans.iter().scan(0.0, |at, d| {
+                    *at += d;
+                    Some(*at)
+                }))
+                .collect();
+            let e = plan_extrusion(&column(&offsets, 1.25), &p, [0.0; 2]);
+            let abs: Vec<f64> = leans.iter().map(|d| d.abs()).collect();
+            assert!(
+                (lowest_bead_width(&abs, &p) - e.width[0]).abs() < 1e-12,
+                "{leans:?}: {:?}",
+                e.width
+            );
         }
     }
 

@@ -10,6 +10,7 @@
 //! turn. Every sample is visited exactly once.
 
 use crate::correct::Corrected;
+use crate::extrude::lowest_bead_width;
 use crate::floor::{
     coverage, ring_area, spiral_floor_covering, FloorRefusal, FloorSpiral, MIN_COVER,
 };
@@ -319,6 +320,7 @@ fn vessel_floor(c: &Corrected, v: &VesselPlan) -> Result<LaidFloor, FloorRefusal
             [p[0], p[1]]
         })
         .collect();
+    let mut out = first_turn_excess(c, v, &corrected);
     // The cover reported and judged is measured on a 0.5 mm grid (the
     // spiral was chosen on a 1 mm one).
     let lay = |ring: Vec<[f64; 2]>| {
@@ -328,7 +330,21 @@ fn vessel_floor(c: &Corrected, v: &VesselPlan) -> Result<LaidFloor, FloorRefusal
             spiral,
         })
     };
-    let first = lay(corrected);
+    // The floor's last bead runs on to under the wall's first point: moved
+    // out, a floor that ends more than half a bead from it would run back
+    // across its own outer ring (2.8 mm on a rounded triangle whose rim
+    // bead leaned 2 mm at the start, widening that column to w_max), so
+    // it is laid where the wall is instead.
+    let start = corrected[0];
+    let ends_near = |f: &LaidFloor| {
+        (f.spiral.pts.first())
+            .is_some_and(|p| (p[0] - start[0]).hypot(p[1] - start[1]) <= 0.5 * s.params.width_min)
+    };
+    let mut first = lay(moved_out(&corrected, &out));
+    if out.iter().any(|&e| e > 0.0) && first.as_ref().is_ok_and(|f| !ends_near(f)) {
+        out.fill(0.0);
+        first = lay(corrected);
+    }
     if first.as_ref().is_ok_and(|f| f.cover >= MIN_COVER) {
         return first;
     }
@@ -341,6 +357,7 @@ fn vessel_floor(c: &Corrected, v: &VesselPlan) -> Result<LaidFloor, FloorRefusal
             [q[0], q[1]]
         })
         .collect();
+    let drawn = moved_out(&drawn, &out);
     let moved = first.as_ref().map_or(true, |f| {
         f.ring
             .iter()
@@ -355,6 +372,80 @@ fn vessel_floor(c: &Corrected, v: &VesselPlan) -> Result<LaidFloor, FloorRefusal
         (Ok(a), Err(_)) => Ok(a),
         (Err(_), b) => b,
     }
+}
+
+/// How far the wall's first turn's bead reaches outside a floor bead on
+/// the same line, at each column from the start column on (mm, ≥ 0): half
+/// of what it is laid wider than `width_min`. The extrusion stage widens
+/// a column's beads where the one above leans off them, down the whole
+/// column (the paper's Algorithm 3; [`lowest_bead_width`]), and a bead
+/// taller than wide. The floor's outermost ring goes out by that much, so
+/// its outer edge is the wall's (docs/ALGORITHMS.md §8, "A flush foot"):
+/// under the bowl, whose wall leans out as it rises, the first turn was
+/// laid 3.8 mm wide on 3 mm floor beads, its edge 0.4 mm outside them.
+fn first_turn_excess(c: &Corrected, v: &VesselPlan, ring: &[[f64; 2]]) -> Vec<f64> {
+    let s = &c.surface;
+    let n = s.columns.len();
+    let (wmin, wmax) = (s.params.width_min, s.params.width_max);
+    let floor_top = v.base_mm();
+    let mut leans = Vec::new();
+    (0..n)
+        .map(|m| {
+            let i = (v.start + m) % n;
+            let col = &s.columns[i];
+            let first = col.first as usize;
+            // Each bead's lean off the one below: across the wall where
+            // the column twists (the rest runs along the bead below, as
+            // the extrusion stage reads it), else all of it.
+            leans.clear();
+            leans.extend((1..col.len()).map(|k| {
+                let (a, b) = (s.position(i, first + k - 1), s.position(i, first + k));
+                let d = [b[0] - a[0], b[1] - a[1]];
+                let full = d[0].hypot(d[1]);
+                if col.twist == 0.0 {
+                    return full;
+                }
+                let (p, q) = (ring[(m + n - 1) % n], ring[(m + 1) % n]);
+                let t = [q[0] - p[0], q[1] - p[1]];
+                let l = t[0].hypot(t[1]);
+                if l < 1e-2 {
+                    full
+                } else {
+                    ((t[0] * d[1] - t[1] * d[0]) / l).abs()
+                }
+            }));
+            let a = s.position(i, first);
+            let w = lowest_bead_width(&leans, &s.params).max((a[2] - floor_top).min(wmax));
+            0.5 * (w - wmin).max(0.0)
+        })
+        .collect()
+}
+
+/// `ring` with each point moved `out[m]` mm along the ring's outward
+/// normal there (the chord of its neighbours turned a right angle).
+fn moved_out(ring: &[[f64; 2]], out: &[f64]) -> Vec<[f64; 2]> {
+    let n = ring.len();
+    // Positive area: counter-clockwise, the outside on the chord's right.
+    let ccw = (0..n)
+        .map(|m| {
+            let (p, q) = (ring[m], ring[(m + 1) % n]);
+            p[0] * q[1] - q[0] * p[1]
+        })
+        .sum::<f64>()
+        > 0.0;
+    let side = if ccw { 1.0 } else { -1.0 };
+    (0..n)
+        .map(|m| {
+            let (p, q) = (ring[(m + n - 1) % n], ring[(m + 1) % n]);
+            let t = [q[0] - p[0], q[1] - p[1]];
+            let l = t[0].hypot(t[1]);
+            if out[m] <= 0.0 || l < 1e-9 {
+                return ring[m];
+            }
+            let k = side * out[m] / l;
+            [ring[m][0] + k * t[1], ring[m][1] - k * t[0]]
+        })
+        .collect()
 }
 
 /// What the path of a vessel holds beyond its points.

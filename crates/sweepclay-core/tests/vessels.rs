@@ -668,3 +668,73 @@ fn a_raised_rim_keeps_the_body_it_rises_from() {
         );
     }
 }
+
+/// Per 5° about the floor's middle, the outermost edge of the floor's top
+/// layer minus that of the wall's first turn (mm; + a ledge, − a notch),
+/// each bead's edge its middle plus half the width the extrusion gives it
+/// (as `scripts/foot-flush` reads a G-code file).
+fn foot_steps(s: &sweepclay_core::Sliced) -> Vec<f64> {
+    let t = &s.toolpath;
+    let w = &s.extrusion.width;
+    let floor_top = t
+        .points
+        .iter()
+        .filter(|p| p.kind == PointKind::Floor)
+        .map(|p| p.pass)
+        .max()
+        .expect("a floor");
+    let top: Vec<usize> = (0..t.points.len())
+        .filter(|&i| t.points[i].kind == PointKind::Floor && t.points[i].pass == floor_top)
+        .collect();
+    let k = top.len() as f64;
+    let c = top.iter().fold([0.0, 0.0], |c, &i| {
+        [c[0] + t.points[i].pos[0] / k, c[1] + t.points[i].pos[1] / k]
+    });
+    let mut edges = [[f64::NEG_INFINITY; 2]; 72];
+    for (i, p) in t.points.iter().enumerate() {
+        let layer = match p.kind {
+            PointKind::Floor if p.pass == floor_top => 0,
+            PointKind::Pass if p.pass == floor_top + 1 => 1,
+            _ => continue,
+        };
+        let (dx, dy) = (p.pos[0] - c[0], p.pos[1] - c[1]);
+        let bin = ((dy.atan2(dx).to_degrees().rem_euclid(360.0)) / 5.0) as usize % 72;
+        let e = &mut edges[bin][layer];
+        *e = e.max(dx.hypot(dy) + 0.5 * w[i]);
+    }
+    edges
+        .iter()
+        .filter(|e| e.iter().all(|v| v.is_finite()))
+        .map(|e| e[0] - e[1])
+        .collect()
+}
+
+#[test]
+fn a_foot_under_a_wall_leaning_out_is_flush_with_its_wider_first_turn() {
+    // The bundled bowl leans out from its foot: the extrusion stage lays
+    // its first turn 3.8 mm wide (the turns above lean off it), and its
+    // edge stood 0.41 mm outside the 3 mm floor beads all round.
+    let (_, text) = sweepclay_core::examples::EXAMPLES
+        .iter()
+        .find(|(n, _)| *n == "bowl.json")
+        .expect("the bowl");
+    let s = slice(&Design::from_json(text).expect("valid")).expect("slices");
+    let first = s
+        .toolpath
+        .points
+        .iter()
+        .position(|p| p.kind == PointKind::Pass)
+        .expect("a wall");
+    assert!(
+        s.extrusion.width[first] > 3.5,
+        "{}",
+        s.extrusion.width[first]
+    );
+    let steps = foot_steps(&s);
+    assert!(steps.len() >= 70, "{} bins", steps.len());
+    let worst = steps.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
+    assert!(
+        worst <= 0.3,
+        "the foot steps by up to {worst:.2} mm: {steps:?}"
+    );
+}
