@@ -933,7 +933,30 @@ impl Candidate {
         // The loop fitted in the frame turned back by the first angle,
         // turned forward: every ray and offset turns with it.
         let forward = self.twist.0.sin_cos();
-        let psi = self.psi.iter().map(|&p| turn_by(p, forward)).collect();
+        // The design reads a profile from its foot (x − x(0),
+        // docs/FORMATS.md), the fit from Ψ: where a profile's foot is off
+        // Ψ (carried on to the bed as the wall leans), Ψ moves out to it
+        // along each ray, by the feet blended as λ blends the profiles
+        // there. Left on Ψ, the sprout planter printed 0.4 mm out at every
+        // height.
+        let foot = |c: &[[f64; 2]]| c.first().map_or(0.0, |p| p[0]);
+        let (fs, ft) = (foot(&self.start), foot(&self.end));
+        let lam = if self.two {
+            lambda_round(&self.interp, self.psi.len())
+        } else {
+            vec![0.0; self.psi.len()]
+        };
+        let psi = (0..self.psi.len())
+            .map(|j| {
+                let f = (1.0 - lam[j]) * fs + lam[j] * ft;
+                let (p, dir) = (self.psi[j], ray(&self.psi, j, self.offset));
+                turn_by([p[0] + f * dir[0], p[1] + f * dir[1]], forward)
+            })
+            .collect();
+        let from_foot = |c: &[[f64; 2]]| -> Vec<[f64; 2]> {
+            let f = foot(c);
+            c.iter().map(|p| [p[0] - f, p[1]]).collect()
+        };
         let traj = TrajectorySpec {
             control_points: None,
             points: Some(psi),
@@ -943,7 +966,7 @@ impl Candidate {
         let mut v = serde_json::json!({
             "sweepclay": 1,
             "name": name,
-            "profile_start": CurveSpec { control_points: self.start.clone(), points: None },
+            "profile_start": CurveSpec { control_points: from_foot(&self.start), points: None },
             "trajectory": traj,
         });
         if let Some(t) = &self.texture {
@@ -956,7 +979,7 @@ impl Candidate {
         }
         if self.two {
             v["profile_end"] = serde_json::json!(CurveSpec {
-                control_points: self.end.clone(),
+                control_points: from_foot(&self.end),
                 points: None,
             });
             v["interpolation"] = serde_json::json!(CurveSpec {
@@ -1112,6 +1135,15 @@ fn lean_to(near: [f64; 2], far: [f64; 2], z: f64) -> f64 {
     }
 }
 
+/// λ at each of `n` points evenly round the loop, from the
+/// interpolation curve's control points.
+fn lambda_round(interp: &[[f64; 2]], n: usize) -> Vec<f64> {
+    let c = BSpline::clamped(interp.to_vec())
+        .expect("points")
+        .flatten(16);
+    (0..n).map(|j| at_x(&c, j as f64 / n as f64)).collect()
+}
+
 /// [`candidate`], its profiles by [`fewest`] within two thirds of the
 /// tolerance first (`few`), or through the values within a third.
 fn candidate_with(
@@ -1161,12 +1193,7 @@ fn candidate_with(
         Vec::new()
     };
     let lam: Vec<f64> = if two.is_some() {
-        let c = BSpline::clamped(interp.clone())
-            .expect("points")
-            .flatten(16);
-        (0..psi.len())
-            .map(|j| at_x(&c, j as f64 / psi.len() as f64))
-            .collect()
+        lambda_round(&interp, psi.len())
     } else {
         vec![0.0; psi.len()]
     };

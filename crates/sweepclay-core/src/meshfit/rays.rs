@@ -190,6 +190,26 @@ pub(super) fn crossings(l: &[[f64; 2]], o: [f64; 2], d: [f64; 2]) -> Vec<(f64, u
 /// in: how many rays, and where the largest fold was (x, y, z).
 type Offsets = (Vec<Vec<f64>>, Vec<[f64; 2]>, (usize, Option<[f64; 3]>));
 
+/// The direction Ψ's point `j` is offset along (a unit vector): from the
+/// centre o (radial), or Ψ's outward normal there (right of travel on
+/// this counter-clockwise Ψ), as a loop's normal offsets move.
+pub(super) fn ray(psi: &[[f64; 2]], j: usize, offset: Offset) -> [f64; 2] {
+    let n = psi.len();
+    match offset {
+        Offset::Radial => {
+            let p = psi[j];
+            let r = p[0].hypot(p[1]).max(1e-9);
+            [p[0] / r, p[1] / r]
+        }
+        Offset::Normal => {
+            let (a, b) = (psi[(j + n - 1) % n], psi[(j + 1) % n]);
+            let t = [b[0] - a[0], b[1] - a[1]];
+            let l = t[0].hypot(t[1]).max(1e-12);
+            [t[1] / l, -t[0] / l]
+        }
+    }
+}
+
 /// D(k, j): for each section k and each point j of Ψ, the offset of the
 /// section's wall along the ray of the frame (`offset`), and each ray's
 /// direction. Where a ray from the centre (radial) meets a loop more than
@@ -206,20 +226,10 @@ pub(super) fn offsets(
     let n = psi.len();
     let rays: Vec<([f64; 2], [f64; 2], f64)> = (0..n)
         .map(|j| {
-            let p = psi[j];
+            let (p, dir) = (psi[j], ray(psi, j, offset));
             match offset {
-                Offset::Radial => {
-                    let r = p[0].hypot(p[1]).max(1e-9);
-                    ([0.0, 0.0], [p[0] / r, p[1] / r], r)
-                }
-                Offset::Normal => {
-                    let (a, b) = (psi[(j + n - 1) % n], psi[(j + 1) % n]);
-                    let t = [b[0] - a[0], b[1] - a[1]];
-                    let l = t[0].hypot(t[1]).max(1e-12);
-                    // Outward, as a loop's normal offsets move (right
-                    // of travel on this counter-clockwise Ψ).
-                    (p, [t[1] / l, -t[0] / l], 0.0)
-                }
+                Offset::Radial => ([0.0, 0.0], dir, p[0].hypot(p[1])),
+                Offset::Normal => (p, dir, 0.0),
             }
         })
         .collect();
