@@ -1187,6 +1187,24 @@ async fn modeler_speed_budget() {
         .and_then(|v| v.parse().ok())
         .unwrap_or(20);
     let q = |v: &[f64], f: f64| v[((v.len() as f64 - 1.0) * f).round() as usize];
+    // SWEEPCLAY_BENCH_LOAD=N: N threads spinning beside the browser and
+    // the server for the whole run, a machine busy with other work.
+    let load: usize = std::env::var("SWEEPCLAY_BENCH_LOAD")
+        .ok()
+        .and_then(|v| v.parse().ok())
+        .unwrap_or(0);
+    let stop = std::sync::Arc::new(std::sync::atomic::AtomicBool::new(false));
+    let spinners: Vec<_> = (0..load)
+        .map(|_| {
+            let stop = stop.clone();
+            std::thread::spawn(move || {
+                let mut x = 0u64;
+                while !stop.load(std::sync::atomic::Ordering::Relaxed) {
+                    x = std::hint::black_box(x.wrapping_mul(6364136223846793005).wrapping_add(1));
+                }
+            })
+        })
+        .collect();
     for example in ["t1", "vase"] {
         c.goto(&format!("{base}/?example={example}")).await.unwrap();
         if example == "t1" {
@@ -1257,7 +1275,7 @@ async fn modeler_speed_budget() {
         }
         assert!(!edit.is_empty(), "the edited curve was never painted");
         eprintln!(
-            "modeler speed ({example}, {rounds} drags of 60 moves at 60 Hz, from each event's timeStamp to the painted frame): the edited curve {} frames, median {:.0} ms, 95th percentile {:.0} ms; the sliced preview after the release {} times, median {:.0} ms, 95th percentile {:.0} ms; the verdict median {:.0} ms, max {:.0} ms; the wait before the page hears an event median {:.0} ms; between frames median {:.0} ms, 95th percentile {:.0} ms",
+            "modeler speed ({example}, {rounds} drags of 60 moves at 60 Hz, {load} threads of other work spinning, from each event's timeStamp to the painted frame): the edited curve {} frames, median {:.0} ms, 95th percentile {:.0} ms; the sliced preview after the release {} times, median {:.0} ms, 95th percentile {:.0} ms; the verdict median {:.0} ms, max {:.0} ms; the wait before the page hears an event median {:.0} ms; between frames median {:.0} ms, 95th percentile {:.0} ms",
             edit.len(),
             q(&edit, 0.5),
             q(&edit, 0.95),
@@ -1270,6 +1288,10 @@ async fn modeler_speed_budget() {
             q(&gap, 0.5),
             q(&gap, 0.95),
         );
+    }
+    stop.store(true, std::sync::atomic::Ordering::Relaxed);
+    for t in spinners {
+        t.join().unwrap();
     }
     c.close().await.unwrap();
 }
