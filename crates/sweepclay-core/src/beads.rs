@@ -20,8 +20,9 @@
 //! body's square, so the figure errs low (by at most a cell's diagonal in
 //! reach). One pass, linear in the path's points.
 
-use crate::extrude::{overlap_fraction, Extrusion};
+use crate::extrude::Extrusion;
 use crate::toolpath::Toolpath;
+use crate::widths::overlap_fraction;
 
 /// The four figures of every path point, in path order.
 #[derive(Clone, Debug, Default, PartialEq, serde::Serialize)]

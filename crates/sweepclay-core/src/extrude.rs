@@ -18,6 +18,7 @@
 
 use crate::design::Params;
 use crate::toolpath::Toolpath;
+use crate::widths::{across_chord, lean_width, overlap_fraction};
 
 /// Bead sizes and volumes along a toolpath.
 #[derive(Clone, Debug, PartialEq)]
@@ -66,14 +67,6 @@ impl Extrusion {
 /// screw or piston cannot slow much further without stalling the clay.
 pub const MIN_TURN_FEED: f64 = 0.25;
 
-/// Overlap of a bead of width `wa` with one of width `wb` whose centre is
-/// `s` to the side, as a fraction of `wa`.
-pub fn overlap_fraction(wa: f64, wb: f64, s: f64) -> f64 {
-    let lo = (-wa / 2.0).max(s - wb / 2.0);
-    let hi = (wa / 2.0).min(s + wb / 2.0);
-    ((hi - lo).max(0.0) / wa).min(1.0)
-}
-
 /// How far the point below (`q`) lies across the bead at point `i` on a
 /// twisted surface: the horizontal offset less its part along the path,
 /// which the bead below carries on under it. A twisted vessel's column
@@ -83,7 +76,6 @@ pub fn overlap_fraction(wa: f64, wb: f64, s: f64) -> f64 {
 fn across(path: &Toolpath, i: usize, q: [f64; 3]) -> f64 {
     let p = path.points[i].pos;
     let d = [p[0] - q[0], p[1] - q[1]];
-    let full = d[0].hypot(d[1]);
     // The bead's direction: the chord of its neighbours in its own
     // layer (a step up or down is no part of it).
     let level = |k: usize| {
@@ -96,14 +88,7 @@ fn across(path: &Toolpath, i: usize, q: [f64; 3]) -> f64 {
         .get(i + 1)
         .and_then(|_| level(i + 1))
         .unwrap_or(p);
-    let t = [b[0] - a[0], b[1] - a[1]];
-    let l = t[0].hypot(t[1]);
-    // A chord shorter than a hundredth of a millimetre (a bead's only
-    // point in its layer) gives no direction: the whole offset counts.
-    if l < 1e-2 {
-        return full;
-    }
-    ((t[0] * d[1] - t[1] * d[0]) / l).abs()
+    across_chord([b[0] - a[0], b[1] - a[1]], d)
 }
 
 /// For a twisted vessel, whether point `i` lies behind the start of the
@@ -187,7 +172,7 @@ pub fn plan_extrusion(path: &Toolpath, params: &Params, origin: [f64; 2]) -> Ext
     }
     for i in 0..n {
         if let Some(b) = path.below[i] {
-            let need = (offset[i] / (1.0 - ov)).clamp(wmin, wmax);
+            let need = lean_width(offset[i], params);
             width[i] = width[i].max(need);
             width[b as usize] = width[b as usize].max(need);
         }
@@ -262,35 +247,6 @@ pub fn plan_extrusion(path: &Toolpath, params: &Params, origin: [f64; 2]) -> Ext
     }
 }
 
-/// The width [`plan_extrusion`] gives the lowest bead of a column of
-/// beads each resting on the one before, `leans[k]` the offset of bead
-/// k + 1 from bead k (mm): each bead as wide as the lean onto it and off
-/// it needs (Algorithm 3), and widened to the bead above where that one
-/// would overlap it too little, the rule run down from the top, as
-/// `plan_extrusion` runs it over the path backwards. Linear in the beads.
-/// The floor plans its outer ring with it before the path exists
-/// (docs/ALGORITHMS.md §8, "A flush foot").
-pub fn lowest_bead_width(leans: &[f64], params: &Params) -> f64 {
-    let (wmin, wmax, ov) = (params.width_min, params.width_max, params.overlap);
-    let need = |d: f64| (d / (1.0 - ov)).clamp(wmin, wmax);
-    // Bead j + 1 is final when bead j is reached: (its width, its lean).
-    let mut above: Option<(f64, f64)> = None;
-    for j in (0..=leans.len()).rev() {
-        let own = j.checked_sub(1).map_or(wmin, |k| need(leans[k]));
-        let mut w = own.max(leans.get(j).map_or(wmin, |&d| need(d)));
-        if let Some((wa, d)) = above {
-            if overlap_fraction(wa, w, d) < ov {
-                w = w.max(wa);
-            }
-        }
-        match j.checked_sub(1) {
-            Some(k) => above = Some((w, leans[k])),
-            None => return w,
-        }
-    }
-    wmin
-}
-
 /// Whether the move into point `i` is a step: it climbs (or drops) at
 /// least half as much as it runs in plan, as the checker reads a step
 /// (docs/CHECKER.md, "Turns"), on the coordinates the G-code carries
@@ -340,6 +296,7 @@ pub fn step_volume(w: f64, dz: f64) -> f64 {
 mod tests {
     use super::*;
     use crate::toolpath::{PathPoint, PointKind};
+    use crate::widths::lowest_bead_width;
 
     fn column(offsets: &[f64], dz: f64) -> Toolpath {
         let points: Vec<PathPoint> = offsets
@@ -364,14 +321,6 @@ mod tests {
             vessel: None,
             twisted: false,
         }
-    }
-
-    #[test]
-    fn overlap_fraction_closed_forms() {
-        assert_eq!(overlap_fraction(3.0, 3.0, 0.0), 1.0);
-        assert!((overlap_fraction(3.0, 3.0, 1.0) - 2.0 / 3.0).abs() < 1e-12);
-        assert_eq!(overlap_fraction(3.0, 3.0, 4.0), 0.0);
-        assert!((overlap_fraction(6.0, 3.0, 0.0) - 0.5).abs() < 1e-12);
     }
 
     #[test]

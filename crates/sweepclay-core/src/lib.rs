@@ -71,6 +71,7 @@ pub mod surface;
 pub mod texture;
 pub mod toolpath;
 pub mod vessel;
+pub mod widths;
 
 pub use correct::{Corrected, CorrectionReport};
 pub use design::{Design, Offset, Params};

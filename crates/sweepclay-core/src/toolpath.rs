@@ -10,11 +10,11 @@
 //! turn. Every sample is visited exactly once.
 
 use crate::correct::Corrected;
-use crate::extrude::lowest_bead_width;
 use crate::floor::{
     coverage, ring_area, spiral_floor_covering, FloorRefusal, FloorSpiral, MIN_COVER,
 };
 use crate::vessel::{floor_beads, VesselPlan};
+use crate::widths::{across_chord, lowest_bead_width};
 use serde::Serialize;
 
 /// What kind of sample a path point is.
@@ -401,18 +401,11 @@ fn first_turn_excess(c: &Corrected, v: &VesselPlan, ring: &[[f64; 2]]) -> Vec<f6
             leans.extend((1..col.len()).map(|k| {
                 let (a, b) = (s.position(i, first + k - 1), s.position(i, first + k));
                 let d = [b[0] - a[0], b[1] - a[1]];
-                let full = d[0].hypot(d[1]);
                 if col.twist == 0.0 {
-                    return full;
+                    return d[0].hypot(d[1]);
                 }
                 let (p, q) = (ring[(m + n - 1) % n], ring[(m + 1) % n]);
-                let t = [q[0] - p[0], q[1] - p[1]];
-                let l = t[0].hypot(t[1]);
-                if l < 1e-2 {
-                    full
-                } else {
-                    ((t[0] * d[1] - t[1] * d[0]) / l).abs()
-                }
+                across_chord([q[0] - p[0], q[1] - p[1]], d)
             }));
             let a = s.position(i, first);
             let w = lowest_bead_width(&leans, &s.params).max((a[2] - floor_top).min(wmax));
@@ -425,15 +418,8 @@ fn first_turn_excess(c: &Corrected, v: &VesselPlan, ring: &[[f64; 2]]) -> Vec<f6
 /// normal there (the chord of its neighbours turned a right angle).
 fn moved_out(ring: &[[f64; 2]], out: &[f64]) -> Vec<[f64; 2]> {
     let n = ring.len();
-    // Positive area: counter-clockwise, the outside on the chord's right.
-    let ccw = (0..n)
-        .map(|m| {
-            let (p, q) = (ring[m], ring[(m + 1) % n]);
-            p[0] * q[1] - q[0] * p[1]
-        })
-        .sum::<f64>()
-        > 0.0;
-    let side = if ccw { 1.0 } else { -1.0 };
+    // Counter-clockwise (positive area): the outside on the chord's right.
+    let side = crate::plane::signed_area2(ring).signum();
     (0..n)
         .map(|m| {
             let (p, q) = (ring[(m + n - 1) % n], ring[(m + 1) % n]);

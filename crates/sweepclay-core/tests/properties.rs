@@ -202,7 +202,7 @@ fn prints_in_clay(d: &Design) -> Result<(), TestCaseError> {
         prop_assert!(ex.width[i] >= p.width_min - 1e-12 && ex.width[i] <= p.width_max + 1e-12);
         if let Some(b) = b {
             let (a, q) = (t.points[i].pos, t.points[*b as usize].pos);
-            let f = sweepclay_core::extrude::overlap_fraction(
+            let f = sweepclay_core::widths::overlap_fraction(
                 ex.width[i],
                 ex.width[*b as usize],
                 (a[0] - q[0]).hypot(a[1] - q[1]),

@@ -1158,21 +1158,10 @@ fn lean_to(near: [f64; 2], far: [f64; 2], z: f64) -> f64 {
 /// share of its length its point in `a` (the same loop moved) has there,
 /// at most.
 fn along_shift(a: &[[f64; 2]], b: &[[f64; 2]]) -> f64 {
-    let shares = |l: &[[f64; 2]]| {
-        let n = l.len();
-        let mut at = Vec::with_capacity(n);
-        let mut s = 0.0;
-        for j in 0..n {
-            at.push(s);
-            let (p, q) = (l[j], l[(j + 1) % n]);
-            s += (q[0] - p[0]).hypot(q[1] - p[1]);
-        }
-        (at, s.max(1e-12))
-    };
-    let ((sa, la), (sb, lb)) = (shares(a), shares(b));
-    sa.iter()
-        .zip(&sb)
-        .map(|(x, y)| (y / lb - x / la).abs() * lb)
+    let ((ua, _), (ub, lb)) = (places(a), places(b));
+    ua.iter()
+        .zip(&ub)
+        .map(|(x, y)| (y - x).abs() * lb)
         .fold(0.0, f64::max)
 }
 
