@@ -81,15 +81,17 @@ def bounds(tris):
     return min(zs), max(zs)
 
 
-def compare(mesh, printed):
-    """Per height: (z, mean, worst) of the print's outside less the mesh's."""
+def compare(mesh, printed, cut=0.0):
+    """Per height: (z, mean, worst) of the print's outside less the mesh's;
+    `cut`: the mm of the mesh's bottom the print leaves out (a tilted or
+    round foot cut level), so the print's bed is that high on the mesh."""
     m, p = read_stl(mesh), read_stl(printed)
     (mz0, mz1), (pz0, _) = bounds(m), bounds(p)
     rows = []
     for f in HEIGHTS:
         # Off the heights a mesh's rings of vertices often sit at.
         h = f * (mz1 - mz0) + 0.0137
-        sm, sp = section(m, mz0 + h), section(p, pz0 + h)
+        sm, sp = section(m, mz0 + h), section(p, pz0 + h - cut)
         if not sm or not sp:
             rows.append((h, None, None))
             continue

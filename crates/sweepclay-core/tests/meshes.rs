@@ -457,8 +457,10 @@ fn closed_forms_trimesh_wrote_come_back_as_their_sweeps() {
             z(&g.design.profile_end),
         );
         assert!(
-            (a - lo).abs() < 1e-6 && (b - hi).abs() < 1e-6 && g.sweep.is_none(),
-            "flipped every {every}: {a} {b}"
+            // The rims' heights read between sections (a ray's top
+            // section by a ray either way) agree to a tenth of one.
+            (a - lo).abs() < 0.03 && (b - hi).abs() < 0.03 && g.sweep.is_none(),
+            "flipped every {every}: {a} {b} (as written {lo} {hi})"
         );
         assert!(
             (g.deviation_mm - f.deviation_mm).abs() < 0.02,
@@ -735,5 +737,44 @@ fn a_wall_flaring_from_its_foot_keeps_its_outside_with_its_profile_run_on_to_the
         "the outside is {:+.2} mm off at z {:.1} mm",
         worst.0,
         worst.1
+    );
+}
+
+#[test]
+fn a_round_bottom_stands_on_a_flat_foot_cut_where_clay_holds_its_wall() {
+    // A jar turned as a ball of radius 50 mm on a 4 mm point, open at
+    // z = 80 mm: its wall leans out 87° at the bed, which no bead holds.
+    let ball = |_: f64, z: f64| (2500.0 - (z - 50.0).powi(2)).sqrt().max(2.0);
+    let f = fit(&solid(ball, 80.0, 240, 320), &FitOptions::default()).unwrap();
+    let said = f.absorbed.clone().unwrap_or_default();
+    assert!(said.contains("its bottom is round"), "{said}");
+    // Cut where the wall above leans out past 57° by no more than the
+    // corrections move (5 mm): under the 8.1 mm where the ball itself
+    // leans 57°, over the 1 mm its point takes.
+    let cut: f64 = said
+        .split("cut at z = ")
+        .nth(1)
+        .and_then(|t| t.split(' ').next())
+        .and_then(|t| t.parse().ok())
+        .unwrap_or_else(|| panic!("{said}"));
+    assert!((1.0..8.1).contains(&cut), "{said}");
+    let s = sweepclay_core::slice(&f.design).unwrap();
+    let r = common::check_full(&s);
+    assert!(r.printable, "{}", r.render());
+    // Its widest, 50 mm round at the ball's middle, is the print's: the
+    // bead's outer edge on the mesh's outside.
+    let widest = f
+        .design
+        .profile_start
+        .control_points
+        .iter()
+        .fold(0.0f64, |m, p| m.max(p[0]));
+    assert!(widest > 0.0, "{widest}");
+    // A jar with a flat foot (the same ball cut 10 mm up) keeps it.
+    let footed = |_: f64, z: f64| (2500.0 - (z + 10.0 - 50.0).powi(2)).sqrt();
+    let g = fit(&solid(footed, 70.0, 240, 280), &FitOptions::default()).unwrap();
+    assert!(
+        !g.absorbed.unwrap_or_default().contains("round"),
+        "a flat foot is kept"
     );
 }

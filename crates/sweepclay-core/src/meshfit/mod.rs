@@ -538,6 +538,57 @@ fn tilted_foot(cut: &[sections::Section]) -> Option<usize> {
     (k > 0 && a0 < 0.5 * ak && (c0[0] - ck[0]).hypot(c0[1] - ck[1]) > 0.25 * radius).then_some(k)
 }
 
+/// Where a round bottom (a jar turned on a point, a sphere's underside)
+/// is cut flat (docs/MESHES.md, "A round bottom"): the lowest section
+/// above which the wall's outside, read as the radius of its area, never
+/// leans out past the overhang clay holds (`max_overhang_deg`) by more
+/// than the corrections move a wall (`max_correction_mm`, the defaults
+/// the design gets); `None` when the foot itself is such a section, or
+/// is over [`FOOT_POINT_SHARE`] of that section across. A bowl flaring
+/// 50°, a foot's rounding or a flange keeps its foot; a jar on a 4 mm
+/// point does not. Only the lower half is searched: what leans out
+/// further up is the corrections' (or the check's) to say.
+fn round_bottom(cut: &[sections::Section]) -> Option<usize> {
+    let p = crate::design::Params::default();
+    let lean = p.max_overhang_deg.to_radians().tan();
+    let r: Vec<Option<f64>> = cut
+        .iter()
+        .map(|s| {
+            outside(&s.loops)
+                .map(|i| (0.5 * signed_area2(&s.loops[i]).abs() / std::f64::consts::PI).sqrt())
+        })
+        .collect();
+    // How far the outside above section k leans out past the limit.
+    let excess = |k: usize| -> f64 {
+        let Some(rk) = r[k] else {
+            return f64::INFINITY;
+        };
+        (k + 1..cut.len())
+            .filter_map(|m| r[m].map(|rm| rm - rk - lean * (cut[m].z - cut[k].z)))
+            .fold(0.0, f64::max)
+    };
+    // A bottom that narrows to a point or a small disk is one loop at the
+    // bed; feet or a ring foot are the refusals' and the recess's.
+    if cut.first().is_none_or(|s| s.loops.len() != 1) || excess(0) <= p.max_correction_mm {
+        return None;
+    }
+    // A round bottom narrows to a point under where it is cut: a foot
+    // that is a real base (a flange flaring from it, a pedestal) is the
+    // corrections' and the relief's, as before.
+    (1..cut.len() / 2)
+        .find(|&k| excess(k) <= p.max_correction_mm)
+        .filter(|&k| {
+            r[0].zip(r[k])
+                .is_some_and(|(a, b)| a < FOOT_POINT_SHARE * b)
+        })
+}
+
+/// A round bottom's foot is under this share of the flat foot it is cut
+/// to (a jar on a point: 0.09; a ball of 50 mm sectioned every 0.25 mm,
+/// its first section 0.125 mm up: 0.29; a vase on a 42 mm base flaring
+/// to 80 mm within 3 mm, a flange the corrections shape: 0.53).
+const FOOT_POINT_SHARE: f64 = 0.4;
+
 /// Adds `note` to what the fit says it took in or changed.
 fn say(absorbed: &mut Option<String>, note: String) {
     *absorbed = Some(match absorbed.take() {
@@ -585,6 +636,26 @@ fn fit_with(mesh: &TriMesh, opts: &FitOptions, absorbed: &mut Option<String>) ->
         bed += z0;
         let note = format!(
             "its foot is not level: it meets the bed on one side and is whole {z0:.1} mm up (a tilted export), so the print starts level there, {z0:.1} mm shorter"
+        );
+        say(absorbed, note);
+    }
+    if let Some(k) = round_bottom(&cut) {
+        let z0 = cut[k].z - 0.5 * dz;
+        let across = |s: &sections::Section| {
+            outside(&s.loops).map_or(0.0, |i| {
+                2.0 * (0.5 * signed_area2(&s.loops[i]).abs() / std::f64::consts::PI).sqrt()
+            })
+        };
+        let (foot, flat) = (across(&cut[0]), across(&cut[k]));
+        cut.drain(..k);
+        for s in &mut cut {
+            s.z -= z0;
+        }
+        height -= z0;
+        bed += z0;
+        let note = format!(
+            "its bottom is round: it meets the bed {foot:.1} mm across under a wall leaning out past the {}° clay holds, so it stands on a flat foot cut at z = {z0:.1} mm, {flat:.0} mm across (the print {z0:.1} mm shorter)",
+            crate::design::Params::default().max_overhang_deg
         );
         say(absorbed, note);
     }
@@ -1208,8 +1279,9 @@ fn candidate_with(
                 .fold(0.0, f64::max)
                 .max(1e-9);
             let interp = few
-                .then(|| interpolation_fewest(lambda, 2.0 * tol / (3.0 * spread)))
+                .then(|| interpolation_fewest(lambda, 2.0 * tol / (3.0 * spread), false))
                 .flatten()
+                .map(|(c, _)| c)
                 .unwrap_or_else(|| interpolation_through(lambda));
             (profile(t), interp)
         }

@@ -175,8 +175,18 @@ const SHARP: f64 = 0.52;
 
 /// An interpolation curve through `lambda` (one value a point of Ψ, from
 /// u = 0) by the fewest control points within `limit` of it ([`fewest`],
-/// u in the part of height), its points held in [0, 1] so the curve is.
-pub(super) fn interpolation_fewest(lambda: &[f64], limit: f64) -> Option<Vec<[f64; 2]>> {
+/// u in the part of height), its points held in [0, 1] as the design
+/// file takes them. With `rescale`, points above 1 (a peak's, which a
+/// curve needs to reach λ = 1 there) are kept by dividing f by the
+/// largest, m, returned: the curve is λ / m. Without, m is 1 and the
+/// points are clamped. Either way the curve as written is checked again
+/// (a peak's points clamped to 1 pulled a slanted solid's curve 0.09
+/// under its highest λ).
+pub(super) fn interpolation_fewest(
+    lambda: &[f64],
+    limit: f64,
+    rescale: bool,
+) -> Option<(Vec<[f64; 2]>, f64)> {
     let jj = lambda.len();
     let mut pts: Vec<[f64; 2]> = (0..jj)
         .map(|j| [lambda[j].clamp(0.0, 1.0), j as f64 / jj as f64])
@@ -184,13 +194,25 @@ pub(super) fn interpolation_fewest(lambda: &[f64], limit: f64) -> Option<Vec<[f6
     pts.push([0.0, 1.0]);
     pts[0] = [0.0, 0.0];
     let c = fewest(&pts, limit)?;
+    let m = if rescale {
+        c.iter().map(|p| p[0]).fold(1.0, f64::max)
+    } else {
+        1.0
+    };
     let mut c: Vec<[f64; 2]> = c
         .into_iter()
-        .map(|p| [p[1], p[0].clamp(0.0, 1.0)])
+        .map(|p| [p[1], (p[0] / m).clamp(0.0, 1.0)])
         .collect();
     let last = c.len() - 1;
     c[0] = [0.0, 0.0];
     c[last] = [1.0, 0.0];
+    let line = BSpline::clamped(c.clone())?.flatten(16);
+    let off = (0..jj)
+        .map(|j| (m * at_x(&line, j as f64 / jj as f64) - lambda[j].clamp(0.0, 1.0)).abs())
+        .fold(0.0, f64::max);
+    if off > limit {
+        return None;
+    }
     // As the design file takes it: u rising strictly (a corner repeated
     // three times is not).
     let spec = crate::design::CurveSpec {
@@ -199,7 +221,7 @@ pub(super) fn interpolation_fewest(lambda: &[f64], limit: f64) -> Option<Vec<[f6
     };
     crate::curves::Interpolation::new_closed(Some(&spec))
         .is_ok()
-        .then_some(c)
+        .then_some((c, m))
 }
 
 /// At most `k` of `pts`, evenly chosen, the ends kept.

@@ -117,12 +117,17 @@ pub(super) fn fit_uneven(
     }
     // Each ray's rim: the top of the highest section it reaches, with no
     // gap below it.
-    let mut rim = vec![0.0; jj];
-    for j in 0..jj {
-        let top = (0..d.len())
+    let mut tops = vec![0usize; jj];
+    for (j, top) in tops.iter_mut().enumerate() {
+        *top = (0..d.len())
             .take_while(|&k| d[k][j].is_some())
             .last()
             .unwrap_or(0);
+    }
+    let fine = rim_between_sections(&tops, &zs);
+    let mut rim = vec![0.0; jj];
+    for j in 0..jj {
+        let top = tops[j];
         if let Some(k) = (top + 1..d.len()).find(|&k| d[k][j].is_some()) {
             let p = psi[j];
             return Err(Error::invalid(
@@ -133,7 +138,7 @@ pub(super) fn fit_uneven(
                 ),
             ));
         }
-        rim[j] = zs[top] + 0.5 * dz;
+        rim[j] = fine[j].unwrap_or(zs[top] + 0.5 * dz);
         // The top 3 mm under the rim are its lip: a rim's rounding, the
         // end caps where a rim rises (a ray there can cross a cap, not
         // the wall), a printed wall's last bead standing above its
@@ -218,8 +223,6 @@ pub(super) fn fit_uneven(
         sv.push([a, t * zs_lo]);
         tv.push([a + slope, t * zt_hi]);
     }
-    let start = profile_through(&sv, tol);
-    let end = profile_through(&tv, tol);
     // λ sets the rim's height and blends the profiles: its error moves
     // either by it times their spread; within a third of the tolerance.
     let spread = sv
@@ -228,8 +231,19 @@ pub(super) fn fit_uneven(
         .map(|(a, b)| (a[0] - b[0]).abs())
         .fold(zt_hi - zs_lo, f64::max)
         .max(1e-9);
-    let interp = interpolation_fewest(&lambda, tol / (3.0 * spread))
-        .unwrap_or_else(|| interpolation_through(&lambda));
+    let (interp, peak) = interpolation_fewest(&lambda, tol / (3.0 * spread), true)
+        .unwrap_or_else(|| (interpolation_through(&lambda), 1.0));
+    // A curve that reaches the highest rim only with control points above
+    // 1 blends toward an end profile that far beyond (the surface is
+    // linear in λ, so it is the same surface): the end profile taller by
+    // that share of the spread, λ divided by it.
+    let zt_hi = zs_lo + peak * (zt_hi - zs_lo);
+    for (i, (a, b)) in sv.iter().zip(tv.iter_mut()).enumerate() {
+        b[0] = a[0] + peak * (b[0] - a[0]);
+        b[1] = i as f64 / (m - 1) as f64 * zt_hi;
+    }
+    let start = profile_through(&sv, tol);
+    let end = profile_through(&tv, tol);
     // The design as it will be sampled, against every offset found.
     let (sp, ep) = (dense(&start), dense(&end));
     let lc = BSpline::clamped(interp.clone())
@@ -334,4 +348,118 @@ pub(super) fn fit_uneven(
         moved: [-c[0], -c[1], -bed],
         sweep,
     })
+}
+
+/// Each ray's rim height between the sections, from where the rim
+/// crosses them (docs/MESHES.md, "Uneven rims"): a ray reaching section
+/// `top` but not the next has its rim somewhere in that section's
+/// thickness, and read so a slanted rim is a staircase whose half-section
+/// steps round the loop would tilt the spiral up and down a bead's
+/// height within a few millimetres (the nozzle's body then meets the
+/// clay just laid). Where neighbouring rays reach different sections the
+/// rim crosses the levels between them half-way; each ray is read
+/// linearly between those crossings, a peak or a valley (crossings of
+/// one level on both sides) half a section beyond them at its middle,
+/// and always within the section its ray reaches. `None` for a level rim
+/// (no crossing).
+fn rim_between_sections(tops: &[usize], zs: &[f64]) -> Vec<Option<f64>> {
+    let jj = tops.len();
+    let level = |k: usize| zs[k.min(zs.len() - 1)];
+    let dz = if zs.len() > 1 { zs[1] - zs[0] } else { 0.0 };
+    let crossings: Vec<(f64, f64)> = (0..jj)
+        .filter_map(|j| {
+            let (a, b) = (tops[j], tops[(j + 1) % jj]);
+            (a != b).then(|| {
+                let (lo, hi) = (a.min(b), a.max(b));
+                (j as f64 + 0.5, 0.5 * (level(lo + 1) + level(hi)))
+            })
+        })
+        .collect();
+    if crossings.is_empty() {
+        return vec![None; jj];
+    }
+    let n = crossings.len();
+    (0..jj)
+        .map(|j| {
+            let x = j as f64;
+            // The crossings either side of the ray, round the loop.
+            let i = crossings.partition_point(|c| c.0 < x);
+            let (pa, ha) = if i == 0 {
+                (crossings[n - 1].0 - jj as f64, crossings[n - 1].1)
+            } else {
+                crossings[i - 1]
+            };
+            let (pb, hb) = if i == n {
+                (crossings[0].0 + jj as f64, crossings[0].1)
+            } else {
+                crossings[i]
+            };
+            let s = (x - pa) / (pb - pa);
+            let mut h = ha + s * (hb - ha);
+            if (ha - hb).abs() < 1e-9 {
+                // A peak or a valley between crossings of one level: a
+                // parabola leaving them as steeply as the rim reached
+                // them (the crossings beyond, either side), within the
+                // section.
+                let (ia, ib) = ((i + n - 1) % n, i % n);
+                let before = crossings[(ia + n - 1) % n];
+                let after = crossings[(ib + 1) % n];
+                let w = pb - pa;
+                // A parabola's mean slope over a run beyond its crossing
+                // is its slope there times (w + run) / w.
+                let at = |h: f64, p: f64, q: f64| {
+                    let run = (q - p).rem_euclid(jj as f64).max(1.0);
+                    (ha - h).abs() / run * w / (w + run)
+                };
+                let slope = if n > 2 {
+                    0.5 * (at(before.1, before.0, crossings[ia].0)
+                        + at(after.1, crossings[ib].0, after.0))
+                } else {
+                    2.0 * dz / w
+                };
+                let rise = (slope * w / 4.0).min(dz);
+                let mid = zs[tops[j]] + 0.5 * dz;
+                h += (mid - ha).signum() * rise * 4.0 * s * (1.0 - s);
+            }
+            Some(h.clamp(zs[tops[j]], zs[tops[j]] + dz))
+        })
+        .collect()
+}
+
+#[cfg(test)]
+mod tests {
+    use super::rim_between_sections;
+
+    #[test]
+    fn a_slanted_rim_is_read_between_the_sections_it_crosses() {
+        // A rim cut by a tilted plane round a cylinder, H = 50.1 + 10 cos θ,
+        // sectioned every 0.5 mm: each ray reaches the highest section
+        // at or under its rim.
+        let dz = 0.5;
+        let zs: Vec<f64> = (0..200).map(|k| k as f64 * dz).collect();
+        let jj = 360;
+        let truth: Vec<f64> = (0..jj)
+            .map(|j| 50.1 + 10.0 * (std::f64::consts::TAU * j as f64 / jj as f64).cos())
+            .collect();
+        let tops: Vec<usize> = truth.iter().map(|h| (h / dz).floor() as usize).collect();
+        let fine = rim_between_sections(&tops, &zs);
+        let worst =
+            |f: &dyn Fn(usize) -> f64| (0..jj).map(|j| (f(j) - truth[j]).abs()).fold(0.0, f64::max);
+        let staircase = worst(&|j| zs[tops[j]] + 0.5 * dz);
+        let read = worst(&|j| fine[j].expect("a slanted rim"));
+        assert!(staircase > 0.24, "{staircase}");
+        assert!(
+            read < 0.08,
+            "read {read} mm off (the staircase {staircase})"
+        );
+        let step = (0..jj)
+            .map(|j| (fine[(j + 1) % jj].unwrap() - fine[j].unwrap()).abs())
+            .fold(0.0, f64::max);
+        // The rim rises 0.17 mm a ray at most; the staircase 0.5 mm.
+        assert!(step < 0.26, "{step}");
+        // A level rim is left as the sections read it.
+        assert!(rim_between_sections(&[40; 8], &zs)
+            .iter()
+            .all(Option::is_none));
+    }
 }
