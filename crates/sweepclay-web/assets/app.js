@@ -50,7 +50,16 @@ function sliceAtRest() {
   state.seq++;
   setVerdict('checking');
   clearTimeout(state.restTimer);
-  state.restTimer = setTimeout(() => requestSlice(false, { rest: true }), REST_MS);
+  // A rest is a pause three times as long as the moves' own gaps, at
+  // least REST_MS: on a busy machine a drag's moves reach the page
+  // 100 ms and more apart, and a fixed 100 ms took each gap for a rest,
+  // slicing 15 to 45 times a drag while the server and the worker took
+  // the core the page needed (docs/MODELER.md, "Speed budget").
+  const now = performance.now();
+  const gap = now - state.lastMove;
+  state.lastMove = now;
+  if (gap < 1000) state.moveGap = 0.7 * state.moveGap + 0.3 * gap;
+  state.restTimer = setTimeout(() => requestSlice(false, { rest: true }), Math.max(REST_MS, 3 * state.moveGap));
 }
 
 /** Greys the preview while it shows a design older than the editors'. */

@@ -29,6 +29,10 @@ export const state = {
   sent: 0,
   settling: false,
   restTimer: 0,
+  // When the last drag move came, and the moves' mean gap (ms): a rest
+  // is a pause longer than the moves' own gaps.
+  lastMove: 0,
+  moveGap: 16,
   lastEdit: null,
   roundTrips: [],
   // Pointer event → the painted frame with the edited curve (ms).

@@ -1220,8 +1220,15 @@ async fn modeler_speed_budget() {
         } else {
             1
         };
-        let (mut edit, mut preview, mut verdict, mut input, mut gap) =
-            (Vec::new(), Vec::new(), Vec::new(), Vec::new(), Vec::new());
+        let (mut edit, mut preview, mut verdict, mut input, mut gap, mut work) = (
+            Vec::new(),
+            Vec::new(),
+            Vec::new(),
+            Vec::new(),
+            Vec::new(),
+            Vec::new(),
+        );
+        let mut rests = 0.0;
         for r in 0..rounds {
             js(&c, "const s = window.sweepclay; s.roundTrips = []; s.verdictTimes = []; s.editTimes = []; s.frames.work = []; s.frames.gap = []; s.frames.input = []; return 0").await;
             let top = point_at(&c, editor, "ed.points.length - 1").await;
@@ -1254,7 +1261,7 @@ async fn modeler_speed_budget() {
             .await;
             let v = js(
                 &c,
-                "const s = window.sweepclay; return [s.editTimes, s.roundTrips.filter(r => !r.rest).map(r => r.ms), s.verdictTimes.at(-1), s.frames.input, s.frames.gap]",
+                "const s = window.sweepclay; return [s.editTimes, s.roundTrips.filter(r => !r.rest).map(r => r.ms), s.verdictTimes.at(-1), s.frames.input, s.frames.gap, s.frames.work, [s.roundTrips.filter(r => r.rest).length]]",
             )
             .await;
             let nums = |k: usize| -> Vec<f64> {
@@ -1269,13 +1276,22 @@ async fn modeler_speed_budget() {
             verdict.push(v[2].as_f64().unwrap());
             input.extend(nums(3));
             gap.extend(nums(4));
+            work.extend(nums(5));
+            rests += nums(6)[0];
         }
-        for v in [&mut edit, &mut preview, &mut verdict, &mut input, &mut gap] {
+        for v in [
+            &mut edit,
+            &mut preview,
+            &mut verdict,
+            &mut input,
+            &mut gap,
+            &mut work,
+        ] {
             v.sort_by(f64::total_cmp);
         }
         assert!(!edit.is_empty(), "the edited curve was never painted");
         eprintln!(
-            "modeler speed ({example}, {rounds} drags of 60 moves at 60 Hz, {load} threads of other work spinning, from each event's timeStamp to the painted frame): the edited curve {} frames, median {:.0} ms, 95th percentile {:.0} ms; the sliced preview after the release {} times, median {:.0} ms, 95th percentile {:.0} ms; the verdict median {:.0} ms, max {:.0} ms; the wait before the page hears an event median {:.0} ms; between frames median {:.0} ms, 95th percentile {:.0} ms",
+            "modeler speed ({example}, {rounds} drags of 60 moves at 60 Hz, {load} threads of other work spinning, from each event's timeStamp to the painted frame): the edited curve {} frames, median {:.0} ms, 95th percentile {:.0} ms; the sliced preview after the release {} times, median {:.0} ms, 95th percentile {:.0} ms; the verdict median {:.0} ms, max {:.0} ms; the wait before the page hears an event median {:.0} ms; between frames median {:.0} ms, 95th percentile {:.0} ms; a frame's own work median {:.1} ms, 95th percentile {:.1} ms; {rests} slices sent mid-drag at a rest",
             edit.len(),
             q(&edit, 0.5),
             q(&edit, 0.95),
@@ -1287,6 +1303,8 @@ async fn modeler_speed_budget() {
             q(&input, 0.5),
             q(&gap, 0.5),
             q(&gap, 0.95),
+            q(&work, 0.5),
+            q(&work, 0.95),
         );
     }
     stop.store(true, std::sync::atomic::Ordering::Relaxed);
@@ -2850,6 +2868,75 @@ async fn a_drag_slices_only_when_the_pointer_rests_or_lets_go() {
         Some(false),
         "the preview is no longer greyed"
     );
+    wait_js(&c, PRINTABLE, "the verdict after the drag").await;
+    no_page_errors_and_close(c).await;
+}
+
+#[tokio::test(flavor = "multi_thread", worker_threads = 2)]
+async fn a_drag_on_a_busy_machine_is_not_taken_for_rests() {
+    // A busy machine hands the page a drag's moves 100 ms and more apart
+    // (docs/MODELER.md, "Speed budget"). A rest is a pause longer than the
+    // moves' own gaps: twelve moves 180 ms apart slice at most once (the
+    // first gap, before any gap is known), where a fixed 100 ms sliced at
+    // nearly every one; a second's rest still slices.
+    let Some(Session {
+        tmp: _tmp,
+        downloads: _,
+        driver: _driver,
+        c,
+        base,
+    }) = Session::start().await
+    else {
+        return;
+    };
+    open_first_slice(&c, &base).await;
+    let sent = || async {
+        js(&c, "return window.sweepclay.sent")
+            .await
+            .as_u64()
+            .unwrap()
+    };
+    let sent0 = sent().await;
+    let top = point_at(&c, 1, "ed.points.length - 1").await;
+    let mut m = MouseActions::new("mouse".into())
+        .then(PointerAction::MoveTo {
+            duration: None,
+            x: top.0.round(),
+            y: top.1.round(),
+        })
+        .then(PointerAction::Down {
+            button: MOUSE_BUTTON_LEFT,
+        });
+    for k in 1..=12 {
+        m = m
+            .then(PointerAction::Pause {
+                duration: Duration::from_millis(180),
+            })
+            .then(PointerAction::MoveTo {
+                duration: None,
+                x: top.0.round(),
+                y: (top.1 - 2.0 * k as f64).round(),
+            });
+    }
+    c.perform_actions(m).await.unwrap();
+    let slow = sent().await - sent0;
+    assert!(
+        slow <= 1,
+        "{slow} slices sent while the moves came 180 ms apart"
+    );
+    // A second's rest with the button down is a rest.
+    tokio::time::sleep(Duration::from_millis(1500)).await;
+    wait_js(
+        &c,
+        &format!("return {IDLE} && window.sweepclay.sent > {}", sent0 + slow),
+        "the slice of the rested drag",
+    )
+    .await;
+    c.perform_actions(MouseActions::new("mouse".into()).then(PointerAction::Up {
+        button: MOUSE_BUTTON_LEFT,
+    }))
+    .await
+    .unwrap();
     wait_js(&c, PRINTABLE, "the verdict after the drag").await;
     no_page_errors_and_close(c).await;
 }
