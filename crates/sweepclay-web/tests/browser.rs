@@ -331,15 +331,19 @@ async fn drag(c: &Client, from: (f64, f64), by: (f64, f64), steps: usize) {
         .then(PointerAction::Down {
             button: MOUSE_BUTTON_LEFT,
         });
+    // Moves 40 ms apart, resting half a second after every fifth: a rest
+    // is a pause longer than the drag's own gaps (docs/MODELER.md), so a
+    // drag that rests re-slices there.
     for k in 1..=steps {
         let f = k as f64 / steps as f64;
-        m = m
-            .then(PointerAction::MoveTo {
-                duration: Some(Duration::from_millis(40)),
-                x: (from.0 + by.0 * f).round(),
-                y: (from.1 + by.1 * f).round(),
-            })
-            .pause(Duration::from_millis(60));
+        m = m.then(PointerAction::MoveTo {
+            duration: Some(Duration::from_millis(40)),
+            x: (from.0 + by.0 * f).round(),
+            y: (from.1 + by.1 * f).round(),
+        });
+        if k % 5 == 0 {
+            m = m.pause(Duration::from_millis(500));
+        }
     }
     m = m.then(PointerAction::Up {
         button: MOUSE_BUTTON_LEFT,
