@@ -28,6 +28,10 @@ precision mediump float;
 in vec3 v_col; out vec4 o;
 void main() { o = vec4(v_col, 1.0); }`;
 
+/** The shortest time between two drawings of the edited curves over the
+ * 3D view while they change (ms; docs/MODELER.md, "Speed budget"). */
+const OVERLAY_MS = 66;
+
 const CLAY = [0.83, 0.62, 0.48];
 const MOVED = [1.0, 0.5, 0.0];
 // Outside the printer is violet: red is kept for a bead at a limit.
@@ -209,13 +213,26 @@ export class View3D {
    */
   showCurves(lines, since) {
     // Drawn on the overlay at the frame, never in an input handler: a
-    // drag's many moves make one drawing a frame (docs/MODELER.md).
+    // drag's many moves make one drawing a frame (docs/MODELER.md). And
+    // at most every OVERLAY_MS: the whole overlay redrawn and composited
+    // each frame held the frames 33–50 ms apart where the editor alone
+    // paints every 17 ms, and the finger's curve is the editor's.
     this.curvesSince = this.curvesSince ?? since ?? null;
-    onFrame('view3d-curves', () => {
-      this.lines = typeof lines === 'function' ? lines() : lines;
-      this.drawOverlay();
-      this.timeCurves();
-    });
+    this.nextLines = lines;
+    if (this.overlayTimer) return;
+    const draw = () => {
+      this.overlayTimer = 0;
+      onFrame('view3d-curves', () => {
+        this.overlayAt = performance.now();
+        const l = this.nextLines;
+        this.lines = typeof l === 'function' ? l() : l;
+        this.drawOverlay();
+        this.timeCurves();
+      });
+    };
+    const wait = OVERLAY_MS - (performance.now() - this.overlayAt);
+    if (wait <= 0) draw();
+    else this.overlayTimer = setTimeout(draw, wait);
   }
 
   /**
@@ -580,6 +597,8 @@ export class View3D {
 
   /** Times from edits to their curves on screen (ms), newest last. */
   curveTimes = [];
+  overlayAt = -Infinity;
+  overlayTimer = 0;
 
   drawMesh(m, mode) {
     if (!m) return;
