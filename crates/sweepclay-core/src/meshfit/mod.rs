@@ -551,13 +551,7 @@ fn tilted_foot(cut: &[sections::Section]) -> Option<usize> {
 fn round_bottom(cut: &[sections::Section]) -> Option<usize> {
     let p = crate::design::Params::default();
     let lean = p.max_overhang_deg.to_radians().tan();
-    let r: Vec<Option<f64>> = cut
-        .iter()
-        .map(|s| {
-            outside(&s.loops)
-                .map(|i| (0.5 * signed_area2(&s.loops[i]).abs() / std::f64::consts::PI).sqrt())
-        })
-        .collect();
+    let r: Vec<Option<f64>> = cut.iter().map(area_radius).collect();
     // How far the outside above section k leans out past the limit.
     let excess = |k: usize| -> f64 {
         let Some(rk) = r[k] else {
@@ -581,6 +575,31 @@ fn round_bottom(cut: &[sections::Section]) -> Option<usize> {
             r[0].zip(r[k])
                 .is_some_and(|(a, b)| a < FOOT_POINT_SHARE * b)
         })
+}
+
+/// The radius of a circle of the area inside a section's outside.
+fn area_radius(s: &sections::Section) -> Option<f64> {
+    outside(&s.loops).map(|i| (0.5 * signed_area2(&s.loops[i]).abs() / std::f64::consts::PI).sqrt())
+}
+
+/// Leaves out the sections under `k` (a foot cut level: tilted, or
+/// round), the rest and the pot's `height` and `bed` moved down by where
+/// section `k` begins, which it returns (mm).
+fn cut_foot_level(
+    cut: &mut Vec<sections::Section>,
+    k: usize,
+    dz: f64,
+    height: &mut f64,
+    bed: &mut f64,
+) -> f64 {
+    let z0 = cut[k].z - 0.5 * dz;
+    cut.drain(..k);
+    for s in cut.iter_mut() {
+        s.z -= z0;
+    }
+    *height -= z0;
+    *bed += z0;
+    z0
 }
 
 /// A round bottom's foot is under this share of the flat foot it is cut
@@ -627,32 +646,16 @@ fn fit_with(mesh: &TriMesh, opts: &FitOptions, absorbed: &mut Option<String>) ->
     // degree or two) starts level where its loop is whole.
     let (mut height, mut bed) = (height, lo[2]);
     if let Some(k) = tilted_foot(&cut) {
-        let z0 = cut[k].z - 0.5 * dz;
-        cut.drain(..k);
-        for s in &mut cut {
-            s.z -= z0;
-        }
-        height -= z0;
-        bed += z0;
+        let z0 = cut_foot_level(&mut cut, k, dz, &mut height, &mut bed);
         let note = format!(
             "its foot is not level: it meets the bed on one side and is whole {z0:.1} mm up (a tilted export), so the print starts level there, {z0:.1} mm shorter"
         );
         say(absorbed, note);
     }
     if let Some(k) = round_bottom(&cut) {
-        let z0 = cut[k].z - 0.5 * dz;
-        let across = |s: &sections::Section| {
-            outside(&s.loops).map_or(0.0, |i| {
-                2.0 * (0.5 * signed_area2(&s.loops[i]).abs() / std::f64::consts::PI).sqrt()
-            })
-        };
+        let across = |s: &sections::Section| 2.0 * area_radius(s).unwrap_or(0.0);
         let (foot, flat) = (across(&cut[0]), across(&cut[k]));
-        cut.drain(..k);
-        for s in &mut cut {
-            s.z -= z0;
-        }
-        height -= z0;
-        bed += z0;
+        let z0 = cut_foot_level(&mut cut, k, dz, &mut height, &mut bed);
         let note = format!(
             "its bottom is round: it meets the bed {foot:.1} mm across under a wall leaning out past the {}° clay holds, so it stands on a flat foot cut at z = {z0:.1} mm, {flat:.0} mm across (the print {z0:.1} mm shorter)",
             crate::design::Params::default().max_overhang_deg

@@ -359,9 +359,9 @@ pub(super) fn fit_uneven(
 /// clay just laid). Where neighbouring rays reach different sections the
 /// rim crosses the levels between them half-way; each ray is read
 /// linearly between those crossings, a peak or a valley (crossings of
-/// one level on both sides) half a section beyond them at its middle,
-/// and always within the section its ray reaches. `None` for a level rim
-/// (no crossing).
+/// one level on both sides) as a parabola leaving them as steeply as the
+/// rim reached them, and always within the section its ray reaches.
+/// `None` for a level rim (no crossing).
 fn rim_between_sections(tops: &[usize], zs: &[f64]) -> Vec<Option<f64>> {
     let jj = tops.len();
     let level = |k: usize| zs[k.min(zs.len() - 1)];
