@@ -326,7 +326,8 @@ fn a_mesh_a_few_units_tall_is_taken_as_inches_and_said_so() {
         .starts_with("scale:"));
     m.scale(25.4);
     let f = fit(&m, &FitOptions::default()).unwrap();
-    assert!(f.deviation_mm < 0.05, "{}", f.deviation_mm);
+    // Within the third of the tolerance a round loop's few points keep.
+    assert!(f.deviation_mm <= 0.1, "{}", f.deviation_mm);
 }
 
 #[test]
@@ -399,10 +400,18 @@ fn closed_forms_trimesh_wrote_come_back_as_their_sweeps() {
     let s = sweepclay_core::slice(&f.design).unwrap();
     let r = common::check_full(&s);
     assert!(r.printable, "{}", r.render());
-    // The cylinder's 64 facets are within 0.05 mm of its circle, and the
-    // design's height is the mesh's.
+    // The cylinder's 64 facets come back as a round loop of a few
+    // control points, within a third of the tolerance (the loop's own
+    // share, docs/MESHES.md "Few control points").
     let f = trimesh_form("cylinder").unwrap();
-    assert!(f.deviation_mm < 0.05, "{}", f.deviation_mm);
+    assert!(f.deviation_mm <= 0.1, "{}", f.deviation_mm);
+    let ctrl = f
+        .design
+        .trajectory
+        .control_points
+        .as_ref()
+        .expect("a curve");
+    assert!(ctrl.len() <= 8, "{} points", ctrl.len());
     // The pentagon trimesh swept up 70 mm turning 0.6 rad clockwise from
     // its foot: a twist of −34.4° · 67.5 / 70 from the floor's top on a
     // loop turned by the rest, and a relief for the floor's 2.5 mm where

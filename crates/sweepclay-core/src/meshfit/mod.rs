@@ -4,9 +4,10 @@
 //! centre, or along Ψ's normal) each section's wall lies at an offset
 //! D(k, j); and D is fitted by the design's own form — one profile, or two
 //! blended round the loop by an interpolation curve, D ≈ S(z) + λ(u)·(T(z)
-//! − S(z)) (the paper's §3 sweep, eq. 1–2). The fit's profiles and
-//! interpolation are B-splines of the fewest control points that hold
-//! the tolerance (least squares, or a polyline's corners), and the
+//! − S(z)) (the paper's §3 sweep, eq. 1–2). The fit's profiles,
+//! interpolation and, where it holds, loop are B-splines of the fewest
+//! control points that hold the tolerance (least squares, or a
+//! polyline's corners), and the
 //! largest difference between the fitted design and the mesh's sections
 //! is measured and reported with where it lies. What no bead prints
 //! (details, drainage holes, a floor's groove, creases, a tilted foot)
@@ -28,6 +29,7 @@ use crate::meshread::TriMesh;
 use crate::relief::Relief;
 use crate::sections::{self, signed_area2};
 
+mod loopfit;
 mod rays;
 mod relief;
 mod ribs;
@@ -863,7 +865,29 @@ fn fit_with(mesh: &TriMesh, opts: &FitOptions, absorbed: &mut Option<String>) ->
             ),
         ));
     }
-    let mut design = Design::from_json(&b.json(&opts.name))?;
+    // The loop by few control points where they hold the tolerance and
+    // make a design the file takes (a curve that keeps clear of o and of
+    // itself); else Ψ's points.
+    let few_loop = if sweep.is_none() {
+        b.few_loop(&zs, tol)
+    } else {
+        None
+    };
+    let mut design = None;
+    if let Some((ctrl, dev, worst)) = few_loop {
+        b.loop_ctrl = Some(ctrl);
+        match Design::from_json(&b.json(&opts.name)) {
+            Ok(d) => {
+                design = Some(d);
+                (b.deviation, b.at) = (dev, worst);
+            }
+            Err(_) => b.loop_ctrl = None,
+        }
+    }
+    let mut design = match design {
+        Some(d) => d,
+        None => Design::from_json(&b.json(&opts.name))?,
+    };
     design.name = opts.name.clone();
     let (mut deviation, mut at) = (b.deviation, b.at);
     if sweep.is_some() {
@@ -992,6 +1016,10 @@ struct Candidate {
     twist: (f64, f64),
     /// Rays read at a fold's outside, and where the widest fold was.
     folds: (usize, Option<[f64; 3]>),
+    /// The loop as the control points of a closed curve (in the frame
+    /// the fit measures in), where few hold the tolerance; else Ψ's
+    /// points are the design's polyline.
+    loop_ctrl: Option<Vec<[f64; 2]>>,
 }
 
 impl Candidate {
@@ -1003,10 +1031,10 @@ impl Candidate {
         [x, y, at[2]]
     }
 
-    fn json(&self, name: &str) -> String {
-        // The loop fitted in the frame turned back by the first angle,
-        // turned forward: every ray and offset turns with it.
-        let forward = self.twist.0.sin_cos();
+    /// The loop the design file gets, in the frame the fit measures in
+    /// (before the twist's first turn), and whether it is Ψ as fitted
+    /// (`true`) or moved out to the profiles' feet.
+    fn design_loop(&self) -> (Vec<[f64; 2]>, bool) {
         // The design reads a profile from its foot (x − x(0),
         // docs/FORMATS.md), the fit from Ψ: where a profile's foot is off
         // Ψ (carried on to the bed as the wall leans), Ψ moves out to it
@@ -1044,15 +1072,37 @@ impl Candidate {
             });
         let spacing = perimeter(&self.psi) / self.psi.len().max(1) as f64;
         let keep = self.psi.len() < 3 || crosses || along_shift(&self.psi, &moved) > 0.5 * spacing;
-        let psi = if keep { &self.psi } else { &moved };
-        let psi = psi.iter().map(|&p| turn_by(p, forward)).collect();
+        (if keep { self.psi.clone() } else { moved }, keep)
+    }
+
+    /// The loop as the fewest control points that keep the design
+    /// within `tol` ([`loopfit::loop_fewest`]), the design's new largest
+    /// difference and where (`zs` the sections' heights); `None` where
+    /// sixteen are not enough.
+    fn few_loop(&self, zs: &[f64], tol: f64) -> Option<(Vec<[f64; 2]>, f64, [f64; 3])> {
+        let (psi, _) = self.design_loop();
+        let dirs: Vec<[f64; 2]> = (0..self.psi.len())
+            .map(|j| ray(&self.psi, j, self.offset))
+            .collect();
+        let (ctrl, dev, (k, j)) = loopfit::loop_fewest(&psi, &dirs, &self.residual, tol)?;
+        let z = zs.get(k).copied().unwrap_or(0.0);
+        Some((ctrl, dev, [self.psi[j][0], self.psi[j][1], z]))
+    }
+
+    fn json(&self, name: &str) -> String {
+        // The loop fitted in the frame turned back by the first angle,
+        // turned forward: every ray and offset turns with it.
+        let forward = self.twist.0.sin_cos();
+        let (psi, keep) = self.design_loop();
+        let foot = |c: &[[f64; 2]]| c.first().map_or(0.0, |p| p[0]);
         let from_foot = |c: &[[f64; 2]]| -> Vec<[f64; 2]> {
             let f = if keep { 0.0 } else { foot(c) };
             c.iter().map(|p| [p[0] - f, p[1]]).collect()
         };
+        let turned = |l: &[[f64; 2]]| l.iter().map(|&p| turn_by(p, forward)).collect();
         let traj = TrajectorySpec {
-            control_points: None,
-            points: Some(psi),
+            control_points: self.loop_ctrl.as_deref().map(turned),
+            points: self.loop_ctrl.is_none().then(|| turned(&psi)),
             closed: true,
             offset: self.offset,
         };
@@ -1146,16 +1196,63 @@ fn fit_offsets(
         height,
         tol,
     };
-    let one = candidate(&g, &d, &mean, None);
+    // A design a potter edits point by point first: one profile of few
+    // control points, then two; only then as many points as hold the
+    // tolerance (one profile of 160 points is no simpler to edit than two
+    // of nine).
+    let one = few_points(&g, &d, &mean, None);
+    if one.as_ref().is_some_and(|c| c.deviation <= tol) {
+        return one.expect("just read");
+    }
+    let two = few_points(&g, &d, &s, Some((&t, &lambda)));
+    if two.as_ref().is_some_and(|c| c.deviation <= tol) {
+        return two.expect("just read");
+    }
+    let through = |s: &[f64], two: Option<(&[f64], &[f64])>| {
+        candidate_with(&g, &d, s, two, None).expect("through the values")
+    };
+    let one = nearer(one, through(&mean, None));
     if one.deviation <= tol {
         return one;
     }
-    let two = candidate(&g, &d, &s, Some((&t, &lambda)));
-    if two.deviation < one.deviation {
-        two
-    } else {
-        one
+    nearer(Some(one), nearer(two, through(&s, Some((&t, &lambda)))))
+}
+
+/// The nearer the mesh of a candidate and maybe another.
+fn nearer(a: Option<Candidate>, b: Candidate) -> Candidate {
+    match a {
+        Some(a) if a.deviation <= b.deviation => a,
+        _ => b,
     }
+}
+
+/// The shares of the tolerance a profile of few control points is
+/// tried within, in turn: the rest is left to what the profiles cannot
+/// follow (the wall's changes round the loop).
+const FEW_SHARES: [f64; 4] = [2.0 / 3.0, 1.0 / 2.0, 1.0 / 3.0, 1.0 / 6.0];
+
+/// The design whose profiles have the fewest control points (at most
+/// [`FEWEST_MAX`]) within the largest share of the tolerance
+/// ([`FEW_SHARES`]) that brings the whole design within it; else the
+/// nearest of those tried; `None` when no share has so few.
+fn few_points(
+    g: &Frame,
+    d: &[Vec<f64>],
+    s: &[f64],
+    two: Option<(&[f64], &[f64])>,
+) -> Option<Candidate> {
+    let mut best: Option<Candidate> = None;
+    for share in FEW_SHARES {
+        let Some(c) = candidate_with(g, d, s, two, Some(share)) else {
+            // A smaller share takes more points still.
+            break;
+        };
+        if c.deviation <= g.tol {
+            return Some(c);
+        }
+        best = Some(nearer(best, c));
+    }
+    best
 }
 
 /// What every candidate of one fit shares: Ψ, the sections' heights,
@@ -1167,26 +1264,6 @@ struct Frame<'a> {
     offset: Offset,
     height: f64,
     tol: f64,
-}
-
-/// The design of profile values `s` (and `t` blended by `lambda`) at the
-/// sections' heights, as B-splines through them, and its largest
-/// difference from `d`.
-fn candidate(g: &Frame, d: &[Vec<f64>], s: &[f64], two: Option<(&[f64], &[f64])>) -> Candidate {
-    // The fewest control points that keep each profile within two
-    // thirds of the tolerance, when the design then holds it; else each
-    // within a third, by as many as that takes (docs/MESHES.md, "Few
-    // control points").
-    let few = candidate_with(g, d, s, two, true);
-    if few.deviation <= g.tol {
-        return few;
-    }
-    let close = candidate_with(g, d, s, two, false);
-    if close.deviation < few.deviation {
-        close
-    } else {
-        few
-    }
 }
 
 /// A profile's values `v` at the sections' heights `zs`, from the bed
@@ -1248,15 +1325,18 @@ fn lambda_round(interp: &[[f64; 2]], n: usize) -> Vec<f64> {
     (0..n).map(|j| at_x(&c, j as f64 / n as f64)).collect()
 }
 
-/// [`candidate`], its profiles by [`fewest`] within two thirds of the
-/// tolerance first (`few`), or through the values within a third.
+/// The design of profile values `s` (and `t` blended by `lambda`) at the
+/// sections' heights, as B-splines through them, and its largest
+/// difference from `d`: each profile by [`fewest`] within `few` (a share
+/// of the tolerance), or without it through the values within a third
+/// (as many points as that takes, docs/MESHES.md, "Few control points").
 fn candidate_with(
     g: &Frame,
     d: &[Vec<f64>],
     s: &[f64],
     two: Option<(&[f64], &[f64])>,
-    few: bool,
-) -> Candidate {
+    few: Option<f64>,
+) -> Option<Candidate> {
     let Frame {
         psi,
         zs,
@@ -1264,14 +1344,14 @@ fn candidate_with(
         height,
         tol,
     } = *g;
-    let profile = |v: &[f64]| -> Vec<[f64; 2]> {
+    let profile = |v: &[f64]| -> Option<Vec<[f64; 2]>> {
         let pts = bed_to_rim(v, zs, height);
-        match few.then(|| fewest(&pts, 2.0 * tol / 3.0)).flatten() {
-            Some(c) => c,
-            None => profile_through(&pts, tol),
+        match few {
+            Some(share) => fewest(&pts, share * tol),
+            None => Some(profile_through(&pts, tol)),
         }
     };
-    let start = profile(s);
+    let start = profile(s)?;
     let (end, interp) = match two {
         Some((t, lambda)) => {
             // λ's error moves the wall by it times the profiles' spread.
@@ -1282,11 +1362,10 @@ fn candidate_with(
                 .fold(0.0, f64::max)
                 .max(1e-9);
             let interp = few
-                .then(|| interpolation_fewest(lambda, 2.0 * tol / (3.0 * spread), false))
-                .flatten()
+                .and_then(|share| interpolation_fewest(lambda, share * tol / spread, false))
                 .map(|(c, _)| c)
                 .unwrap_or_else(|| interpolation_through(lambda));
-            (profile(t), interp)
+            (profile(t)?, interp)
         }
         None => (Vec::new(), Vec::new()),
     };
@@ -1322,8 +1401,9 @@ fn candidate_with(
         }
         residual.push(row);
     }
-    Candidate {
+    Some(Candidate {
         folds: (0, None),
+        loop_ctrl: None,
         offset,
         two: two.is_some(),
         psi: psi.to_vec(),
@@ -1336,7 +1416,7 @@ fn candidate_with(
         d: d.to_vec(),
         texture: None,
         twist: (0.0, 0.0),
-    }
+    })
 }
 
 #[cfg(test)]

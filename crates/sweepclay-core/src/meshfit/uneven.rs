@@ -287,6 +287,7 @@ pub(super) fn fit_uneven(
     };
     let cand = Candidate {
         folds: (0, None),
+        loop_ctrl: None,
         offset: Offset::Radial,
         two: true,
         psi,

@@ -1,0 +1,302 @@
+//! The loop Ψ with few control points (docs/MESHES.md, "Few control
+//! points"): the foot's wall, read as one point a ray (360 round), is
+//! fitted by the closed curve the design file takes — a periodic uniform
+//! cubic B-spline (docs/FORMATS.md, `trajectory`) — with the fewest
+//! control points that keep the whole design within the tolerance. Each
+//! ray's wall moves by as much as the curve lies off its point along
+//! that ray, so the design's difference from the mesh is known exactly
+//! from the fit's residual, section by section.
+
+use super::*;
+
+/// The fewest control points a loop is tried with: a triangle's three
+/// round off to a curve no pot's foot is.
+const LOOP_MIN: usize = 4;
+
+/// The most: a round, oval or lobed loop a potter edits point by point
+/// (docs/MESHES.md).
+const LOOP_MAX: usize = 16;
+
+/// Curve points a span when the fit reads it.
+const PER_SPAN: usize = 48;
+
+/// The parameter corrections a fit makes (Hoschek's).
+const REPROJECT: usize = 8;
+
+/// How much a point's turn counts toward its parameter, tried in turn.
+const TURN_WEIGHTS: [f64; 3] = [0.0, 0.5, 1.0];
+
+/// A loop's control points, the design's largest difference from the
+/// mesh with it, and where (section, ray).
+pub(super) type LoopFit = (Vec<[f64; 2]>, f64, (usize, usize));
+
+/// A loop of the fewest control points ([`LOOP_MIN`] to [`LOOP_MAX`])
+/// whose curve lies within a third of `tol` of the loop along each ray
+/// (a round pot stays round to a tenth of a millimetre, as a profile
+/// keeps two thirds for its own) and keeps the design within `tol` of
+/// the mesh: `psi` the
+/// loop as fitted, `dirs` its rays, `residual` the mesh's offsets less
+/// the design's (section by section, ray by ray). With it, the design's
+/// new largest difference and where (section, ray). `None` when sixteen
+/// are not enough (a polygon's sharp corners, a wall of facets too
+/// coarse for the tolerance).
+pub(super) fn loop_fewest(
+    psi: &[[f64; 2]],
+    dirs: &[[f64; 2]],
+    residual: &[Vec<f64>],
+    tol: f64,
+) -> Option<LoopFit> {
+    let n = psi.len();
+    if n < 2 * LOOP_MAX {
+        return None;
+    }
+    for m in LOOP_MIN..=LOOP_MAX {
+        // The points placed along the curve by length and by length and
+        // turn, the better kept (by length alone, a 60 × 40 mm oval took
+        // 16 points to hold 0.05 mm).
+        let mut best: Option<LoopFit> = None;
+        for w in TURN_WEIGHTS {
+            let mut t: Vec<f64> = shares(psi, w).iter().map(|x| x * m as f64).collect();
+            let mut ctrl = periodic_least_squares(psi, &t, m)?;
+            for _ in 0..REPROJECT {
+                reproject_periodic(&ctrl, psi, &mut t);
+                ctrl = periodic_least_squares(psi, &t, m)?;
+            }
+            if let Some((own, dev, at)) = measure(&ctrl, psi, dirs, residual) {
+                if own <= tol / 3.0 && best.as_ref().is_none_or(|b| dev < b.1) {
+                    best = Some((ctrl, dev, at));
+                }
+            }
+        }
+        if let Some(b) = best.filter(|b| b.1 <= tol) {
+            return Some(b);
+        }
+    }
+    None
+}
+
+/// Each point's share of the loop from the first, a step counting its
+/// length and `w` times its turn (as a share of the loop's length a full
+/// turn): uniform spans then put more control points where the loop
+/// bends most.
+fn shares(psi: &[[f64; 2]], w: f64) -> Vec<f64> {
+    let n = psi.len();
+    let len = |a: [f64; 2], b: [f64; 2]| (b[0] - a[0]).hypot(b[1] - a[1]);
+    let turn = |i: usize| {
+        let (a, b, c) = (psi[(i + n - 1) % n], psi[i], psi[(i + 1) % n]);
+        let (e, f) = ([b[0] - a[0], b[1] - a[1]], [c[0] - b[0], c[1] - b[1]]);
+        (e[0] * f[1] - e[1] * f[0])
+            .atan2(e[0] * f[0] + e[1] * f[1])
+            .abs()
+    };
+    let total = perimeter(psi);
+    let step = |i: usize| {
+        let j = (i + 1) % n;
+        len(psi[i], psi[j]) + w * total * 0.5 * (turn(i) + turn(j)) / std::f64::consts::TAU
+    };
+    let mut u = Vec::with_capacity(n);
+    let mut acc = 0.0;
+    for i in 0..n {
+        u.push(acc);
+        acc += step(i);
+    }
+    u.iter().map(|x| x / acc.max(1e-12)).collect()
+}
+
+/// How far the curve of `ctrl` lies off the loop along its rays at
+/// most, and the design's largest difference from the mesh with that
+/// curve for its loop and where (section, ray): each ray's residual less
+/// how far along the ray the curve lies off its point; `None` when a
+/// ray misses the curve.
+fn measure(
+    ctrl: &[[f64; 2]],
+    psi: &[[f64; 2]],
+    dirs: &[[f64; 2]],
+    residual: &[Vec<f64>],
+) -> Option<(f64, f64, (usize, usize))> {
+    let curve = crate::curves::periodic_bspline(ctrl, PER_SPAN);
+    let moved = (0..psi.len())
+        .map(|j| along_ray(&curve, psi[j], dirs[j]))
+        .collect::<Option<Vec<f64>>>()?;
+    let mut worst = (0.0f64, (0, 0));
+    for (k, row) in residual.iter().enumerate() {
+        for (j, (r, e)) in row.iter().zip(&moved).enumerate() {
+            let off = (r - e).abs();
+            if off > worst.0 {
+                worst = (off, (k, j));
+            }
+        }
+    }
+    let own = moved.iter().fold(0.0f64, |m, e| m.max(e.abs()));
+    Some((own, worst.0, worst.1))
+}
+
+/// The periodic uniform cubic B-spline's four basis values at `t` (in
+/// [0, m)) and the first of the four control points they weigh.
+fn basis(t: f64, m: usize) -> (usize, [f64; 4]) {
+    let t = t.rem_euclid(m as f64);
+    let j = (t.floor() as usize).min(m - 1);
+    let u = t - j as f64;
+    let (u2, u3) = (u * u, u * u * u);
+    (
+        j,
+        [
+            (1.0 - u).powi(3) / 6.0,
+            (3.0 * u3 - 6.0 * u2 + 4.0) / 6.0,
+            (-3.0 * u3 + 3.0 * u2 + 3.0 * u + 1.0) / 6.0,
+            u3 / 6.0,
+        ],
+    )
+}
+
+/// The `m` control points of the closed curve nearest `pts` at
+/// parameters `t` in least squares. No pull toward an even polygon, as
+/// a profile's fit has: round a loop with no ends held, that pull
+/// shrinks the loop, and a dozen points from hundreds need none.
+fn periodic_least_squares(pts: &[[f64; 2]], t: &[f64], m: usize) -> Option<Vec<[f64; 2]>> {
+    use nalgebra::{DMatrix, DVector};
+    let mut ata = DMatrix::<f64>::zeros(m, m);
+    let mut atb = [DVector::<f64>::zeros(m), DVector::<f64>::zeros(m)];
+    for (p, &ti) in pts.iter().zip(t) {
+        let (j, b) = basis(ti, m);
+        for (a, ba) in b.iter().enumerate() {
+            let i = (j + a) % m;
+            for (c, bc) in b.iter().enumerate() {
+                ata[(i, (j + c) % m)] += ba * bc;
+            }
+            atb[0][i] += ba * p[0];
+            atb[1][i] += ba * p[1];
+        }
+    }
+    let lu = ata.lu();
+    let xs = [lu.solve(&atb[0])?, lu.solve(&atb[1])?];
+    let ctrl: Vec<[f64; 2]> = (0..m).map(|i| [xs[0][i], xs[1][i]]).collect();
+    ctrl.iter()
+        .all(|p| p[0].is_finite() && p[1].is_finite())
+        .then_some(ctrl)
+}
+
+/// Moves each parameter to the nearest place on the curve to its
+/// point, searched near where it was (the points run round the curve
+/// in order).
+fn reproject_periodic(ctrl: &[[f64; 2]], pts: &[[f64; 2]], t: &mut [f64]) {
+    let m = ctrl.len();
+    let eval = |t: f64| {
+        let (j, b) = basis(t, m);
+        let mut p = [0.0; 2];
+        for (a, w) in b.iter().enumerate() {
+            let c = ctrl[(j + a) % m];
+            p = [p[0] + w * c[0], p[1] + w * c[1]];
+        }
+        p
+    };
+    let d2 = |a: [f64; 2], b: [f64; 2]| (a[0] - b[0]).powi(2) + (a[1] - b[1]).powi(2);
+    let h = 0.25;
+    for (p, ti) in pts.iter().zip(t.iter_mut()) {
+        let (mut lo, mut hi) = (*ti - h, *ti + h);
+        for _ in 0..30 {
+            let (a, b) = (lo + (hi - lo) / 3.0, hi - (hi - lo) / 3.0);
+            if d2(eval(a), *p) < d2(eval(b), *p) {
+                hi = b;
+            } else {
+                lo = a;
+            }
+        }
+        *ti = 0.5 * (lo + hi);
+    }
+}
+
+/// How far along `dir` from `p` the closed polyline `curve` lies (the
+/// crossing nearest `p`), or `None` when the ray meets it nowhere near.
+fn along_ray(curve: &[[f64; 2]], p: [f64; 2], dir: [f64; 2]) -> Option<f64> {
+    let mut best: Option<f64> = None;
+    for w in curve.windows(2) {
+        let (a, b) = (w[0], w[1]);
+        let e = [b[0] - a[0], b[1] - a[1]];
+        let den = dir[0] * e[1] - dir[1] * e[0];
+        if den.abs() < 1e-12 {
+            continue;
+        }
+        let ap = [a[0] - p[0], a[1] - p[1]];
+        let s = (ap[0] * e[1] - ap[1] * e[0]) / den;
+        let f = (ap[0] * dir[1] - ap[1] * dir[0]) / den;
+        if (-1e-9..=1.0 + 1e-9).contains(&f) && best.is_none_or(|x| s.abs() < x.abs()) {
+            best = Some(s);
+        }
+    }
+    // A crossing farther than a few millimetres is the loop's other side.
+    best.filter(|s| s.abs() < 5.0)
+}
+
+#[cfg(test)]
+mod tests {
+    use super::*;
+
+    fn ring(r: impl Fn(f64) -> f64, n: usize) -> Vec<[f64; 2]> {
+        (0..n)
+            .map(|j| {
+                let a = std::f64::consts::TAU * j as f64 / n as f64;
+                [r(a) * a.cos(), r(a) * a.sin()]
+            })
+            .collect()
+    }
+
+    fn radial(psi: &[[f64; 2]]) -> Vec<[f64; 2]> {
+        (0..psi.len())
+            .map(|j| ray(psi, j, Offset::Radial))
+            .collect()
+    }
+
+    /// A circle (r 40 mm) takes few points and stays round (within a
+    /// third of the tolerance); an oval and a four-lobed loop stay within
+    /// sixteen; a square's corners do not.
+    #[test]
+    fn round_oval_and_lobed_loops_take_few_points() {
+        let zero = vec![vec![0.0; 360]; 3];
+        let circle = ring(|_| 40.0, 360);
+        let (c, dev, _) = loop_fewest(&circle, &radial(&circle), &zero, 0.15).expect("a circle");
+        assert!(c.len() <= 8, "{} points", c.len());
+        assert!(dev <= 0.05);
+        // Measured independently: every curve point's radius.
+        for q in crate::curves::periodic_bspline(&c, 64) {
+            assert!((q[0].hypot(q[1]) - 40.0).abs() <= 0.05, "{q:?}");
+        }
+        let oval: Vec<[f64; 2]> = circle.iter().map(|p| [1.5 * p[0], p[1]]).collect();
+        let (c, _, _) = loop_fewest(&oval, &radial(&oval), &zero, 0.15).expect("an oval");
+        assert!(c.len() <= 10, "{} points", c.len());
+        let lobes = ring(|a| 40.0 + 4.0 * (4.0 * a).cos(), 360);
+        let (c, _, _) = loop_fewest(&lobes, &radial(&lobes), &zero, 0.3).expect("four lobes");
+        assert!(c.len() <= 16, "{} points", c.len());
+        let square: Vec<[f64; 2]> = ring(|a| 40.0 / a.cos().abs().max(a.sin().abs()), 360);
+        assert!(loop_fewest(&square, &radial(&square), &zero, 0.3).is_none());
+    }
+
+    /// The wall's own difference from the design adds to the loop's:
+    /// sections off by ±0.25 mm leave a loop of three 2 mm lobes 0.05 mm of a 0.3 mm
+    /// tolerance, which takes more points than the whole 0.3 does.
+    #[test]
+    fn the_loops_difference_adds_to_the_walls() {
+        let r = |a: f64| 40.0 + 2.0 * (3.0 * a).cos();
+        let lobes = ring(r, 360);
+        let dirs = radial(&lobes);
+        let (loose, _, _) = loop_fewest(&lobes, &dirs, &[vec![0.0; 360]], 0.3).expect("loose");
+        let walls = [vec![0.25; 360], vec![-0.25; 360]];
+        let (tight, dev, _) = loop_fewest(&lobes, &dirs, &walls, 0.3).expect("tight");
+        assert!(
+            tight.len() > loose.len(),
+            "{} vs {}",
+            tight.len(),
+            loose.len()
+        );
+        assert!((0.25..=0.3).contains(&dev), "{dev}");
+        // Measured independently: the curve's radius along each ray.
+        let curve = crate::curves::periodic_bspline(&tight, 64);
+        for (j, p) in lobes.iter().enumerate() {
+            let a = p[1].atan2(p[0]);
+            let off = along_ray(&curve, *p, dirs[j]).expect("crosses");
+            assert!(off.abs() <= 0.05 + 1e-9, "{j}: {off}");
+            let q = [p[0] + off * dirs[j][0], p[1] + off * dirs[j][1]];
+            assert!((q[0].hypot(q[1]) - r(a)).abs() <= 0.05 + 1e-9);
+        }
+    }
+}
