@@ -3,7 +3,7 @@
 (crates/sweepclay-core/tests/meshes.rs, docs/MESHES.md "Closed forms").
 
     pip install trimesh numpy shapely mapbox_earcut manifold3d
-    python3 scripts/mesh-fixtures.py
+    python3 scripts/mesh-fixtures.py [NAME…]
 
 writes small binary STLs to crates/sweepclay-core/tests/fixtures/meshes/.
 Each is a form whose sweep is known: the tests read what trimesh wrote,
@@ -195,7 +195,23 @@ def main():
     body = trimesh.creation.cylinder(radius=36.0, height=70.0, sections=96)
     body.apply_translation((0, 0, 35.0))
     forms["creased"] = body.difference(trimesh.util.concatenate(creases))
+    # A collar inside the cup's wall from 40 to 50 mm, 12.5 mm wide, its
+    # underside rising 0.6 mm to the wall (brianfoshee's vase at its
+    # neck): sections just under the join cut the underside alone, a
+    # ring apart from the wall.
+    collar = trimesh.creation.revolve(
+        np.array([(20.0, 39.2), (32.5, 39.8), (32.5, 50.0), (20.0, 50.0), (20.0, 39.2)]), sections=96)
+    forms["collared-cup"] = cup().union(collar)
+    # A post 10 mm across standing 25 mm up from the floor: a part inside.
+    post = trimesh.creation.cylinder(radius=5.0, height=25.0, sections=48)
+    post.apply_translation((0, 0, 5.0 + 12.5))
+    forms["post-cup"] = cup().union(post)
+    # `python3 scripts/mesh-fixtures.py NAME…` writes only those (a
+    # newer trimesh or manifold may triangulate the others differently).
+    only = sys.argv[1:]
     for name, m in forms.items():
+        if only and name not in only:
+            continue
         if not m.is_watertight:
             sys.exit(f"{name}: trimesh wrote a mesh that is not watertight")
         path = os.path.join(OUT, f"{name}.stl")

@@ -686,6 +686,26 @@ fn holes_grooves_creases_and_a_tilt_are_taken_in_and_said() {
     assert!(creased.deviation_mm <= 0.3, "{}", creased.deviation_mm);
 }
 
+/// A collar inside the wall whose underside rises 0.6 mm to it is cut
+/// as a ring apart from the wall by the sections under the join: a
+/// sliver, taken into the wall and said (refused as "a part inside it"
+/// before). A post 25 mm tall on the floor is still a part inside.
+#[test]
+fn a_ledges_underside_is_a_sliver_and_a_post_is_a_part_inside() {
+    let f = trimesh_form("collared-cup").expect("the sliver taken in");
+    let said = f.absorbed.unwrap_or_default();
+    assert!(said.contains("sliver(s) inside its cavity"), "{said}");
+    assert!(said.contains("from z = 39."), "{said}");
+    assert!(f.deviation_mm <= 0.3, "{}", f.deviation_mm);
+    let s = sweepclay_core::slice(&f.design).unwrap();
+    let r = common::check_full(&s);
+    assert!(r.printable, "{}", r.render());
+    let post = trimesh_form("post-cup")
+        .expect_err("a post refused")
+        .to_string();
+    assert!(post.contains("has a part inside it"), "{post}");
+}
+
 #[test]
 fn a_handle_feet_and_windows_are_refused_saying_where() {
     let refused = |name: &str| {

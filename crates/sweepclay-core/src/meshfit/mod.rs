@@ -486,6 +486,7 @@ fn one_wall(cut: &mut [sections::Section], dz: f64) -> Result<Option<String>> {
     }
     // Where the cavity starts: the floor's top.
     let floor_top = cut.iter().position(|s| s.loops.len() == 2);
+    let mut slivers = vec![];
     for (a, b) in runs_where(&islands) {
         let (ar, at) = largest_in(&islands, cut, (a, b));
         let rise = z(b) - z(a) + dz;
@@ -498,6 +499,12 @@ fn one_wall(cut: &mut [sections::Section], dz: f64) -> Result<Option<String>> {
                 at[0],
                 at[1]
             ));
+        } else if rise <= RIM_LIP_MM {
+            // A sliver in the cavity no taller than a lip: where the wall
+            // thickens inward over a ledge, the ledge's underside cut by a
+            // section or two (brianfoshee's vase at its neck, 0.5 mm).
+            // The outside is the pot, and the inside moves.
+            slivers.push((rise, z(a), at));
         } else {
             return Err(Error::invalid(
                 "mesh",
@@ -511,6 +518,14 @@ fn one_wall(cut: &mut [sections::Section], dz: f64) -> Result<Option<String>> {
                 ),
             ));
         }
+    }
+    if let Some(&(rise, z0, at)) = slivers.first() {
+        notes.push(format!(
+            "{} sliver(s) inside its cavity, none over {RIM_LIP_MM} mm tall (the first {rise:.1} mm tall from z = {z0:.1} mm near ({:.1}, {:.1}) mm: a ledge's underside where the wall thickens inward), are taken into the wall",
+            slivers.len(),
+            at[0],
+            at[1]
+        ));
     }
     Ok((!notes.is_empty()).then(|| notes.join("; ")))
 }
