@@ -18,7 +18,7 @@
 
 use crate::design::Params;
 use crate::toolpath::Toolpath;
-use crate::widths::{across_chord, lean_width, overlap_fraction};
+use crate::widths::{across_chord, lean_width, least_support, overlap_fraction};
 
 /// Bead sizes and volumes along a toolpath.
 #[derive(Clone, Debug, PartialEq)]
@@ -181,7 +181,7 @@ pub fn plan_extrusion(path: &Toolpath, params: &Params, origin: [f64; 2]) -> Ext
         if let Some(b) = path.below[i] {
             let b = b as usize;
             if overlap_fraction(width[i], width[b], offset[i]) < ov {
-                width[b] = width[b].max(width[i]);
+                width[b] = width[b].max(least_support(width[i], width[b], offset[i], ov).min(wmax));
             }
         }
     }
@@ -360,10 +360,14 @@ mod tests {
         assert_eq!(lowest_bead_width(&[], &p), 3.0);
         assert_eq!(lowest_bead_width(&[0.0, 0.0], &p), 3.0);
         assert!((lowest_bead_width(&[1.5], &p) - 4.5).abs() < 1e-12);
-        assert_eq!(lowest_bead_width(&[0.0, 3.0], &p), 6.0);
-        // A lean high up widens the whole column below it: beads 4.5
-        // wide, 0.96 apart, overlap a 3 mm bead by 0.62 < 2/3.
-        assert!((lowest_bead_width(&[0.96, 0.96, 1.5], &p) - 4.5).abs() < 1e-12);
+        // A 6 mm bead (w_max) straight over the lowest needs it 4 wide.
+        assert!((lowest_bead_width(&[0.0, 3.0], &p) - 4.0).abs() < 1e-9);
+        // A lean high up widens the column below it as far as each bead
+        // needs: 4.5 mm beads 0.96 off a 3 mm bead overlap it by 0.62 <
+        // 2/3, so it widens to 3.42 (its near edge 0.75 mm past the upper
+        // bead's middle), and the bead under that to 3.06, not to 4.5 all
+        // the way down.
+        assert!((lowest_bead_width(&[0.96, 0.96, 1.5], &p) - 3.06).abs() < 1e-9);
         // The same as `plan_extrusion` over such columns, leaning either
         // way by up to 2 mm a layer.
         let mut x = 0.37_f64;

@@ -377,12 +377,13 @@ fn vessel_floor(c: &Corrected, v: &VesselPlan) -> Result<LaidFloor, FloorRefusal
 /// How far the wall's first turn's bead reaches outside a floor bead on
 /// the same line, at each column from the start column on (mm, ≥ 0): half
 /// of what it is laid wider than `width_min`. The extrusion stage widens
-/// a column's beads where the one above leans off them, down the whole
-/// column (the paper's Algorithm 3; [`lowest_bead_width`]), and a bead
-/// taller than wide. The floor's outermost ring goes out by that much, so
-/// its outer edge is the wall's (docs/ALGORITHMS.md §8, "A flush foot"):
-/// under the bowl, whose wall leans out as it rises, the first turn was
-/// laid 3.8 mm wide on 3 mm floor beads, its edge 0.4 mm outside them.
+/// a column's beads where the one above leans off them, each as far as
+/// the one above needs (the paper's Algorithm 3; [`lowest_bead_width`]),
+/// and a bead taller than wide. The floor's outermost ring goes out by
+/// that much, so its outer edge is the wall's (docs/ALGORITHMS.md §8, "A
+/// flush foot"): under the bowl, when every bead under a wide one was
+/// widened to its width, the first turn was laid 3.8 mm wide on 3 mm
+/// floor beads, its edge 0.4 mm outside them.
 fn first_turn_excess(c: &Corrected, v: &VesselPlan, ring: &[[f64; 2]]) -> Vec<f64> {
     let s = &c.surface;
     let n = s.columns.len();
