@@ -3161,10 +3161,36 @@ async fn a_mesh_opens_as_an_editable_design_and_downloads_its_gcode() {
     if let Ok(path) = std::env::var("SWEEPCLAY_MESH_SCREENSHOT") {
         std::fs::write(&path, c.screenshot().await.unwrap()).unwrap();
     }
-    // Editable: its profile is a curve the editors hold.
+    // Editable: its profile is a curve the editors hold, its round loop
+    // a closed curve of a few control points (it was the 360 points of
+    // the fit's rays), and the widths table a row per profile point.
     assert_eq!(
         js(&c, "return window.sweepclay.design.trajectory.closed").await,
         json!(true)
+    );
+    let loop_points = js(
+        &c,
+        "return window.sweepclay.design.trajectory.control_points?.length ?? -1",
+    )
+    .await;
+    let loop_points = loop_points.as_i64().unwrap();
+    assert!((4..=16).contains(&loop_points), "{loop_points} loop points");
+    let (rows, profile) = (
+        js(
+            &c,
+            "return document.querySelectorAll('#pot-rows tbody tr').length",
+        )
+        .await,
+        js(
+            &c,
+            "return window.sweepclay.design.profile_start.control_points.length",
+        )
+        .await,
+    );
+    let (rows, profile) = (rows.as_i64().unwrap(), profile.as_i64().unwrap());
+    assert!(
+        profile <= 12 && rows <= profile + 1,
+        "{rows} rows, {profile} points"
     );
     let (text, _) =
         download_printable(&c, &downloads, "no G-code of the mesh was downloaded").await;
