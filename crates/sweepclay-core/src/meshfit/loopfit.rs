@@ -26,9 +26,19 @@ const REPROJECT: usize = 8;
 /// How much a point's turn counts toward its parameter, tried in turn.
 const TURN_WEIGHTS: [f64; 3] = [0.0, 0.5, 1.0];
 
-/// A loop's control points, the design's largest difference from the
-/// mesh with it, and where (section, ray).
-pub(super) type LoopFit = (Vec<[f64; 2]>, f64, (usize, usize));
+/// The loop as the design file writes it.
+#[derive(Clone, Debug, PartialEq)]
+pub(super) enum Loop {
+    /// The control points of a closed curve (`control_points`).
+    Curve(Vec<[f64; 2]>),
+    /// The corners of a closed polyline (`points`): a polygon's sides
+    /// straight and its corners as sharp as the mesh's.
+    Polygon(Vec<[f64; 2]>),
+}
+
+/// A loop, the design's largest difference from the mesh with it, and
+/// where (section, ray).
+pub(super) type LoopFit = (Loop, f64, (usize, usize));
 
 /// A loop of the fewest control points ([`LOOP_MIN`] to [`LOOP_MAX`])
 /// whose curve lies within a third of `tol` of the loop along each ray
@@ -62,14 +72,61 @@ pub(super) fn loop_fewest(
                 reproject_periodic(&ctrl, psi, &mut t);
                 ctrl = periodic_least_squares(psi, &t, m)?;
             }
-            if let Some((own, dev, at)) = measure(&ctrl, psi, dirs, residual) {
+            let curve = crate::curves::periodic_bspline(&ctrl, PER_SPAN);
+            if let Some((own, dev, at)) = measure(&curve, psi, dirs, residual) {
                 if own <= tol / 3.0 && best.as_ref().is_none_or(|b| dev < b.1) {
-                    best = Some((ctrl, dev, at));
+                    best = Some((Loop::Curve(ctrl), dev, at));
                 }
             }
         }
         if let Some(b) = best.filter(|b| b.1 <= tol) {
             return Some(b);
+        }
+    }
+    polygon(psi, dirs, residual, tol)
+}
+
+/// The loop as a polygon of at most [`LOOP_MAX`] corners, where no curve
+/// of as few points holds (a hexagonal planter's corners): the loop's
+/// points simplified (Douglas–Peucker, round the loop from its two
+/// farthest-apart points) within a third of the tolerance and then a
+/// sixth, measured as the design draws it (its sharpest corners rounded
+/// for the bead, `curves::round_corners`), kept on the same terms as a
+/// curve.
+fn polygon(
+    psi: &[[f64; 2]],
+    dirs: &[[f64; 2]],
+    residual: &[Vec<f64>],
+    tol: f64,
+) -> Option<LoopFit> {
+    let n = psi.len();
+    let far = (0..n)
+        .max_by(|&a, &b| {
+            let d = |i: usize| (psi[i][0] - psi[0][0]).hypot(psi[i][1] - psi[0][1]);
+            d(a).total_cmp(&d(b))
+        })
+        .filter(|&k| k > 0)?;
+    let params = crate::design::Params::default();
+    for eps in [tol / 3.0, tol / 6.0] {
+        let mut corners = super::through::simplify(&psi[..=far], eps);
+        let back: Vec<[f64; 2]> = psi[far..].iter().chain(&psi[..1]).copied().collect();
+        let back = super::through::simplify(&back, eps);
+        corners.extend_from_slice(&back[1..back.len() - 1]);
+        // The two points it started from stay only where they are corners.
+        let corners = without_straight(corners, eps);
+        if corners.len() < 3 || corners.len() > LOOP_MAX {
+            continue;
+        }
+        // As the design draws it before sampling: its corners sharper
+        // than a loop's limit rounded for the widest bead (sampled, every
+        // loop's corners are cut alike, the 360 points' too).
+        let (mut line, _) =
+            crate::curves::round_corners(&corners, true, params.width_max, 0.25 * params.spacing);
+        line.push(line[0]);
+        if let Some((own, dev, at)) = measure(&line, psi, dirs, residual) {
+            if own <= tol / 3.0 && dev <= tol {
+                return Some((Loop::Polygon(corners), dev, at));
+            }
         }
     }
     None
@@ -103,20 +160,37 @@ fn shares(psi: &[[f64; 2]], w: f64) -> Vec<f64> {
     u.iter().map(|x| x / acc.max(1e-12)).collect()
 }
 
-/// How far the curve of `ctrl` lies off the loop along its rays at
-/// most, and the design's largest difference from the mesh with that
-/// curve for its loop and where (section, ray): each ray's residual less
-/// how far along the ray the curve lies off its point; `None` when a
-/// ray misses the curve.
+/// The closed polygon `corners` without the vertices that lie within
+/// `eps` of the line through their neighbours.
+fn without_straight(mut corners: Vec<[f64; 2]>, eps: f64) -> Vec<[f64; 2]> {
+    let mut i = 0;
+    while corners.len() > 3 && i < corners.len() {
+        let n = corners.len();
+        let (a, b, c) = (corners[(i + n - 1) % n], corners[i], corners[(i + 1) % n]);
+        let len = (c[0] - a[0]).hypot(c[1] - a[1]).max(1e-12);
+        let off = ((c[0] - a[0]) * (a[1] - b[1]) - (a[0] - b[0]) * (c[1] - a[1])).abs() / len;
+        if off <= eps {
+            corners.remove(i);
+        } else {
+            i += 1;
+        }
+    }
+    corners
+}
+
+/// How far the closed polyline `curve` (its first point repeated at its
+/// end) lies off the loop along its rays at most, and the design's
+/// largest difference from the mesh with it for its loop and where
+/// (section, ray): each ray's residual less how far along the ray the
+/// curve lies off its point; `None` when a ray misses the curve.
 fn measure(
-    ctrl: &[[f64; 2]],
+    curve: &[[f64; 2]],
     psi: &[[f64; 2]],
     dirs: &[[f64; 2]],
     residual: &[Vec<f64>],
 ) -> Option<(f64, f64, (usize, usize))> {
-    let curve = crate::curves::periodic_bspline(ctrl, PER_SPAN);
     let moved = (0..psi.len())
-        .map(|j| along_ray(&curve, psi[j], dirs[j]))
+        .map(|j| along_ray(curve, psi[j], dirs[j]))
         .collect::<Option<Vec<f64>>>()?;
     let mut worst = (0.0f64, (0, 0));
     for (k, row) in residual.iter().enumerate() {
@@ -241,6 +315,13 @@ mod tests {
             .collect()
     }
 
+    fn curve_of(l: Loop) -> Vec<[f64; 2]> {
+        match l {
+            Loop::Curve(c) => c,
+            Loop::Polygon(p) => panic!("a polygon of {} corners", p.len()),
+        }
+    }
+
     fn radial(psi: &[[f64; 2]]) -> Vec<[f64; 2]> {
         (0..psi.len())
             .map(|j| ray(psi, j, Offset::Radial))
@@ -249,12 +330,13 @@ mod tests {
 
     /// A circle (r 40 mm) takes few points and stays round (within a
     /// third of the tolerance); an oval and a four-lobed loop stay within
-    /// sixteen; a square's corners do not.
+    /// sixteen; a square's and a hexagon's corners take a polygon.
     #[test]
-    fn round_oval_and_lobed_loops_take_few_points() {
+    fn round_oval_and_lobed_loops_take_few_points_and_polygons_their_corners() {
         let zero = vec![vec![0.0; 360]; 3];
         let circle = ring(|_| 40.0, 360);
         let (c, dev, _) = loop_fewest(&circle, &radial(&circle), &zero, 0.15).expect("a circle");
+        let c = curve_of(c);
         assert!(c.len() <= 8, "{} points", c.len());
         assert!(dev <= 0.05);
         // Measured independently: every curve point's radius.
@@ -263,12 +345,42 @@ mod tests {
         }
         let oval: Vec<[f64; 2]> = circle.iter().map(|p| [1.5 * p[0], p[1]]).collect();
         let (c, _, _) = loop_fewest(&oval, &radial(&oval), &zero, 0.15).expect("an oval");
+        let c = curve_of(c);
         assert!(c.len() <= 10, "{} points", c.len());
         let lobes = ring(|a| 40.0 + 4.0 * (4.0 * a).cos(), 360);
         let (c, _, _) = loop_fewest(&lobes, &radial(&lobes), &zero, 0.3).expect("four lobes");
+        let c = curve_of(c);
         assert!(c.len() <= 16, "{} points", c.len());
+        // A square's corners: no curve of sixteen holds them (its 90°
+        // corners, rounded for the bead as the design draws a loop's,
+        // are no polygon within the tolerance either).
         let square: Vec<[f64; 2]> = ring(|a| 40.0 / a.cos().abs().max(a.sin().abs()), 360);
-        assert!(loop_fewest(&square, &radial(&square), &zero, 0.3).is_none());
+        assert!(!matches!(
+            loop_fewest(&square, &radial(&square), &zero, 0.3),
+            Some((Loop::Curve(_), _, _))
+        ));
+        // A hexagon (a planter's): its six corners, the polygon within
+        // 0.05 mm of it along every ray (measured independently).
+        let hexagon = ring(
+            |a| {
+                let s = std::f64::consts::PI / 3.0;
+                40.0 * (s / 2.0).cos() / ((a + s / 2.0).rem_euclid(s) - s / 2.0).cos()
+            },
+            360,
+        );
+        let dirs = radial(&hexagon);
+        match loop_fewest(&hexagon, &dirs, &zero, 0.3) {
+            Some((Loop::Polygon(p), _, _)) => {
+                assert_eq!(p.len(), 6, "{p:?}");
+                let mut line = p.clone();
+                line.push(p[0]);
+                for (j, q) in hexagon.iter().enumerate() {
+                    let off = along_ray(&line, *q, dirs[j]).expect("crosses");
+                    assert!(off.abs() < 0.05, "{j}: {off}");
+                }
+            }
+            other => panic!("{other:?}"),
+        }
     }
 
     /// The wall's own difference from the design adds to the loop's:
@@ -280,8 +392,10 @@ mod tests {
         let lobes = ring(r, 360);
         let dirs = radial(&lobes);
         let (loose, _, _) = loop_fewest(&lobes, &dirs, &[vec![0.0; 360]], 0.3).expect("loose");
+        let loose = curve_of(loose);
         let walls = [vec![0.25; 360], vec![-0.25; 360]];
         let (tight, dev, _) = loop_fewest(&lobes, &dirs, &walls, 0.3).expect("tight");
+        let tight = curve_of(tight);
         assert!(
             tight.len() > loose.len(),
             "{} vs {}",

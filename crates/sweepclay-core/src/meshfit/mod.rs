@@ -1031,10 +1031,10 @@ struct Candidate {
     twist: (f64, f64),
     /// Rays read at a fold's outside, and where the widest fold was.
     folds: (usize, Option<[f64; 3]>),
-    /// The loop as the control points of a closed curve (in the frame
-    /// the fit measures in), where few hold the tolerance; else Ψ's
-    /// points are the design's polyline.
-    loop_ctrl: Option<Vec<[f64; 2]>>,
+    /// The loop as a closed curve's control points or a polygon's
+    /// corners (in the frame the fit measures in), where few hold the
+    /// tolerance; else Ψ's points are the design's polyline.
+    loop_ctrl: Option<loopfit::Loop>,
 }
 
 impl Candidate {
@@ -1094,7 +1094,7 @@ impl Candidate {
     /// within `tol` ([`loopfit::loop_fewest`]), the design's new largest
     /// difference and where (`zs` the sections' heights); `None` where
     /// sixteen are not enough.
-    fn few_loop(&self, zs: &[f64], tol: f64) -> Option<(Vec<[f64; 2]>, f64, [f64; 3])> {
+    fn few_loop(&self, zs: &[f64], tol: f64) -> Option<(loopfit::Loop, f64, [f64; 3])> {
         let (psi, _) = self.design_loop();
         let dirs: Vec<[f64; 2]> = (0..self.psi.len())
             .map(|j| ray(&self.psi, j, self.offset))
@@ -1114,10 +1114,16 @@ impl Candidate {
             let f = if keep { 0.0 } else { foot(c) };
             c.iter().map(|p| [p[0] - f, p[1]]).collect()
         };
-        let turned = |l: &[[f64; 2]]| l.iter().map(|&p| turn_by(p, forward)).collect();
+        let turned =
+            |l: &[[f64; 2]]| -> Vec<[f64; 2]> { l.iter().map(|&p| turn_by(p, forward)).collect() };
+        let (control_points, points) = match &self.loop_ctrl {
+            Some(loopfit::Loop::Curve(c)) => (Some(turned(c)), None),
+            Some(loopfit::Loop::Polygon(p)) => (None, Some(turned(p))),
+            None => (None, Some(turned(&psi))),
+        };
         let traj = TrajectorySpec {
-            control_points: self.loop_ctrl.as_deref().map(turned),
-            points: self.loop_ctrl.is_none().then(|| turned(&psi)),
+            control_points,
+            points,
             closed: true,
             offset: self.offset,
         };

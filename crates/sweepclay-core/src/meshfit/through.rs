@@ -110,7 +110,7 @@ pub(super) fn fewest(pts: &[[f64; 2]], limit: f64) -> Option<Vec<[f64; 2]>> {
 
 /// The points of `pts` that keep every other within `eps` of the
 /// polyline through them (Douglas–Peucker), the ends kept.
-fn simplify(pts: &[[f64; 2]], eps: f64) -> Vec<[f64; 2]> {
+pub(super) fn simplify(pts: &[[f64; 2]], eps: f64) -> Vec<[f64; 2]> {
     let mut keep = vec![false; pts.len()];
     let last = pts.len() - 1;
     keep[0] = true;
