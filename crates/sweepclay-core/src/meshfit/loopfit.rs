@@ -5,7 +5,8 @@
 //! control points that keep the whole design within the tolerance. Each
 //! ray's wall moves by as much as the curve lies off its point along
 //! that ray, so the design's difference from the mesh is known exactly
-//! from the fit's residual, section by section.
+//! from the fit's residual, section by section. A loop no such curve
+//! holds (a polygon's corners) is tried as the polygon of its corners.
 
 use super::*;
 
@@ -44,12 +45,12 @@ pub(super) type LoopFit = (Loop, f64, (usize, usize));
 /// whose curve lies within a third of `tol` of the loop along each ray
 /// (a round pot stays round to a tenth of a millimetre, as a profile
 /// keeps two thirds for its own) and keeps the design within `tol` of
-/// the mesh: `psi` the
-/// loop as fitted, `dirs` its rays, `residual` the mesh's offsets less
-/// the design's (section by section, ray by ray). With it, the design's
-/// new largest difference and where (section, ray). `None` when sixteen
-/// are not enough (a polygon's sharp corners, a wall of facets too
-/// coarse for the tolerance).
+/// the mesh: `psi` the loop as fitted, `dirs` its rays, `residual` the
+/// mesh's offsets less the design's (section by section, ray by ray).
+/// With it, the design's new largest difference and where (section,
+/// ray). Where sixteen are not enough, the polygon of its corners
+/// ([`polygon`]); `None` where that does not hold either (a wall of
+/// facets too coarse for the tolerance, a design already near it).
 pub(super) fn loop_fewest(
     psi: &[[f64; 2]],
     dirs: &[[f64; 2]],
@@ -67,10 +68,15 @@ pub(super) fn loop_fewest(
         let mut best: Option<LoopFit> = None;
         for w in TURN_WEIGHTS {
             let mut t: Vec<f64> = shares(psi, w).iter().map(|x| x * m as f64).collect();
-            let mut ctrl = periodic_least_squares(psi, &t, m)?;
+            let Some(mut ctrl) = periodic_least_squares(psi, &t, m) else {
+                continue;
+            };
             for _ in 0..REPROJECT {
                 reproject_periodic(&ctrl, psi, &mut t);
-                ctrl = periodic_least_squares(psi, &t, m)?;
+                match periodic_least_squares(psi, &t, m) {
+                    Some(c) => ctrl = c,
+                    None => break,
+                }
             }
             let curve = crate::curves::periodic_bspline(&ctrl, PER_SPAN);
             if let Some((own, dev, at)) = measure(&curve, psi, dirs, residual) {

@@ -7,7 +7,7 @@
 //! − S(z)) (the paper's §3 sweep, eq. 1–2). The fit's profiles,
 //! interpolation and, where it holds, loop are B-splines of the fewest
 //! control points that hold the tolerance (least squares, or a
-//! polyline's corners), and the
+//! polyline's corners; a loop also a polygon), and the
 //! largest difference between the fitted design and the mesh's sections
 //! is measured and reported with where it lies. What no bead prints
 //! (details, drainage holes, a floor's groove, creases, a tilted foot)
@@ -889,8 +889,8 @@ fn fit_with(mesh: &TriMesh, opts: &FitOptions, absorbed: &mut Option<String>) ->
         None
     };
     let mut design = None;
-    if let Some((ctrl, dev, worst)) = few_loop {
-        b.loop_ctrl = Some(ctrl);
+    if let Some((l, dev, worst)) = few_loop {
+        b.loop_ctrl = Some(l);
         match Design::from_json(&b.json(&opts.name)) {
             Ok(d) => {
                 design = Some(d);
@@ -1090,10 +1090,10 @@ impl Candidate {
         (if keep { self.psi.clone() } else { moved }, keep)
     }
 
-    /// The loop as the fewest control points that keep the design
-    /// within `tol` ([`loopfit::loop_fewest`]), the design's new largest
-    /// difference and where (`zs` the sections' heights); `None` where
-    /// sixteen are not enough.
+    /// The loop as the fewest control points (or a polygon's corners)
+    /// that keep the design within `tol` ([`loopfit::loop_fewest`]), the
+    /// design's new largest difference and where (`zs` the sections'
+    /// heights); `None` where neither holds.
     fn few_loop(&self, zs: &[f64], tol: f64) -> Option<(loopfit::Loop, f64, [f64; 3])> {
         let (psi, _) = self.design_loop();
         let dirs: Vec<[f64; 2]> = (0..self.psi.len())
