@@ -18,6 +18,10 @@ const LOOP_MIN: usize = 4;
 /// (docs/MESHES.md).
 const LOOP_MAX: usize = 16;
 
+/// The most corners of a polygon loop: a polygon's rounded corners take
+/// two or three points each (the hexagonal planter's, 18).
+const POLYGON_MAX: usize = 24;
+
 /// Curve points a span when the fit reads it.
 const PER_SPAN: usize = 48;
 
@@ -92,7 +96,7 @@ pub(super) fn loop_fewest(
     polygon(psi, dirs, residual, tol)
 }
 
-/// The loop as a polygon of at most [`LOOP_MAX`] corners, where no curve
+/// The loop as a polygon of at most [`POLYGON_MAX`] corners, where no curve
 /// of as few points holds (a hexagonal planter's corners): the loop's
 /// points simplified (Douglas–Peucker, round the loop from its two
 /// farthest-apart points) within a third of the tolerance and then a
@@ -120,7 +124,7 @@ fn polygon(
         corners.extend_from_slice(&back[1..back.len() - 1]);
         // The two points it started from stay only where they are corners.
         let corners = without_straight(corners, eps);
-        if corners.len() < 3 || corners.len() > LOOP_MAX {
+        if corners.len() < 3 || corners.len() > POLYGON_MAX {
             continue;
         }
         // As the design draws it before sampling: its corners sharper
