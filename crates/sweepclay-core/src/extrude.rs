@@ -5,8 +5,9 @@
 //! horizontal offset s from the point below needs w = s / (1 − overlap),
 //! clamped to [w_min, w_max]; both points are widened to it together (the
 //! paper's "expand both with the same scale"). A second walk, top-down,
-//! widens the point below to the width of the point above wherever the
-//! overlap is still short of the target (the paper adjusts "twice"). With
+//! widens the point below wherever the overlap is still short of the
+//! target (the paper adjusts "twice"), as far as that overlap needs and
+//! no further, so a wide bead tapers down over a bead or two. With
 //! s ≤ w_max (1 − overlap) from the support-free correction, every bead then
 //! overlaps the one below by at least the target fraction of its width.
 //! No bead is narrower than it is tall (within w_max).
