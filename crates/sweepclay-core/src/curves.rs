@@ -423,12 +423,7 @@ pub fn periodic_bspline(pts: &[[f64; 2]], per_span: usize) -> Vec<[f64; 2]> {
     for j in 0..m {
         let [p0, p1, p2, p3] = [0, 1, 2, 3].map(|k| pts[(j + k) % m]);
         for step in 0..per_span {
-            let t = step as f64 / per_span as f64;
-            let (t2, t3) = (t * t, t * t * t);
-            let b0 = (1.0 - t).powi(3) / 6.0;
-            let b1 = (3.0 * t3 - 6.0 * t2 + 4.0) / 6.0;
-            let b2 = (-3.0 * t3 + 3.0 * t2 + 3.0 * t + 1.0) / 6.0;
-            let b3 = t3 / 6.0;
+            let [b0, b1, b2, b3] = uniform_cubic_basis(step as f64 / per_span as f64);
             out.push([
                 b0 * p0[0] + b1 * p1[0] + b2 * p2[0] + b3 * p3[0],
                 b0 * p0[1] + b1 * p1[1] + b2 * p2[1] + b3 * p3[1],
@@ -437,6 +432,18 @@ pub fn periodic_bspline(pts: &[[f64; 2]], per_span: usize) -> Vec<[f64; 2]> {
     }
     out.push(out[0]);
     out
+}
+
+/// The four weights of a uniform cubic B-spline's span at `t` in [0, 1]:
+/// of its control points j … j + 3 for span j.
+pub fn uniform_cubic_basis(t: f64) -> [f64; 4] {
+    let (t2, t3) = (t * t, t * t * t);
+    [
+        (1.0 - t).powi(3) / 6.0,
+        (3.0 * t3 - 6.0 * t2 + 4.0) / 6.0,
+        (-3.0 * t3 + 3.0 * t2 + 3.0 * t + 1.0) / 6.0,
+        t3 / 6.0,
+    ]
 }
 
 /// Arc length at each vertex of a polyline (0 at the first).

@@ -53,7 +53,7 @@ pub(super) type LoopFit = (Loop, f64, (usize, usize));
 /// mesh's offsets less the design's (section by section, ray by ray).
 /// With it, the design's new largest difference and where (section,
 /// ray). Where sixteen are not enough, the polygon of its corners
-/// ([`polygon`]); `None` where that does not hold either (a wall of
+/// ([`Rays::polygon`]); `None` where that does not hold either (a wall of
 /// facets too coarse for the tolerance, a design already near it).
 pub(super) fn loop_fewest(
     psi: &[[f64; 2]],
@@ -61,10 +61,15 @@ pub(super) fn loop_fewest(
     residual: &[Vec<f64>],
     tol: f64,
 ) -> Option<LoopFit> {
-    let n = psi.len();
-    if n < 2 * LOOP_MAX {
+    if psi.len() < 2 * LOOP_MAX {
         return None;
     }
+    let rays = Rays {
+        psi,
+        dirs,
+        residual,
+        tol,
+    };
     for m in LOOP_MIN..=LOOP_MAX {
         // The points placed along the curve by length and by length and
         // turn, the better kept (by length alone, a 60 × 40 mm oval took
@@ -83,7 +88,7 @@ pub(super) fn loop_fewest(
                 }
             }
             let curve = crate::curves::periodic_bspline(&ctrl, PER_SPAN);
-            if let Some((own, dev, at)) = measure(&curve, psi, dirs, residual) {
+            if let Some((own, dev, at)) = rays.measure(&curve) {
                 if own <= tol / 3.0 && best.as_ref().is_none_or(|b| dev < b.1) {
                     best = Some((Loop::Curve(ctrl), dev, at));
                 }
@@ -93,53 +98,88 @@ pub(super) fn loop_fewest(
             return Some(b);
         }
     }
-    polygon(psi, dirs, residual, tol)
+    rays.polygon()
 }
 
-/// The loop as a polygon of at most [`POLYGON_MAX`] corners, where no curve
-/// of as few points holds (a hexagonal planter's corners): the loop's
-/// points simplified (Douglas–Peucker, round the loop from its two
-/// farthest-apart points) within a third of the tolerance and then a
-/// sixth, measured as the design draws it (its sharpest corners rounded
-/// for the bead, `curves::round_corners`), kept on the same terms as a
-/// curve.
-fn polygon(
-    psi: &[[f64; 2]],
-    dirs: &[[f64; 2]],
-    residual: &[Vec<f64>],
+/// What a loop is fitted against: `psi` the loop as fitted, `dirs` its
+/// rays, `residual` the mesh's offsets less the design's (section by
+/// section, ray by ray), `tol` the tolerance.
+struct Rays<'a> {
+    psi: &'a [[f64; 2]],
+    dirs: &'a [[f64; 2]],
+    residual: &'a [Vec<f64>],
     tol: f64,
-) -> Option<LoopFit> {
-    let n = psi.len();
-    let far = (0..n)
-        .max_by(|&a, &b| {
-            let d = |i: usize| (psi[i][0] - psi[0][0]).hypot(psi[i][1] - psi[0][1]);
-            d(a).total_cmp(&d(b))
-        })
-        .filter(|&k| k > 0)?;
-    let params = crate::design::Params::default();
-    for eps in [tol / 3.0, tol / 6.0] {
-        let mut corners = super::through::simplify(&psi[..=far], eps);
-        let back: Vec<[f64; 2]> = psi[far..].iter().chain(&psi[..1]).copied().collect();
-        let back = super::through::simplify(&back, eps);
-        corners.extend_from_slice(&back[1..back.len() - 1]);
-        // The two points it started from stay only where they are corners.
-        let corners = without_straight(corners, eps);
-        if corners.len() < 3 || corners.len() > POLYGON_MAX {
-            continue;
-        }
-        // As the design draws it before sampling: its corners sharper
-        // than a loop's limit rounded for the widest bead (sampled, every
-        // loop's corners are cut alike, the 360 points' too).
-        let (mut line, _) =
-            crate::curves::round_corners(&corners, true, params.width_max, 0.25 * params.spacing);
-        line.push(line[0]);
-        if let Some((own, dev, at)) = measure(&line, psi, dirs, residual) {
-            if own <= tol / 3.0 && dev <= tol {
-                return Some((Loop::Polygon(corners), dev, at));
+}
+
+impl Rays<'_> {
+    /// The loop as a polygon of at most [`POLYGON_MAX`] corners, where
+    /// no curve of as few points holds (a hexagonal planter's corners):
+    /// the loop's points simplified (Douglas–Peucker, round the loop from
+    /// its two farthest-apart points) within a third of the tolerance and
+    /// then a sixth, measured as the design draws it (its sharpest corners
+    /// rounded for the bead, `curves::round_corners`), kept on the same
+    /// terms as a curve.
+    fn polygon(&self) -> Option<LoopFit> {
+        let (psi, tol) = (self.psi, self.tol);
+        let n = psi.len();
+        let far = (0..n)
+            .max_by(|&a, &b| {
+                let d = |i: usize| (psi[i][0] - psi[0][0]).hypot(psi[i][1] - psi[0][1]);
+                d(a).total_cmp(&d(b))
+            })
+            .filter(|&k| k > 0)?;
+        let params = crate::design::Params::default();
+        for eps in [tol / 3.0, tol / 6.0] {
+            let mut corners = simplify(&psi[..=far], eps);
+            let back: Vec<[f64; 2]> = psi[far..].iter().chain(&psi[..1]).copied().collect();
+            let back = simplify(&back, eps);
+            corners.extend_from_slice(&back[1..back.len() - 1]);
+            // The two points it started from stay only where they are
+            // corners.
+            let corners = without_straight(corners, eps);
+            if corners.len() < 3 || corners.len() > POLYGON_MAX {
+                continue;
+            }
+            // As the design draws it before sampling: its corners sharper
+            // than a loop's limit rounded for the widest bead (sampled, every
+            // loop's corners are cut alike, the 360 points' too).
+            let (mut line, _) = crate::curves::round_corners(
+                &corners,
+                true,
+                params.width_max,
+                0.25 * params.spacing,
+            );
+            line.push(line[0]);
+            if let Some((own, dev, at)) = self.measure(&line) {
+                if own <= tol / 3.0 && dev <= tol {
+                    return Some((Loop::Polygon(corners), dev, at));
+                }
             }
         }
+        None
     }
-    None
+
+    /// How far the closed polyline `curve` (its first point repeated at
+    /// its end) lies off the loop along its rays at most, and the design's
+    /// largest difference from the mesh with it for its loop and where
+    /// (section, ray): each ray's residual less how far along the ray the
+    /// curve lies off its point; `None` when a ray misses the curve.
+    fn measure(&self, curve: &[[f64; 2]]) -> Option<(f64, f64, (usize, usize))> {
+        let moved = (0..self.psi.len())
+            .map(|j| along_ray(curve, self.psi[j], self.dirs[j]))
+            .collect::<Option<Vec<f64>>>()?;
+        let mut worst = (0.0f64, (0, 0));
+        for (k, row) in self.residual.iter().enumerate() {
+            for (j, (r, e)) in row.iter().zip(&moved).enumerate() {
+                let off = (r - e).abs();
+                if off > worst.0 {
+                    worst = (off, (k, j));
+                }
+            }
+        }
+        let own = moved.iter().fold(0.0f64, |m, e| m.max(e.abs()));
+        Some((own, worst.0, worst.1))
+    }
 }
 
 /// Each point's share of the loop from the first, a step counting its
@@ -149,13 +189,7 @@ fn polygon(
 fn shares(psi: &[[f64; 2]], w: f64) -> Vec<f64> {
     let n = psi.len();
     let len = |a: [f64; 2], b: [f64; 2]| (b[0] - a[0]).hypot(b[1] - a[1]);
-    let turn = |i: usize| {
-        let (a, b, c) = (psi[(i + n - 1) % n], psi[i], psi[(i + 1) % n]);
-        let (e, f) = ([b[0] - a[0], b[1] - a[1]], [c[0] - b[0], c[1] - b[1]]);
-        (e[0] * f[1] - e[1] * f[0])
-            .atan2(e[0] * f[0] + e[1] * f[1])
-            .abs()
-    };
+    let turn = |i: usize| bend(psi[(i + n - 1) % n], psi[i], psi[(i + 1) % n]).abs();
     let total = perimeter(psi);
     let step = |i: usize| {
         let j = (i + 1) % n;
@@ -177,9 +211,7 @@ fn without_straight(mut corners: Vec<[f64; 2]>, eps: f64) -> Vec<[f64; 2]> {
     while corners.len() > 3 && i < corners.len() {
         let n = corners.len();
         let (a, b, c) = (corners[(i + n - 1) % n], corners[i], corners[(i + 1) % n]);
-        let len = (c[0] - a[0]).hypot(c[1] - a[1]).max(1e-12);
-        let off = ((c[0] - a[0]) * (a[1] - b[1]) - (a[0] - b[0]) * (c[1] - a[1])).abs() / len;
-        if off <= eps {
+        if off_line(a, c, b) <= eps {
             corners.remove(i);
         } else {
             i += 1;
@@ -188,49 +220,12 @@ fn without_straight(mut corners: Vec<[f64; 2]>, eps: f64) -> Vec<[f64; 2]> {
     corners
 }
 
-/// How far the closed polyline `curve` (its first point repeated at its
-/// end) lies off the loop along its rays at most, and the design's
-/// largest difference from the mesh with it for its loop and where
-/// (section, ray): each ray's residual less how far along the ray the
-/// curve lies off its point; `None` when a ray misses the curve.
-fn measure(
-    curve: &[[f64; 2]],
-    psi: &[[f64; 2]],
-    dirs: &[[f64; 2]],
-    residual: &[Vec<f64>],
-) -> Option<(f64, f64, (usize, usize))> {
-    let moved = (0..psi.len())
-        .map(|j| along_ray(curve, psi[j], dirs[j]))
-        .collect::<Option<Vec<f64>>>()?;
-    let mut worst = (0.0f64, (0, 0));
-    for (k, row) in residual.iter().enumerate() {
-        for (j, (r, e)) in row.iter().zip(&moved).enumerate() {
-            let off = (r - e).abs();
-            if off > worst.0 {
-                worst = (off, (k, j));
-            }
-        }
-    }
-    let own = moved.iter().fold(0.0f64, |m, e| m.max(e.abs()));
-    Some((own, worst.0, worst.1))
-}
-
 /// The periodic uniform cubic B-spline's four basis values at `t` (in
 /// [0, m)) and the first of the four control points they weigh.
 fn basis(t: f64, m: usize) -> (usize, [f64; 4]) {
     let t = t.rem_euclid(m as f64);
     let j = (t.floor() as usize).min(m - 1);
-    let u = t - j as f64;
-    let (u2, u3) = (u * u, u * u * u);
-    (
-        j,
-        [
-            (1.0 - u).powi(3) / 6.0,
-            (3.0 * u3 - 6.0 * u2 + 4.0) / 6.0,
-            (-3.0 * u3 + 3.0 * u2 + 3.0 * u + 1.0) / 6.0,
-            u3 / 6.0,
-        ],
-    )
+    (j, crate::curves::uniform_cubic_basis(t - j as f64))
 }
 
 /// The `m` control points of the closed curve nearest `pts` at
@@ -290,40 +285,28 @@ fn reproject_periodic(ctrl: &[[f64; 2]], pts: &[[f64; 2]], t: &mut [f64]) {
     }
 }
 
+/// A crossing farther than this from the loop is the loop's other side
+/// (mm).
+const NEAR_MM: f64 = 5.0;
+
+/// Of crossings (t along the ray, segment), the nearest the ray's start,
+/// if it is nearer than [`NEAR_MM`].
+fn nearest(c: impl Iterator<Item = (f64, usize)>) -> Option<(f64, usize)> {
+    c.min_by(|a, b| a.0.abs().total_cmp(&b.0.abs()))
+        .filter(|c| c.0.abs() < NEAR_MM)
+}
+
 /// How far along `dir` from `p` the closed polyline `curve` lies (the
 /// crossing nearest `p`), or `None` when the ray meets it nowhere near.
 fn along_ray(curve: &[[f64; 2]], p: [f64; 2], dir: [f64; 2]) -> Option<f64> {
-    let mut best: Option<f64> = None;
-    for w in curve.windows(2) {
-        let (a, b) = (w[0], w[1]);
-        let e = [b[0] - a[0], b[1] - a[1]];
-        let den = dir[0] * e[1] - dir[1] * e[0];
-        if den.abs() < 1e-12 {
-            continue;
-        }
-        let ap = [a[0] - p[0], a[1] - p[1]];
-        let s = (ap[0] * e[1] - ap[1] * e[0]) / den;
-        let f = (ap[0] * dir[1] - ap[1] * dir[0]) / den;
-        if (-1e-9..=1.0 + 1e-9).contains(&f) && best.is_none_or(|x| s.abs() < x.abs()) {
-            best = Some(s);
-        }
-    }
-    // A crossing farther than a few millimetres is the loop's other side.
-    best.filter(|s| s.abs() < 5.0)
+    nearest(crossings(curve, p, dir).into_iter()).map(|c| c.0)
 }
 
 #[cfg(test)]
 mod tests {
     use super::*;
 
-    fn ring(r: impl Fn(f64) -> f64, n: usize) -> Vec<[f64; 2]> {
-        (0..n)
-            .map(|j| {
-                let a = std::f64::consts::TAU * j as f64 / n as f64;
-                [r(a) * a.cos(), r(a) * a.sin()]
-            })
-            .collect()
-    }
+    use crate::meshfit::tests::ring;
 
     fn curve_of(l: Loop) -> Vec<[f64; 2]> {
         match l {

@@ -569,15 +569,18 @@ fn round_bottom(cut: &[sections::Section]) -> Option<usize> {
     let p = crate::design::Params::default();
     let lean = p.max_overhang_deg.to_radians().tan();
     let r: Vec<Option<f64>> = cut.iter().map(area_radius).collect();
-    // How far the outside above section k leans out past the limit.
-    let excess = |k: usize| -> f64 {
-        let Some(rk) = r[k] else {
-            return f64::INFINITY;
-        };
-        (k + 1..cut.len())
-            .filter_map(|m| r[m].map(|rm| rm - rk - lean * (cut[m].z - cut[k].z)))
-            .fold(0.0, f64::max)
-    };
+    // How far the outside above section k leans out past the limit: the
+    // most r_m − lean·z_m above it less its own, kept as it is read
+    // from the top down, so the search is linear in the sections.
+    let g: Vec<Option<f64>> = (0..cut.len())
+        .map(|k| r[k].map(|rk| rk - lean * cut[k].z))
+        .collect();
+    let mut above = vec![f64::NEG_INFINITY; cut.len() + 1];
+    for k in (0..cut.len()).rev() {
+        above[k] = above[k + 1].max(g[k].unwrap_or(f64::NEG_INFINITY));
+    }
+    let excess =
+        |k: usize| -> f64 { g[k].map_or(f64::INFINITY, |gk| (above[k + 1] - gk).max(0.0)) };
     // A bottom that narrows to a point or a small disk is one loop at the
     // bed; feet or a ring foot are the refusals' and the recess's.
     if cut.first().is_none_or(|s| s.loops.len() != 1) || excess(0) <= p.max_correction_mm {
@@ -883,23 +886,21 @@ fn fit_with(mesh: &TriMesh, opts: &FitOptions, absorbed: &mut Option<String>) ->
     // The loop by few control points where they hold the tolerance and
     // make a design the file takes (a curve that keeps clear of o and of
     // itself); else Ψ's points.
-    let few_loop = if sweep.is_none() {
+    let few = if sweep.is_none() {
         b.few_loop(&zs, tol)
     } else {
         None
     };
-    let mut design = None;
-    if let Some((l, dev, worst)) = few_loop {
-        b.loop_ctrl = Some(l);
-        match Design::from_json(&b.json(&opts.name)) {
-            Ok(d) => {
-                design = Some(d);
-                (b.deviation, b.at) = (dev, worst);
-            }
-            Err(_) => b.loop_ctrl = None,
+    let with_few = few.and_then(|(l, dev, worst)| {
+        b.fitted_loop = Some(l);
+        let d = Design::from_json(&b.json(&opts.name)).ok();
+        match d {
+            Some(_) => (b.deviation, b.at) = (dev, worst),
+            None => b.fitted_loop = None,
         }
-    }
-    let mut design = match design {
+        d
+    });
+    let mut design = match with_few {
         Some(d) => d,
         None => Design::from_json(&b.json(&opts.name))?,
     };
@@ -1034,7 +1035,7 @@ struct Candidate {
     /// The loop as a closed curve's control points or a polygon's
     /// corners (in the frame the fit measures in), where few hold the
     /// tolerance; else Ψ's points are the design's polyline.
-    loop_ctrl: Option<loopfit::Loop>,
+    fitted_loop: Option<loopfit::Loop>,
 }
 
 impl Candidate {
@@ -1116,7 +1117,7 @@ impl Candidate {
         };
         let turned =
             |l: &[[f64; 2]]| -> Vec<[f64; 2]> { l.iter().map(|&p| turn_by(p, forward)).collect() };
-        let (control_points, points) = match &self.loop_ctrl {
+        let (control_points, points) = match &self.fitted_loop {
             Some(loopfit::Loop::Curve(c)) => (Some(turned(c)), None),
             Some(loopfit::Loop::Polygon(p)) => (None, Some(turned(p))),
             None => (None, Some(turned(&psi))),
@@ -1221,14 +1222,14 @@ fn fit_offsets(
     // control points, then two; only then as many points as hold the
     // tolerance (one profile of 160 points is no simpler to edit than two
     // of nine).
-    let one = few_points(&g, &d, &mean, None);
-    if one.as_ref().is_some_and(|c| c.deviation <= tol) {
-        return one.expect("just read");
-    }
-    let two = few_points(&g, &d, &s, Some((&t, &lambda)));
-    if two.as_ref().is_some_and(|c| c.deviation <= tol) {
-        return two.expect("just read");
-    }
+    let one = match few_points(&g, &d, &mean, None) {
+        Some(c) if c.deviation <= tol => return c,
+        other => other,
+    };
+    let two = match few_points(&g, &d, &s, Some((&t, &lambda))) {
+        Some(c) if c.deviation <= tol => return c,
+        other => other,
+    };
     let through = |s: &[f64], two: Option<(&[f64], &[f64])>| {
         candidate_with(&g, &d, s, two, None).expect("through the values")
     };
@@ -1424,7 +1425,7 @@ fn candidate_with(
     }
     Some(Candidate {
         folds: (0, None),
-        loop_ctrl: None,
+        fitted_loop: None,
         offset,
         two: two.is_some(),
         psi: psi.to_vec(),
@@ -1444,7 +1445,8 @@ fn candidate_with(
 mod tests {
     use super::*;
 
-    fn ring(r: impl Fn(f64) -> f64, n: usize) -> Vec<[f64; 2]> {
+    /// `n` points round o at radius `r(angle)`, from angle 0.
+    pub(super) fn ring(r: impl Fn(f64) -> f64, n: usize) -> Vec<[f64; 2]> {
         (0..n)
             .map(|j| {
                 let a = std::f64::consts::TAU * j as f64 / n as f64;

@@ -89,6 +89,13 @@ pub(super) fn perimeter(l: &[[f64; 2]]) -> f64 {
         .sum()
 }
 
+/// The angle the path `a` → `b` → `c` turns by at `b` (radians, to the
+/// left positive).
+pub(super) fn bend(a: [f64; 2], b: [f64; 2], c: [f64; 2]) -> f64 {
+    let (e, f) = ([b[0] - a[0], b[1] - a[1]], [c[0] - b[0], c[1] - b[1]]);
+    (e[0] * f[1] - e[1] * f[0]).atan2(e[0] * f[0] + e[1] * f[1])
+}
+
 /// `p` turned about o by the angle whose sine and cosine are `(s, c)`.
 pub(super) fn turn_by(p: [f64; 2], (s, c): (f64, f64)) -> [f64; 2] {
     [c * p[0] - s * p[1], s * p[0] + c * p[1]]
@@ -146,13 +153,11 @@ pub(super) fn resample(l: &[[f64; 2]], k: usize) -> Vec<[f64; 2]> {
     let mut at = 0.0;
     for v in 0..n {
         let (a, p, b) = (l[(v + n - 1) % n], l[v], l[(v + 1) % n]);
-        let (e, f) = ([p[0] - a[0], p[1] - a[1]], [b[0] - p[0], b[1] - p[1]]);
-        let bend = (e[0] * f[1] - e[1] * f[0]).atan2(e[0] * f[0] + e[1] * f[1]);
-        if bend.abs() > CORNER && total > 0.0 {
+        if bend(a, p, b).abs() > CORNER && total > 0.0 {
             let m = (at / total * k as f64).round() as usize % k;
             out[m] = p;
         }
-        at += f[0].hypot(f[1]);
+        at += (b[0] - p[0]).hypot(b[1] - p[1]);
     }
     out
 }

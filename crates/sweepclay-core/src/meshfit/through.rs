@@ -108,6 +108,12 @@ pub(super) fn fewest(pts: &[[f64; 2]], limit: f64) -> Option<Vec<[f64; 2]>> {
     straight
 }
 
+/// How far `r` lies from the line through `p` and `q` (mm).
+pub(super) fn off_line(p: [f64; 2], q: [f64; 2], r: [f64; 2]) -> f64 {
+    let len = (q[0] - p[0]).hypot(q[1] - p[1]).max(1e-12);
+    ((q[0] - p[0]) * (p[1] - r[1]) - (p[0] - r[0]) * (q[1] - p[1])).abs() / len
+}
+
 /// The points of `pts` that keep every other within `eps` of the
 /// polyline through them (Douglas–Peucker), the ends kept.
 pub(super) fn simplify(pts: &[[f64; 2]], eps: f64) -> Vec<[f64; 2]> {
@@ -118,15 +124,8 @@ pub(super) fn simplify(pts: &[[f64; 2]], eps: f64) -> Vec<[f64; 2]> {
     let mut todo = vec![(0, last)];
     while let Some((a, b)) = todo.pop() {
         let (p, q) = (pts[a], pts[b]);
-        let len = (q[0] - p[0]).hypot(q[1] - p[1]).max(1e-12);
         let far = (a + 1..b)
-            .map(|i| {
-                let r = pts[i];
-                (
-                    i,
-                    ((q[0] - p[0]) * (p[1] - r[1]) - (p[0] - r[0]) * (q[1] - p[1])).abs() / len,
-                )
-            })
+            .map(|i| (i, off_line(p, q, pts[i])))
             .max_by(|x, y| x.1.total_cmp(&y.1));
         if let Some((i, _)) = far.filter(|&(_, d)| d > eps) {
             keep[i] = true;
@@ -152,11 +151,7 @@ fn polyline(corners: &[[f64; 2]]) -> Vec<[f64; 2]> {
         let times = if i == 0 || i + 1 == n {
             1
         } else {
-            let (a, b) = (corners[i - 1], corners[i + 1]);
-            let (e, f) = ([c[0] - a[0], c[1] - a[1]], [b[0] - c[0], b[1] - c[1]]);
-            let turn = (e[0] * f[1] - e[1] * f[0])
-                .atan2(e[0] * f[0] + e[1] * f[1])
-                .abs();
+            let turn = bend(corners[i - 1], c, corners[i + 1]).abs();
             if turn > SHARP {
                 3
             } else if turn > 0.25 * SHARP {
@@ -315,11 +310,7 @@ fn parameters(pts: &[[f64; 2]], corner: f64) -> Vec<f64> {
     let mut t = vec![0.0; pts.len()];
     for i in 1..pts.len() {
         let turn = if i + 1 < pts.len() {
-            let (a, b, c) = (pts[i - 1], pts[i], pts[i + 1]);
-            let (e, f) = ([b[0] - a[0], b[1] - a[1]], [c[0] - b[0], c[1] - b[1]]);
-            (e[0] * f[1] - e[1] * f[0])
-                .atan2(e[0] * f[0] + e[1] * f[1])
-                .abs()
+            bend(pts[i - 1], pts[i], pts[i + 1]).abs()
         } else {
             0.0
         };

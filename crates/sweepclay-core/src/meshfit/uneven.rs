@@ -117,13 +117,14 @@ pub(super) fn fit_uneven(
     }
     // Each ray's rim: the top of the highest section it reaches, with no
     // gap below it.
-    let mut tops = vec![0usize; jj];
-    for (j, top) in tops.iter_mut().enumerate() {
-        *top = (0..d.len())
-            .take_while(|&k| d[k][j].is_some())
-            .last()
-            .unwrap_or(0);
-    }
+    let tops: Vec<usize> = (0..jj)
+        .map(|j| {
+            (0..d.len())
+                .take_while(|&k| d[k][j].is_some())
+                .last()
+                .unwrap_or(0)
+        })
+        .collect();
     let fine = rim_between_sections(&tops, &zs);
     let mut rim = vec![0.0; jj];
     for j in 0..jj {
@@ -287,7 +288,7 @@ pub(super) fn fit_uneven(
     };
     let cand = Candidate {
         folds: (0, None),
-        loop_ctrl: None,
+        fitted_loop: None,
         offset: Offset::Radial,
         two: true,
         psi,
