@@ -741,3 +741,27 @@ fn a_foot_under_a_wall_leaning_out_is_flush_with_its_wider_first_turn() {
         "the foot steps by up to {worst:.2} mm: {steps:?}"
     );
 }
+
+#[test]
+fn a_cone_leaning_out_from_its_foot_stands_flush_on_its_floor() {
+    // A cone 46° from upright from its very first turn lays that turn
+    // 3.9 mm wide, and the floor's outer ring moves out 0.45 mm to meet
+    // it. With the inner rings stepping over 3 bead widths that spiral
+    // was cut at 555 of 1,364 mm (two turns' steps 2.17 mm apart, the
+    // least gap), so the floor was laid on the ring as drawn and the foot
+    // read −0.45 mm all round. A longer inner step is tried next.
+    let text = r#"{"sweepclay": 1, "name": "cone",
+      "profile_start": {"control_points": [[0, 0], [41.4, 40]]},
+      "trajectory": {"control_points": [[42.666, 0], [30.169, 30.169],
+        [0, 42.666], [-30.169, 30.169], [-42.666, 0], [-30.169, -30.169],
+        [0, -42.666], [30.169, -30.169]], "closed": true},
+      "params": {"floor_layers": 3}, "printer": "cerambot-plus"}"#;
+    let s = slice(&Design::from_json(text).expect("valid")).expect("slices");
+    let steps = foot_steps(&s);
+    assert!(steps.len() >= 70, "{} bins", steps.len());
+    let worst = steps.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
+    assert!(
+        worst <= 0.3,
+        "the foot steps by up to {worst:.2} mm: {steps:?}"
+    );
+}
