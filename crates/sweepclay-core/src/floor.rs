@@ -191,11 +191,40 @@ pub fn spiral_floor_covering(
         None
     };
     let mut stepped_kept = false;
+    // The rays to each candidate spine, nearest and along the normals,
+    // found once and only if the rings' steps do not serve.
+    let ray_families = std::cell::OnceCell::new();
+    let families = || {
+        ray_families.get_or_init(|| {
+            spines(outer)
+                .into_iter()
+                .flat_map(|spine| [rays_to(outer, spine), normal_rays_to(outer, spine)])
+                .collect::<Vec<Vec<Ray>>>()
+        })
+    };
     for step in steps {
         // The steps differ only in the outermost turn's: once one keeps
         // its turns apart, the other covers the same.
         if step.is_some() && stepped_kept {
             continue;
+        }
+        // Where the rings' steps did not serve (an elongated oval's
+        // offsets end in thin lenses whose sides meet, and the walk is cut
+        // there), the rays to a spine are stepped the same way: flush at
+        // the foot.
+        let flush_enough = best.as_ref().is_some_and(|(c, _)| *c >= FLUSH_ENOUGH);
+        if step.is_none() && flush && !flush_enough {
+            for rays in families() {
+                for outer_step in STEP_WIDTHS {
+                    let step = Step {
+                        outer: outer_step,
+                        inner: INNER_STEP_WIDTHS[0],
+                    };
+                    if let Some(m) = ray_floor(rays, beads, Some(step.times(beads.width))) {
+                        consider(m, &mut best);
+                    }
+                }
+            }
         }
         // A flush spiral that covers nearly all is kept over a blended
         // one that covers a little more.
@@ -222,28 +251,14 @@ pub fn spiral_floor_covering(
             return Ok(best.expect("just kept").1.spiral);
         }
     }
-    for spine in spines(outer) {
-        for rays in [rays_to(outer, spine), normal_rays_to(outer, spine)] {
-            let span = |r: &Ray| r.len + (OUTER_START - 0.5) * pitch;
-            let short = rays.iter().map(span).fold(f64::INFINITY, f64::min);
-            if short < pitch {
-                let half_width = rays.iter().map(|r| r.len).fold(f64::INFINITY, f64::min);
-                last_refusal = FloorRefusal::TooNarrow { half_width };
-                continue;
-            }
-            // The most turns whose closest neighbours keep MIN_GAP pitches.
-            let mut turns = ((short / pitch).floor() as usize).clamp(1, MAX_FLOOR_TURNS);
-            let m = loop {
-                let m = measure(&rays, turns, beads);
-                if m.closest.1 < MIN_GAP * pitch && turns > 1 {
-                    turns -= 1;
-                    continue;
-                }
-                break m;
-            };
-            if consider(m, &mut best) && best.as_ref().is_some_and(|(c, _)| *c >= WHOLE) {
-                return Ok(best.expect("just kept").1.spiral);
-            }
+    for rays in families() {
+        let Some(m) = ray_floor(rays, beads, None) else {
+            let half_width = rays.iter().map(|r| r.len).fold(f64::INFINITY, f64::min);
+            last_refusal = FloorRefusal::TooNarrow { half_width };
+            continue;
+        };
+        if consider(m, &mut best) && best.as_ref().is_some_and(|(c, _)| *c >= WHOLE) {
+            return Ok(best.expect("just kept").1.spiral);
         }
     }
     match best {
@@ -277,6 +292,15 @@ struct Step {
 }
 
 impl Step {
+    /// Turn k's step: the outermost's, the inner ones' at least as long.
+    fn of_turn(self, k: usize) -> f64 {
+        if k == 0 {
+            self.outer
+        } else {
+            self.outer.max(self.inner)
+        }
+    }
+
     fn times(self, k: f64) -> Step {
         Step {
             outer: self.outer * k,
@@ -405,8 +429,7 @@ fn offset_spiral(
         // same share of each ring instead measured gaps of 1.9 pitches
         // across the jogs, which lie end to end.)
         let blend = match step {
-            Some(s) if k == 0 => s.outer,
-            Some(s) => s.outer.max(s.inner),
+            Some(s) => s.of_turn(k),
             None => total,
         }
         .min(total);
@@ -462,24 +485,29 @@ fn offset_spiral(
         vec![]
     };
     let mut m = measure_path(pts, turn_of, turns, beads);
-    // Where the outermost ring steps in to the next, its beads widen to
-    // keep their outer edge on the outline's (up to the widest bead): the
-    // wall's first turn above rests on them all round (docs/ALGORITHMS.md
-    // §8).
-    // Its inner edge stops short of the next turn's middle, a pitch in:
-    // a wider bead would lie under that turn, on clay of its own layer.
-    // Nor does any bead of it, widened to touch its inner neighbour,
-    // reach past the outline's outer edge: a ledge at the foot.
-    // The next turn's middle is measured, not taken as a pitch in: where
-    // the step begins it lies up to 1.5 pitches in, and a bead capped at a
-    // pitch left a notch 0.4 mm deep in the foot at every seam.
+    widen_steps(&mut m, deep, beads);
+    Some(m)
+}
+
+/// Where the outermost turn steps in to the next, its beads widen to
+/// keep their outer edge on the outline's (up to the widest bead): the
+/// wall's first turn above rests on them all round (docs/ALGORITHMS.md
+/// §8). `deep`: each point of the outermost turn, its depth inside the
+/// outline and its distance from the next turn's middle.
+fn widen_steps(m: &mut Measured, deep: Vec<(usize, f64, f64)>, beads: FloorBeads) {
+    // A bead's inner edge stops short of the next turn's middle: a wider
+    // bead would lie under that turn, on clay of its own layer. Nor does
+    // any bead, widened to touch its inner neighbour, reach past the
+    // outline's outer edge: a ledge at the foot. The next turn's middle
+    // is measured, not taken as a pitch in: where the step begins it
+    // lies up to 1.5 pitches in, and a bead capped at a pitch left a
+    // notch 0.4 mm deep in the foot at every seam.
     for (i, depth, next) in deep {
         let cap = beads.widest.min(2.0 * STEP_REACH * next);
         let flush = beads.width + 2.0 * depth;
         let w = &mut m.spiral.widths[i];
         *w = w.max(flush.min(cap)).min(flush);
     }
-    Some(m)
 }
 
 /// The points of the outermost turn with their distance inside the
@@ -868,23 +896,119 @@ struct Measured {
 
 /// The spiral of `turns` turns along `rays`, its points thinned to about
 /// the outer turn's spacing, its gaps and widths measured.
-fn measure(rays: &[Ray], turns: usize, beads: FloorBeads) -> Measured {
-    let (pts, turn_of) = ray_spiral(rays, turns, beads);
-    // The closing half turn counts as the innermost.
-    measure_path(pts, turn_of, turns + 1, beads)
+fn measure(rays: &[Ray], turns: usize, beads: FloorBeads, step: Option<Step>) -> Measured {
+    let (pts, turn_of) = ray_spiral(rays, turns, beads, step);
+    stepped_widths(pts, turn_of, turns + 1, beads, step.map(|_| rays))
 }
 
+/// [`measure_path`], the outermost turn's step beads widened to keep
+/// their outer edge on the outline's where a stepped spiral's outermost
+/// turn lies on it (`outer` given).
+fn stepped_widths(
+    pts: Vec<[f64; 2]>,
+    turn_of: Vec<u32>,
+    turns: usize,
+    beads: FloorBeads,
+    outer: Option<&[Ray]>,
+) -> Measured {
+    let outline: Option<Vec<[f64; 2]>> = outer.map(|r| r.iter().map(|r| r.from).collect());
+    let deep = match &outline {
+        Some(o) => outermost_depths(&pts, &turn_of, o, beads),
+        None => vec![],
+    };
+    let mut m = measure_path(pts, turn_of, turns, beads);
+    widen_steps(&mut m, deep, beads);
+    m
+}
+
+/// The spiral along `rays` of the most turns whose closest neighbours
+/// keep [`MIN_GAP`] pitches apart; none where a ray is shorter than a
+/// pitch.
+fn ray_floor(rays: &[Ray], beads: FloorBeads, step: Option<Step>) -> Option<Measured> {
+    let pitch = beads.pitch();
+    // A stepped walk's last step runs along the rays by the wall's start:
+    // slanting there (round a spine's end), it ends a bead or more along
+    // the wall from where it began, and the wall's first beads rested on
+    // less than half their width (docs/ALGORITHMS.md §8).
+    if let Some(st) = step {
+        // The step runs over rays 1, 2, … up to ray 0 (the walk visits
+        // them against the polygon's order).
+        let mut along = 0.0;
+        for w in rays.windows(2) {
+            if w[0].cos < SQUARE_STEP {
+                return None;
+            }
+            along += dist(w[0].from, w[1].from);
+            if along > st.outer + beads.width {
+                break;
+            }
+        }
+    }
+    let span = |r: &Ray| r.len + (OUTER_START - 0.5) * pitch;
+    let short = rays.iter().map(span).fold(f64::INFINITY, f64::min);
+    if short < pitch {
+        return None;
+    }
+    let mut turns = ((short / pitch).floor() as usize).clamp(1, MAX_FLOOR_TURNS);
+    loop {
+        let m = measure(rays, turns, beads, step);
+        if m.closest.1 < MIN_GAP * pitch && turns > 1 {
+            turns -= 1;
+            continue;
+        }
+        return Some(m);
+    }
+}
+
+/// The least cosine between a ray and the wall's normal along a stepped
+/// walk's last step.
+const SQUARE_STEP: f64 = 0.95;
+
 /// The points of the spiral of `turns` turns along `rays`, thinned to
-/// about the outer turn's spacing, and the turn of each.
-fn ray_spiral(rays: &[Ray], turns: usize, beads: FloorBeads) -> (Vec<[f64; 2]>, Vec<u32>) {
+/// about the outer turn's spacing, and the turn of each. Blended (no
+/// `step`), each turn moves in along the rays as it goes round; stepped,
+/// each lies at one depth all round but its last `step` mm (the
+/// outermost on the outline: a flush foot), as [`offset_spiral`]'s rings
+/// do, and the rays still carry it in to their spine.
+fn ray_spiral(
+    rays: &[Ray],
+    turns: usize,
+    beads: FloorBeads,
+    step: Option<Step>,
+) -> (Vec<[f64; 2]>, Vec<u32>) {
     let n = rays.len();
     let pitch = beads.pitch();
     let keep = 0.6 * beads.spacing;
+    // Turn k's depth along a ray before its step (stepped), and the share
+    // of the turn its step takes: its length over the turn's.
+    let depth = |r: &Ray, k: usize| {
+        let first = pitch / r.cos;
+        let end = r.len - 0.5 * pitch;
+        match k {
+            0 => 0.0,
+            _ if turns == 1 => end,
+            _ => first + (k - 1) as f64 * (end - first) / (turns - 1) as f64,
+        }
+    };
+    let shares: Vec<f64> = match step {
+        None => vec![],
+        Some(st) => (0..turns)
+            .map(|k| {
+                let at = |j: usize| {
+                    let r = &rays[j % n];
+                    let d = depth(r, k);
+                    [r.from[0] + d * r.dir[0], r.from[1] + d * r.dir[1]]
+                };
+                let length: f64 = (0..n).map(|j| dist(at(j), at(j + 1))).sum();
+                (st.of_turn(k) / length.max(1e-9)).min(1.0)
+            })
+            .collect(),
+    };
     let mut pts: Vec<[f64; 2]> = Vec::with_capacity(n * turns / 2 + 2);
     let mut turn_of: Vec<u32> = Vec::with_capacity(pts.capacity());
     let total = turns * n;
-    for step in 0..=total {
-        let (k, j) = (step / n, step % n);
+    for at in 0..=total {
+        let (k, j) = (at / n, at % n);
         // Against the polygon's order: ray 0, n − 1, n − 2, …
         let r = &rays[(n - j) % n];
         let sigma = j as f64 / n as f64;
@@ -894,7 +1018,14 @@ fn ray_spiral(rays: &[Ray], turns: usize, beads: FloorBeads) -> (Vec<[f64; 2]>, 
         let first = pitch / r.cos;
         let start = -OUTER_START * first;
         let end = r.len - 0.5 * pitch;
-        let s = if k == 0 || turns == 1 {
+        let s = if let Some(&q) = shares.get(k) {
+            let ramp = ((sigma - (1.0 - q)) / q).clamp(0.0, 1.0);
+            let next = if k + 1 < turns { depth(r, k + 1) } else { end };
+            depth(r, k) + ramp * (next - depth(r, k))
+        } else if step.is_some() {
+            // The last point, where the closing half turn begins.
+            end
+        } else if k == 0 || turns == 1 {
             start + sigma * first
         } else {
             start + first + (k as f64 - 1.0 + sigma) * (end - start - first) / (turns - 1) as f64
@@ -903,7 +1034,7 @@ fn ray_spiral(rays: &[Ray], turns: usize, beads: FloorBeads) -> (Vec<[f64; 2]>, 
         let far_enough = pts
             .last()
             .is_none_or(|q| norm(p[0] - q[0], p[1] - q[1]) >= keep);
-        if far_enough || step == total {
+        if far_enough || at == total {
             pts.push(p);
             turn_of.push(k as u32);
         }

@@ -765,3 +765,57 @@ fn a_cone_leaning_out_from_its_foot_stands_flush_on_its_floor() {
         "the foot steps by up to {worst:.2} mm: {steps:?}"
     );
 }
+
+#[test]
+fn an_elongated_oval_stands_flush_on_a_floor_along_rays() {
+    // A random oval, 106 × 45 mm (seed 61, vessel 142): its offsets a
+    // pitch apart end in thin lenses whose sides come within the least
+    // gap, so no stepped ring walk kept its turns apart, and the floor was
+    // the rays' blended spiral, from half a pitch outside the outline to
+    // half a pitch inside: 57 of 72 bins beyond ±0.3 mm, −2.0 to +1.8.
+    // The rays stepped as the rings are keep the outermost turn on it.
+    let text = r#"{"sweepclay": 1, "name": "long oval",
+      "profile_start": {"control_points": [[0, 0], [7.35, 14.14], [0, 28.29]]},
+      "profile_end": {"control_points": [[0, 0], [-0.6, 15.35], [0, 30.7]]},
+      "trajectory": {"control_points": [[54.375, 5.868], [38.838, 21.655],
+        [1.327, 28.194], [-36.184, 21.655], [-51.721, 5.868],
+        [-36.184, -9.919], [1.327, -16.458], [38.838, -9.919]],
+        "closed": true, "offset": "normal"},
+      "params": {"floor_layers": 1},
+      "printer": {"name": "wide", "build_volume": [300, 300, 250], "origin": [150, 150]}}"#;
+    let s = slice(&Design::from_json(text).expect("valid")).expect("slices");
+    let steps = foot_steps(&s);
+    assert!(steps.len() >= 70, "{} bins", steps.len());
+    let beyond = steps.iter().filter(|d| d.abs() > 0.3).count();
+    assert!(beyond <= 2, "{beyond} bins beyond ±0.3 mm: {steps:?}");
+}
+
+#[test]
+fn a_floor_is_not_stepped_along_rays_slanting_at_the_walls_start() {
+    // Seed 3's case 1,235 of `random_vessels_print_in_clay`: a 106 × 46 mm
+    // oval with six shallow lobes, three floor layers. The ray from the
+    // wall's start ran nearly along the outline round the spine's end;
+    // stepped along it, the floor's last step ended a bead along the wall
+    // from where it began, and the wall's first two beads rested on less
+    // than half their width. Such rays are not walked stepped.
+    let l = Loop {
+        shape: 1,
+        rx: 53.164225783954485,
+        ry: 23.042513385847904,
+        lobes: 6,
+        depth: 0.05806219365454452,
+        centre: (0.0, 0.0),
+        normal: true,
+    };
+    let v = serde_json::json!({
+        "sweepclay": 1, "name": "lobed oval",
+        "profile_start": profile(24.68028131554854, -5.557182687701134),
+        "profile_end": profile(24.68028131554854, -5.557182687701134),
+        "trajectory": trajectory(&l),
+        "params": { "floor_layers": 3 },
+        "printer": { "name": "wide", "build_volume": [300.0, 300.0, 200.0], "origin": [150.0, 150.0] },
+    });
+    let s = slice(&Design::from_json(&v.to_string()).unwrap()).expect("slices");
+    let r = common::check_full(&s);
+    assert!(r.printable, "{}", r.render());
+}
