@@ -180,9 +180,9 @@ pub fn spiral_floor_covering(
     // (a cone leaning 46° from its foot kept 555 of 1,364 mm).
     let steps = INNER_STEP_WIDTHS
         .iter()
-        .flat_map(|&inner| STEP_WIDTHS.map(|outer| Some(Step { outer, inner })))
-        .map(|s| s.map(|s| s.times(beads.width)));
-    let steps = steps.filter(|_| flush).chain([None]);
+        .flat_map(|&inner| STEP_WIDTHS.map(|outer| Some(Step { outer, inner }.times(beads.width))))
+        .filter(|_| flush)
+        .chain([None]);
     // The offsets cost most (i_overlay): the rings on the outline serve
     // both step lengths; the blended turns' are computed only if reached.
     let on_outline = if flush {
