@@ -180,17 +180,10 @@ pub fn spiral_floor_covering(
     // (a cone leaning 46° from its foot kept 555 of 1,364 mm).
     let steps = INNER_STEP_WIDTHS
         .iter()
-        .flat_map(|&inner| STEP_WIDTHS.map(|outer| Some(Step { outer, inner }.times(beads.width))))
-        .filter(|_| flush)
-        .chain([None]);
-    // The offsets cost most (i_overlay): the rings on the outline serve
-    // both step lengths; the blended turns' are computed only if reached.
-    let on_outline = if flush {
-        offset_rings(outer, beads, 0.0)
-    } else {
-        None
+        .flat_map(|&inner| STEP_WIDTHS.map(|outer| Step { outer, inner }.times(beads.width)));
+    let covers = |best: &Option<(f64, Measured)>, share: f64| {
+        best.as_ref().is_some_and(|(c, _)| *c >= share)
     };
-    let mut stepped_kept = false;
     // The rays to each candidate spine, nearest and along the normals,
     // found once and only if the rings' steps do not serve.
     let ray_families = std::cell::OnceCell::new();
@@ -202,18 +195,30 @@ pub fn spiral_floor_covering(
                 .collect::<Vec<Vec<Ray>>>()
         })
     };
-    for step in steps {
-        // The steps differ only in the outermost turn's: once one keeps
-        // its turns apart, the other covers the same.
-        if step.is_some() && stepped_kept {
-            continue;
+    if flush {
+        // The offsets cost most (i_overlay): the rings on the outline
+        // serve every step length.
+        if let Some(rings) = offset_rings(outer, beads, 0.0) {
+            for step in steps {
+                let Some(m) = offset_spiral(outer, beads, &rings, Some(step)) else {
+                    continue;
+                };
+                // The steps differ only in their length: once one keeps
+                // its turns apart, the others cover the same.
+                let kept = m.closest.1 >= MIN_GAP * pitch;
+                if consider(m, &mut best) && covers(&best, WHOLE) {
+                    return Ok(best.expect("just kept").1.spiral);
+                }
+                if kept {
+                    break;
+                }
+            }
         }
         // Where the rings' steps did not serve (an elongated oval's
         // offsets end in thin lenses whose sides meet, and the walk is cut
         // there), the rays to a spine are stepped the same way: flush at
         // the foot.
-        let flush_enough = best.as_ref().is_some_and(|(c, _)| *c >= FLUSH_ENOUGH);
-        if step.is_none() && flush && !flush_enough {
+        if !covers(&best, FLUSH_ENOUGH) {
             for rays in families() {
                 for outer_step in STEP_WIDTHS {
                     let step = Step {
@@ -226,28 +231,20 @@ pub fn spiral_floor_covering(
                 }
             }
         }
-        // A flush spiral that covers nearly all is kept over a blended
-        // one that covers a little more.
-        if step.is_none() && best.as_ref().is_some_and(|(c, _)| *c >= FLUSH_ENOUGH) {
-            return Ok(best.expect("just kept").1.spiral);
-        }
-        let blended;
-        let rings = match step {
-            Some(_) => on_outline.as_deref(),
-            None => {
-                blended = offset_rings(outer, beads, OUTER_START);
-                blended.as_deref()
-            }
-        };
-        let Some(m) = rings.and_then(|r| offset_spiral(outer, beads, r, step)) else {
-            continue;
-        };
-        stepped_kept |= step.is_some() && m.closest.1 >= MIN_GAP * pitch;
-        // An offset spiral ends round its last offset: a thin lens there
-        // (an oval's) stays bare, a hole under 1 % of the floor. Where it
-        // covers less than all, the rays, which close over their spine,
-        // are tried too.
-        if consider(m, &mut best) && best.as_ref().is_some_and(|(c, _)| *c >= WHOLE) {
+    }
+    // A flush spiral that covers nearly all is kept over a blended one
+    // that covers a little more.
+    if covers(&best, FLUSH_ENOUGH) {
+        return Ok(best.expect("just kept").1.spiral);
+    }
+    // An offset spiral ends round its last offset: a thin lens there (an
+    // oval's) stays bare, a hole under 1 % of the floor. Where it covers
+    // less than all, the rays, which close over their spine, are tried
+    // too.
+    let blended =
+        offset_rings(outer, beads, OUTER_START).and_then(|r| offset_spiral(outer, beads, &r, None));
+    if let Some(m) = blended {
+        if consider(m, &mut best) && covers(&best, WHOLE) {
             return Ok(best.expect("just kept").1.spiral);
         }
     }
@@ -257,7 +254,7 @@ pub fn spiral_floor_covering(
             last_refusal = FloorRefusal::TooNarrow { half_width };
             continue;
         };
-        if consider(m, &mut best) && best.as_ref().is_some_and(|(c, _)| *c >= WHOLE) {
+        if consider(m, &mut best) && covers(&best, WHOLE) {
             return Ok(best.expect("just kept").1.spiral);
         }
     }
@@ -479,14 +476,13 @@ fn offset_spiral(
     if pts.len() < 2 || (step.is_some() && path_length(&pts) < MIN_COVER * walked) {
         return None;
     }
-    let deep = if step.is_some() {
-        outermost_depths(&pts, &turn_of, outer, beads)
-    } else {
-        vec![]
-    };
-    let mut m = measure_path(pts, turn_of, turns, beads);
-    widen_steps(&mut m, deep, beads);
-    Some(m)
+    Some(measure_widened(
+        pts,
+        turn_of,
+        turns,
+        beads,
+        step.map(|_| outer),
+    ))
 }
 
 /// Where the outermost turn steps in to the next, its beads widen to
@@ -896,23 +892,30 @@ struct Measured {
 
 /// The spiral of `turns` turns along `rays`, its points thinned to about
 /// the outer turn's spacing, its gaps and widths measured.
-fn measure(rays: &[Ray], turns: usize, beads: FloorBeads, step: Option<Step>) -> Measured {
+/// `outline`: the rays' feet, where a stepped spiral's outermost turn
+/// lies.
+fn measure(
+    rays: &[Ray],
+    turns: usize,
+    beads: FloorBeads,
+    step: Option<Step>,
+    outline: Option<&[[f64; 2]]>,
+) -> Measured {
     let (pts, turn_of) = ray_spiral(rays, turns, beads, step);
-    stepped_widths(pts, turn_of, turns + 1, beads, step.map(|_| rays))
+    measure_widened(pts, turn_of, turns + 1, beads, outline)
 }
 
 /// [`measure_path`], the outermost turn's step beads widened to keep
 /// their outer edge on the outline's where a stepped spiral's outermost
-/// turn lies on it (`outer` given).
-fn stepped_widths(
+/// turn lies on it (`outline` given).
+fn measure_widened(
     pts: Vec<[f64; 2]>,
     turn_of: Vec<u32>,
     turns: usize,
     beads: FloorBeads,
-    outer: Option<&[Ray]>,
+    outline: Option<&[[f64; 2]]>,
 ) -> Measured {
-    let outline: Option<Vec<[f64; 2]>> = outer.map(|r| r.iter().map(|r| r.from).collect());
-    let deep = match &outline {
+    let deep = match outline {
         Some(o) => outermost_depths(&pts, &turn_of, o, beads),
         None => vec![],
     };
@@ -949,9 +952,10 @@ fn ray_floor(rays: &[Ray], beads: FloorBeads, step: Option<Step>) -> Option<Meas
     if short < pitch {
         return None;
     }
+    let outline: Option<Vec<[f64; 2]>> = step.map(|_| rays.iter().map(|r| r.from).collect());
     let mut turns = ((short / pitch).floor() as usize).clamp(1, MAX_FLOOR_TURNS);
     loop {
-        let m = measure(rays, turns, beads, step);
+        let m = measure(rays, turns, beads, step, outline.as_deref());
         if m.closest.1 < MIN_GAP * pitch && turns > 1 {
             turns -= 1;
             continue;
@@ -1020,8 +1024,11 @@ fn ray_spiral(
         let end = r.len - 0.5 * pitch;
         let s = if let Some(&q) = shares.get(k) {
             let ramp = ((sigma - (1.0 - q)) / q).clamp(0.0, 1.0);
-            let next = if k + 1 < turns { depth(r, k + 1) } else { end };
-            depth(r, k) + ramp * (next - depth(r, k))
+            let (here, next) = (
+                depth(r, k),
+                if k + 1 < turns { depth(r, k + 1) } else { end },
+            );
+            here + ramp * (next - here)
         } else if step.is_some() {
             // The last point, where the closing half turn begins.
             end

@@ -708,6 +708,22 @@ fn foot_steps(s: &sweepclay_core::Sliced) -> Vec<f64> {
         .collect()
 }
 
+/// [`foot_steps`] of a sliced design, read all round (70 bins or more).
+fn foot_steps_all_round(s: &sweepclay_core::Sliced) -> Vec<f64> {
+    let steps = foot_steps(s);
+    assert!(steps.len() >= 70, "{} bins", steps.len());
+    steps
+}
+
+/// Asserts the foot steps by at most 0.3 mm in every bin.
+fn assert_flush(steps: &[f64]) {
+    let worst = steps.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
+    assert!(
+        worst <= 0.3,
+        "the foot steps by up to {worst:.2} mm: {steps:?}"
+    );
+}
+
 #[test]
 fn a_foot_under_a_wall_leaning_out_is_flush_with_its_wider_first_turn() {
     // The bundled bowl leans out from its foot. Its first turn was laid
@@ -732,13 +748,7 @@ fn a_foot_under_a_wall_leaning_out_is_flush_with_its_wider_first_turn() {
         "{}",
         s.extrusion.width[first]
     );
-    let steps = foot_steps(&s);
-    assert!(steps.len() >= 70, "{} bins", steps.len());
-    let worst = steps.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
-    assert!(
-        worst <= 0.3,
-        "the foot steps by up to {worst:.2} mm: {steps:?}"
-    );
+    assert_flush(&foot_steps_all_round(&s));
 }
 
 #[test]
@@ -756,13 +766,7 @@ fn a_cone_leaning_out_from_its_foot_stands_flush_on_its_floor() {
         [0, -42.666], [30.169, -30.169]], "closed": true},
       "params": {"floor_layers": 3}, "printer": "cerambot-plus"}"#;
     let s = slice(&Design::from_json(text).expect("valid")).expect("slices");
-    let steps = foot_steps(&s);
-    assert!(steps.len() >= 70, "{} bins", steps.len());
-    let worst = steps.iter().fold(0.0_f64, |m, d| m.max(d.abs()));
-    assert!(
-        worst <= 0.3,
-        "the foot steps by up to {worst:.2} mm: {steps:?}"
-    );
+    assert_flush(&foot_steps_all_round(&s));
 }
 
 #[test]
@@ -783,8 +787,7 @@ fn an_elongated_oval_stands_flush_on_a_floor_along_rays() {
       "params": {"floor_layers": 1},
       "printer": {"name": "wide", "build_volume": [300, 300, 250], "origin": [150, 150]}}"#;
     let s = slice(&Design::from_json(text).expect("valid")).expect("slices");
-    let steps = foot_steps(&s);
-    assert!(steps.len() >= 70, "{} bins", steps.len());
+    let steps = foot_steps_all_round(&s);
     let beyond = steps.iter().filter(|d| d.abs() > 0.3).count();
     assert!(beyond <= 2, "{beyond} bins beyond ±0.3 mm: {steps:?}");
 }
